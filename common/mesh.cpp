@@ -1,0 +1,96 @@
+#include "common/mesh.h"
+
+#include <cmath>
+
+#include "common/errors.h"
+
+namespace meshmend {
+
+void Mesh::copyFrom(const Mesh& other) {
+  using Allocator = vcg::tri::Allocator<Mesh>;
+  Mesh& source = const_cast<Mesh&>(other);  // vcglib 2020.09's Append takes non-const meshes
+  Clear();
+  ClearAttributes();
+  // Append copies the attributes present in both meshes: create ours first.
+  if (Allocator::IsValidHandle(source, Allocator::FindPerVertexAttribute<VertexOrigin>(
+                                           source, kVertexOriginAttribute)))
+    vertexOrigins(*this);
+  if (Allocator::IsValidHandle(
+          source, Allocator::FindPerFaceAttribute<FaceOrigin>(source, kFaceOriginAttribute)))
+    faceOrigins(*this);
+  vcg::tri::Append<Mesh, Mesh>::MeshCopy(*this, source);
+}
+
+VertexOriginHandle vertexOrigins(Mesh& mesh) {
+  return vcg::tri::Allocator<Mesh>::GetPerVertexAttribute<VertexOrigin>(mesh,
+                                                                        kVertexOriginAttribute);
+}
+
+FaceOriginHandle faceOrigins(Mesh& mesh) {
+  return vcg::tri::Allocator<Mesh>::GetPerFaceAttribute<FaceOrigin>(mesh, kFaceOriginAttribute);
+}
+
+namespace {
+
+bool isFinite(const Point3& p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+}  // namespace
+
+Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
+              int layer) {
+  const int n = int(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (!isFinite(positions[i]))
+      throw InvalidInputError("vertex " + std::to_string(i) +
+                              " has a non-finite coordinate (NaN or infinity); remove or "
+                              "repair it first");
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int v : triangles[f])
+      if (v < 0 || v >= n)
+        throw InvalidInputError("face " + std::to_string(f) + " refers to vertex " +
+                                std::to_string(v) + ", but the mesh has only " +
+                                std::to_string(n) + " vertices");
+
+  Mesh mesh;
+  auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i, ++vi) vi->P() = positions[i];
+  auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f, ++fi)
+    for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[triangles[f][k]];
+
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  for (std::size_t i = 0; i < mesh.vert.size(); ++i) vo[i] = VertexOrigin{layer, int(i), -1, {}};
+  FaceOriginHandle fo = faceOrigins(mesh);
+  for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
+  return mesh;
+}
+
+std::vector<Point3> positionsOf(const Mesh& mesh) {
+  std::vector<Point3> out;
+  out.reserve(mesh.vert.size());
+  for (const Vertex& v : mesh.vert) out.push_back(v.cP());
+  return out;
+}
+
+std::vector<Triangle> trianglesOf(const Mesh& mesh) {
+  std::vector<Triangle> out;
+  out.reserve(mesh.face.size());
+  for (const Face& f : mesh.face)
+    out.push_back({int(vcg::tri::Index(mesh, f.cV(0))), int(vcg::tri::Index(mesh, f.cV(1))),
+                   int(vcg::tri::Index(mesh, f.cV(2)))});
+  return out;
+}
+
+void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what) {
+  if (mesh.fn == 0)
+    throw InvalidInputError(what + " has no faces: load or select a triangle mesh");
+  for (std::size_t i = 0; i < mesh.vert.size(); ++i)
+    if (!mesh.vert[i].IsD() && !isFinite(mesh.vert[i].cP()))
+      throw InvalidInputError(what + ": vertex " + std::to_string(i) +
+                              " has a non-finite coordinate (NaN or infinity); run "
+                              "\"Remove Unreferenced Vertices\" or repair the file first");
+}
+
+}  // namespace meshmend

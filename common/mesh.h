@@ -1,0 +1,88 @@
+// The core mesh type: a vcglib triangle mesh in double precision, and the
+// provenance every output element carries back to the input it came from.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <vcg/complex/complex.h>
+
+namespace meshmend {
+
+class Vertex;
+class Face;
+struct UsedTypes : public vcg::UsedTypes<vcg::Use<Vertex>::AsVertexType,
+                                         vcg::Use<Face>::AsFaceType> {};
+
+class Vertex : public vcg::Vertex<UsedTypes, vcg::vertex::Coord3d, vcg::vertex::Normal3d,
+                                  vcg::vertex::BitFlags, vcg::vertex::VFAdj, vcg::vertex::Mark> {};
+
+class Face : public vcg::Face<UsedTypes, vcg::face::VertexRef, vcg::face::Normal3d,
+                              vcg::face::BitFlags, vcg::face::FFAdj, vcg::face::VFAdj,
+                              vcg::face::Mark> {};
+
+// vcglib meshes are not copyable; this one copies its elements and every
+// per-element attribute (provenance included) through vcg::tri::Append.
+class Mesh : public vcg::tri::TriMesh<std::vector<Vertex>, std::vector<Face>> {
+ public:
+  Mesh() = default;
+  Mesh(const Mesh& other) : TriMesh() { copyFrom(other); }
+  Mesh& operator=(const Mesh& other) {
+    if (this != &other) copyFrom(other);
+    return *this;
+  }
+
+ private:
+  void copyFrom(const Mesh& other);
+};
+
+using Point3 = vcg::Point3d;
+using Triangle = std::array<int, 3>;
+
+// Where an output vertex comes from. Either an input vertex (`vertex` >= 0), or
+// a new point on input face `face` of layer `layer` at barycentric coordinates
+// `barycentric` (weights of that face's three corners), so that the MeshLab
+// bridge can interpolate colours, quality, normals and texture coordinates.
+struct VertexOrigin {
+  int layer = -1;       // input layer (index into the inputs of the operation)
+  int vertex = -1;      // input vertex index, or -1 for a new vertex
+  int face = -1;        // for a new vertex: the input face it lies on
+  Point3 barycentric{0, 0, 0};
+};
+
+// Where an output face comes from: the input face it was cut from (or that it
+// copies), or -1 for a face that fills space no input face covered (hole
+// patches, stitches).
+struct FaceOrigin {
+  int layer = -1;
+  int face = -1;
+};
+
+// Names of the persistent vcglib attributes that hold provenance.
+inline constexpr const char* kVertexOriginAttribute = "meshmend_vertex_origin";
+inline constexpr const char* kFaceOriginAttribute = "meshmend_face_origin";
+
+using VertexOriginHandle = Mesh::PerVertexAttributeHandle<VertexOrigin>;
+using FaceOriginHandle = Mesh::PerFaceAttributeHandle<FaceOrigin>;
+
+// Provenance attributes of a mesh, created (with default values) if missing.
+VertexOriginHandle vertexOrigins(Mesh& mesh);
+FaceOriginHandle faceOrigins(Mesh& mesh);
+
+// Builds a mesh from arrays; every vertex and face records itself as its own
+// origin in `layer`. Throws InvalidInputError when a face refers to a vertex
+// index out of range or a coordinate is not finite (the message names the
+// first offending element).
+Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
+              int layer = 0);
+
+// Vertex positions and face corner indices of a compact mesh (no deleted elements).
+std::vector<Point3> positionsOf(const Mesh& mesh);
+std::vector<Triangle> trianglesOf(const Mesh& mesh);
+
+// Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh
+// has no faces or a non-finite coordinate.
+void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what);
+
+}  // namespace meshmend

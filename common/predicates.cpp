@@ -1,0 +1,86 @@
+#include "common/predicates.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gmpxx.h>
+
+namespace meshmend {
+
+namespace {
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon() / 2;  // 2^-53
+// Shewchuk's forward error bounds for the rounded determinants.
+constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+// Below this magnitude products may underflow and the bounds no longer hold.
+constexpr double kUnderflowGuard = 1e-250;
+
+int sign(const mpq_class& q) { return sgn(q); }
+
+}  // namespace
+
+namespace exact {
+
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+  const mpq_class acx = mpq_class(ax) - mpq_class(cx), bcx = mpq_class(bx) - mpq_class(cx);
+  const mpq_class acy = mpq_class(ay) - mpq_class(cy), bcy = mpq_class(by) - mpq_class(cy);
+  return sign(acx * bcy - acy * bcx);
+}
+
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  mpq_class m[3][3];
+  for (int k = 0; k < 3; ++k) {
+    m[0][k] = mpq_class(b[k]) - mpq_class(a[k]);
+    m[1][k] = mpq_class(c[k]) - mpq_class(a[k]);
+    m[2][k] = mpq_class(d[k]) - mpq_class(a[k]);
+  }
+  const mpq_class det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                        m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                        m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  return sign(det);
+}
+
+}  // namespace exact
+
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+  const double left = (ax - cx) * (by - cy);
+  const double right = (ay - cy) * (bx - cx);
+  const double det = left - right;
+  const double sum = std::fabs(left) + std::fabs(right);
+  const double bound = kOrient2dBound * sum;
+  if (std::isfinite(det) && sum > kUnderflowGuard) {
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  } else if (left == 0 && right == 0 && ((ax == cx || by == cy) && (ay == cy || bx == cx))) {
+    return 0;  // both products exactly zero because a factor is exactly zero
+  }
+  return exact::orient2d(ax, ay, bx, by, cx, cy);
+}
+
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+  const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
+  const double m1 = cy * dz - cz * dy, m2 = cx * dz - cz * dx, m3 = cx * dy - cy * dx;
+  const double det = bx * m1 - by * m2 + bz * m3;
+  const double permanent = (std::fabs(cy * dz) + std::fabs(cz * dy)) * std::fabs(bx) +
+                           (std::fabs(cx * dz) + std::fabs(cz * dx)) * std::fabs(by) +
+                           (std::fabs(cx * dy) + std::fabs(cy * dx)) * std::fabs(bz);
+  const double bound = kOrient3dBound * permanent;
+  if (std::isfinite(det) && permanent > kUnderflowGuard) {
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return exact::orient3d(a, b, c, d);
+}
+
+bool collinear(const Point3& a, const Point3& b, const Point3& c) {
+  // The cross product (b-a)x(c-a) vanishes exactly iff its three components,
+  // the orientations of the projections onto the three coordinate planes, do.
+  return orient2d(a[0], a[1], b[0], b[1], c[0], c[1]) == 0 &&
+         orient2d(a[1], a[2], b[1], b[2], c[1], c[2]) == 0 &&
+         orient2d(a[2], a[0], b[2], b[0], c[2], c[0]) == 0;
+}
+
+}  // namespace meshmend

@@ -1,0 +1,32 @@
+// Exact geometric predicates on double coordinates (DESIGN §4).
+//
+// Each predicate first evaluates in floating point with a static/semi-static
+// error bound (Shewchuk's bounds for the rounded determinant); only when the
+// bound cannot certify the sign does it fall back to exact rational arithmetic
+// (GMP). The sign returned is always the sign of the exact determinant of the
+// given doubles.
+#pragma once
+
+#include "common/mesh.h"
+
+namespace meshmend {
+
+// Sign of the 2-D orientation determinant of (a, b, c): +1 when c lies to the
+// left of the directed line a->b (counter-clockwise), -1 right, 0 collinear.
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
+
+// Sign of det[b-a, c-a, d-a]: +1 when d lies on the side of the plane through
+// a, b, c that the normal (b-a)x(c-a) points to, -1 on the other side, 0 when
+// the four points are coplanar.
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+
+// Exact: are the three points collinear (including coincident points)?
+bool collinear(const Point3& a, const Point3& b, const Point3& c);
+
+namespace exact {
+// Pure-GMP evaluations, used as the fallback and as the reference in tests.
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+}  // namespace exact
+
+}  // namespace meshmend

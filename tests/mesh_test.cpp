@@ -1,0 +1,73 @@
+#include "common/mesh.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "mesh_builders.h"
+
+namespace meshmend {
+namespace {
+
+TEST(Mesh, MakeMeshRecordsItselfAsOrigin) {
+  Mesh m = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}, 3);
+  ASSERT_EQ(m.vn, 3);
+  ASSERT_EQ(m.fn, 1);
+  VertexOriginHandle vo = vertexOrigins(m);
+  FaceOriginHandle fo = faceOrigins(m);
+  EXPECT_EQ(vo[2].layer, 3);
+  EXPECT_EQ(vo[2].vertex, 2);
+  EXPECT_EQ(fo[0].layer, 3);
+  EXPECT_EQ(fo[0].face, 0);
+}
+
+TEST(Mesh, ArraysRoundTrip) {
+  const Mesh m = testing::box(1, 2, 3);
+  const Mesh copy = makeMesh(positionsOf(m), trianglesOf(m));
+  EXPECT_EQ(positionsOf(copy), positionsOf(m));
+  EXPECT_EQ(trianglesOf(copy), trianglesOf(m));
+}
+
+TEST(Mesh, ProvenanceSurvivesAddingElements) {
+  Mesh m = testing::tetrahedron();
+  vcg::tri::Allocator<Mesh>::AddVertices(m, 10);
+  vcg::tri::Allocator<Mesh>::AddFaces(m, 10);
+  EXPECT_EQ(vertexOrigins(m)[3].vertex, 3);
+  EXPECT_EQ(faceOrigins(m)[3].face, 3);
+  EXPECT_EQ(vertexOrigins(m)[12].vertex, -1);
+}
+
+TEST(Mesh, RejectsIndexOutOfRange) {
+  try {
+    makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 7}});
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("face 0 refers to vertex 7"), std::string::npos);
+  }
+  EXPECT_THROW(makeMesh({{0, 0, 0}}, {{0, 0, -1}}), InvalidInputError);
+}
+
+TEST(Mesh, RejectsNonFiniteCoordinates) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(makeMesh({{0, 0, 0}, {nan, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}), InvalidInputError);
+  EXPECT_THROW(makeMesh({{0, 0, inf}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}), InvalidInputError);
+}
+
+TEST(Mesh, RequireFacesNamesTheLayer) {
+  try {
+    requireFacesAndFiniteCoordinates(Mesh(), "layer 'empty'");
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("layer 'empty' has no faces"), std::string::npos);
+  }
+  Mesh m = testing::tetrahedron();
+  m.vert[1].P()[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(requireFacesAndFiniteCoordinates(m, "x"), InvalidInputError);
+  EXPECT_NO_THROW(requireFacesAndFiniteCoordinates(testing::tetrahedron(), "x"));
+}
+
+}  // namespace
+}  // namespace meshmend
