@@ -1,0 +1,64 @@
+// What every MeshMend plugin needs around a core call: strings, progress,
+// errors that leave the document untouched, the report file, and notes about
+// what MeshLab's importer did to a layer.
+#pragma once
+
+#include <exception>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <QString>
+#include <common/meshmodel.h>
+
+#include "common/errors.h"
+#include "common/json.h"
+#include "common/progress.h"
+
+namespace meshmend::bridge {
+
+inline std::string toStd(const QString& s) { return s.toStdString(); }
+inline QString toQ(const std::string& s) { return QString::fromStdString(s); }
+
+// The layer's name as users see it in the layer dialog, quoted.
+inline std::string layerName(const MeshModel& m) { return "layer '" + toStd(m.label()) + "'"; }
+
+// MeshLab's progress callback as a core Progress (null callback: no reports).
+inline Progress progressFrom(vcg::CallBackPos* cb) {
+  return [cb](int percent, const char* stage) { return cb ? cb(percent, stage) : true; };
+}
+
+// Runs `body`, which must compute everything first and change the document
+// only at its end. Errors become `errorMessage` (shown by MeshLab) and false.
+template <class Body>
+bool guarded(QString& errorMessage, Body&& body) {
+  try {
+    body();
+    return true;
+  } catch (const meshmend::Error& e) {
+    errorMessage = QString::fromUtf8(e.what());
+  } catch (const std::bad_alloc&) {
+    errorMessage = "out of memory: the mesh is too large for this machine's memory";
+  } catch (const std::exception& e) {
+    errorMessage = QString("internal error: ") + e.what() +
+                   " (please report it with the input mesh); the layer was not changed";
+  }
+  return false;
+}
+
+// Writes `report` to `path` when it is not empty (throws InvalidInputError
+// with the path when it cannot be written).
+void writeReport(const QString& path, const JsonObject& report);
+
+// What MeshLab's importer did to a layer, found by comparing the vertex and
+// face counts in the file's header (OFF, PLY, STL, OBJ) with the layer's:
+// triangulated polygons, converted triangle strips, removed degenerate faces,
+// vertices of STL facets. Empty when the counts agree or the file is not known.
+struct ImportNotes {
+  long file_vertices = -1;  // -1: unknown
+  long file_faces = -1;
+  std::vector<std::string> notes;
+};
+ImportNotes importNotes(const MeshModel& model);
+
+}  // namespace meshmend::bridge

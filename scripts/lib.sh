@@ -1,0 +1,23 @@
+# Shared by the scripts in this folder: paths, messages, root helpers.
+# shellcheck shell=bash
+MESHMEND_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${MESHMEND_BUILD_DIR:-$MESHMEND_ROOT/build}"
+PREFIX="$BUILD_DIR/meshlab-prefix"          # private MeshLab with our plugins
+DEPS_DIR="$MESHMEND_ROOT/.deps"              # unpacked MeshLab source (ignored by git)
+SHARED_DIR="$(cd "$MESHMEND_ROOT/.." && pwd)/shared"
+SYSTEM_MESHLAB_LIB=/usr/lib/x86_64-linux-gnu/meshlab
+JOBS="${MESHMEND_JOBS:-$(nproc)}"
+
+say() { printf '\033[1m==> %s\033[0m\n' "$*"; }
+note() { printf '    %s\n' "$*"; }
+die() { printf 'error: %s\n' "$*" >&2; exit 1; }
+
+# Runs a command as root (directly, or through sudo when available).
+as_root() {
+  if [ "$(id -u)" = 0 ]; then "$@"
+  elif command -v sudo >/dev/null; then sudo "$@"
+  else die "root is needed to run: $* (install the packages listed in scripts/setup, or run as root)"
+  fi
+}
+
+seconds_since() { echo $(( $(date +%s) - $1 )); }
