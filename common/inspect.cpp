@@ -212,13 +212,24 @@ class Inspector {
   }
 
   void geometry() {
-    if (!P_.empty()) {
-      r_.bbox = {P_[0][0], P_[0][1], P_[0][2], P_[0][0], P_[0][1], P_[0][2]};
-      for (const Point3& p : P_)
-        for (int k = 0; k < 3; ++k) {
-          r_.bbox[k] = std::min(r_.bbox[k], p[k]);
-          r_.bbox[k + 3] = std::max(r_.bbox[k + 3], p[k]);
-        }
+    std::vector<bool> finite(P_.size());
+    bool anyFinite = false;
+    for (std::size_t i = 0; i < P_.size(); ++i) {
+      const Point3& p = P_[i];
+      finite[i] = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+      if (!finite[i]) {
+        ++r_.non_finite_vertices;
+        markVertex(i, kVertexNonFinite);
+        continue;
+      }
+      if (!anyFinite) r_.bbox = {p[0], p[1], p[2], p[0], p[1], p[2]};
+      anyFinite = true;
+      for (int k = 0; k < 3; ++k) {
+        r_.bbox[k] = std::min(r_.bbox[k], p[k]);
+        r_.bbox[k + 3] = std::max(r_.bbox[k + 3], p[k]);
+      }
+    }
+    if (anyFinite) {
       const double dx = r_.bbox[3] - r_.bbox[0], dy = r_.bbox[4] - r_.bbox[1],
                    dz = r_.bbox[5] - r_.bbox[2];
       r_.bbox_diagonal = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -233,6 +244,7 @@ class Inspector {
     };
     for (std::size_t f = 0; f < T_.size(); ++f) {
       const Triangle& t = T_[f];
+      if (!finite[t[0]] || !finite[t[1]] || !finite[t[2]]) continue;  // no geometry to judge
       const Point3 &a = P_[t[0]], &b = P_[t[1]], &c = P_[t[2]];
       volume6 += (a - center) * ((b - center) ^ (c - center));
       const bool repeated = t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || a == b || b == c ||
@@ -251,7 +263,7 @@ class Inspector {
     r_.mean_min_angle_deg = angleCount ? sumMinAngle / double(angleCount) : 0;
     const bool edgeManifoldOriented =
         r_.is_closed && r_.consistently_oriented && r_.non_manifold_edges == 0;
-    if (edgeManifoldOriented) r_.volume = volume6 / 6.0;
+    if (edgeManifoldOriented && r_.non_finite_vertices == 0) r_.volume = volume6 / 6.0;
     if (edgeManifoldOriented && vertexManifold_ && r_.euler_characteristic % 2 == 0)
       r_.genus = (2 * long(r_.connected_components) - r_.euler_characteristic) / 2;
   }
@@ -292,6 +304,7 @@ JsonObject toJson(const InspectResult& r) {
       .set("non_manifold_vertices", r.non_manifold_vertices)
       .set("isolated_vertices", r.isolated_vertices)
       .set("duplicate_points", r.duplicate_points)
+      .set("non_finite_vertices", r.non_finite_vertices)
       .set("degenerate_faces", r.degenerate_faces)
       .set("duplicate_faces", r.duplicate_faces)
       .set("is_closed", r.is_closed)
@@ -328,6 +341,7 @@ std::string summarize(const InspectResult& r) {
   add(r.duplicate_faces, "duplicate faces");
   add(r.duplicate_points, "duplicate points");
   add(r.isolated_vertices, "unreferenced vertices");
+  add(r.non_finite_vertices, "vertices with NaN or infinite coordinates");
   if (defects.empty()) {
     s << "no defects";
   } else {

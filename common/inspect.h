@@ -33,6 +33,7 @@ enum VertexDefect : std::uint8_t {
   kVertexOnBorder = 2,     // on a border edge
   kVertexIsolated = 4,     // used by no face
   kVertexDuplicate = 8,    // same coordinates as an earlier vertex
+  kVertexNonFinite = 16,   // a coordinate is NaN or infinite
 };
 
 struct InspectResult {
@@ -47,15 +48,16 @@ struct InspectResult {
   std::size_t non_manifold_vertices = 0;           // pinch / bow-tie vertices
   std::size_t isolated_vertices = 0;               // vertices used by no face
   std::size_t duplicate_points = 0;                // vertices repeating an earlier one's coordinates
+  std::size_t non_finite_vertices = 0;             // NaN or infinite coordinates (geometry skips them)
   std::size_t degenerate_faces = 0;                // exact: repeated vertex or collinear
   std::size_t duplicate_faces = 0;                 // same vertex set as an earlier face
   std::size_t orientation_inconsistent_edges = 0;  // two faces run the edge the same way
   bool is_closed = false;                          // no border edge, at least one face
   bool consistently_oriented = true;               // orientation_inconsistent_edges == 0
-  std::optional<double> volume;  // signed; closed, oriented, edge-manifold meshes only
+  std::optional<double> volume;  // signed; closed, oriented, edge-manifold, finite meshes only
   long euler_characteristic = 0;  // used vertices - edges + faces
   std::optional<long> genus;      // closed, edge- and vertex-manifold, oriented meshes only
-  std::array<double, 6> bbox{};   // min x, y, z, max x, y, z over all vertices
+  std::array<double, 6> bbox{};   // min x, y, z, max x, y, z over all finite vertices
   double bbox_diagonal = 0;
   double min_angle_deg = 180;       // smallest interior angle
   double mean_min_angle_deg = 0;    // mean over triangles of their smallest angle

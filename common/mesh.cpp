@@ -41,11 +41,6 @@ bool isFinite(const Point3& p) {
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer) {
   const int n = int(positions.size());
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    if (!isFinite(positions[i]))
-      throw InvalidInputError("vertex " + std::to_string(i) +
-                              " has a non-finite coordinate (NaN or infinity); remove or "
-                              "repair it first");
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (int v : triangles[f])
       if (v < 0 || v >= n)

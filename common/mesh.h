@@ -72,8 +72,9 @@ FaceOriginHandle faceOrigins(Mesh& mesh);
 
 // Builds a mesh from arrays; every vertex and face records itself as its own
 // origin in `layer`. Throws InvalidInputError when a face refers to a vertex
-// index out of range or a coordinate is not finite (the message names the
-// first offending element).
+// index out of range (the message names the first such face). Coordinates are
+// not checked here: operations that need finite ones call
+// requireFacesAndFiniteCoordinates, and inspect() counts the others.
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer = 0);
 

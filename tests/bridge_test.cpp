@@ -155,6 +155,17 @@ TEST(Bridge, ToCoreSkipsDeletedElementsAndKeepsTheirSlots) {
   EXPECT_EQ(vertexOrigins(core)[1].vertex, 2);
 }
 
+TEST(Bridge, ToCoreRefusesFacesPointingOutsideTheVertexArray) {
+  MeshDocument document;
+  MeshModel* m = texturedQuad(document);
+  CVertexO* outside = &m->cm.vert.back() + 5;  // what a corrupt OFF index leaves behind
+  m->cm.face[1].V(2) = outside;
+  EXPECT_THROW(toCore(m->cm), InvalidInputError);
+  m->cm.face[1].V(2) = &m->cm.vert[3];
+  vcg::tri::Allocator<CMeshO>::DeleteVertex(m->cm, m->cm.vert[3]);
+  EXPECT_THROW(toCore(m->cm), InvalidInputError);
+}
+
 TEST(Bridge, ToCoreAppliesTheLayerMatrixWhenAsked) {
   MeshDocument document;
   MeshModel* m = texturedQuad(document);
@@ -165,10 +176,15 @@ TEST(Bridge, ToCoreAppliesTheLayerMatrixWhenAsked) {
 
 TEST(Bridge, GuardedTurnsErrorsIntoMessages) {
   QString message;
-  EXPECT_FALSE(guarded(message, [] { throw InvalidInputError("layer 'x' has no faces"); }));
+  std::string logged;
+  auto log = [&](const std::string& m) { logged = m; };
+  EXPECT_FALSE(guarded(message, [] { throw InvalidInputError("layer 'x' has no faces"); }, log));
   EXPECT_EQ(message, "layer 'x' has no faces");
-  EXPECT_TRUE(guarded(message, [] {}));
-  EXPECT_FALSE(guarded(message, [] { throw std::logic_error("boom"); }));
+  EXPECT_EQ(logged, "MeshMend error: layer 'x' has no faces");
+  logged.clear();
+  EXPECT_TRUE(guarded(message, [] {}, log));
+  EXPECT_TRUE(logged.empty());
+  EXPECT_FALSE(guarded(message, [] { throw std::logic_error("boom"); }, log));
   EXPECT_TRUE(message.contains("internal error: boom"));
 }
 

@@ -1,5 +1,7 @@
 #include "common/inspect.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
@@ -134,6 +136,19 @@ TEST(Inspect, OpenMeshHasBorderLoopsAndNoVolume) {
   EXPECT_FALSE(r.is_closed);
   EXPECT_FALSE(r.volume.has_value());
   EXPECT_FALSE(r.genus.has_value());
+}
+
+TEST(Inspect, NonFiniteVerticesAreCountedNotFatal) {
+  std::vector<Point3> p = positionsOf(tetrahedron());
+  p[3][2] = std::numeric_limits<double>::quiet_NaN();
+  const InspectResult r = inspect(makeMesh(p, trianglesOf(tetrahedron())), {true});
+  EXPECT_EQ(r.non_finite_vertices, 1u);
+  EXPECT_TRUE(r.vertex_defects[3] & kVertexNonFinite);
+  EXPECT_TRUE(r.is_closed);               // topology is still known
+  EXPECT_FALSE(r.volume.has_value());     // geometry is not
+  EXPECT_EQ(r.degenerate_faces, 0u);
+  EXPECT_EQ(r.bbox[5], 0.0);              // the box ignores the NaN vertex
+  EXPECT_NE(summarize(r).find("1 vertices with NaN"), std::string::npos);
 }
 
 TEST(Inspect, EmptyMeshIsNotClosed) {

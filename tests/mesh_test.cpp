@@ -49,11 +49,13 @@ TEST(Mesh, RejectsIndexOutOfRange) {
   EXPECT_THROW(makeMesh({{0, 0, 0}}, {{0, 0, -1}}), InvalidInputError);
 }
 
-TEST(Mesh, RejectsNonFiniteCoordinates) {
+TEST(Mesh, NonFiniteCoordinatesAreRejectedByTheCapabilityCheck) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(makeMesh({{0, 0, 0}, {nan, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}), InvalidInputError);
-  EXPECT_THROW(makeMesh({{0, 0, inf}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}), InvalidInputError);
+  const Mesh withNan = makeMesh({{0, 0, 0}, {nan, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  const Mesh withInf = makeMesh({{0, 0, inf}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  EXPECT_THROW(requireFacesAndFiniteCoordinates(withNan, "x"), InvalidInputError);
+  EXPECT_THROW(requireFacesAndFiniteCoordinates(withInf, "x"), InvalidInputError);
 }
 
 TEST(Mesh, RequireFacesNamesTheLayer) {

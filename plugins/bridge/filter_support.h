@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <QString>
+#include <common/interfaces.h>
 #include <common/meshmodel.h>
 
 #include "common/errors.h"
@@ -29,12 +30,16 @@ inline Progress progressFrom(vcg::CallBackPos* cb) {
 }
 
 // Runs `body`, which must compute everything first and change the document
-// only at its end. Errors become `errorMessage` (shown by MeshLab) and false.
-template <class Body>
-bool guarded(QString& errorMessage, Body&& body) {
+// only at its end. Errors become `errorMessage` (the GUI shows it) and are
+// also logged through `log` (meshlabserver prints only the log), and the
+// result is false.
+template <class Body, class Log>
+bool guarded(QString& errorMessage, Body&& body, Log&& log) {
   try {
     body();
     return true;
+  } catch (const meshmend::CancelledError& e) {
+    errorMessage = "cancelled: the layers were not changed";
   } catch (const meshmend::Error& e) {
     errorMessage = QString::fromUtf8(e.what());
   } catch (const std::bad_alloc&) {
@@ -43,7 +48,15 @@ bool guarded(QString& errorMessage, Body&& body) {
     errorMessage = QString("internal error: ") + e.what() +
                    " (please report it with the input mesh); the layer was not changed";
   }
+  log("MeshMend error: " + errorMessage.toStdString());
   return false;
+}
+
+// The plugin-side form: logs into the plugin's MeshLab log.
+template <class Body>
+bool guarded(MeshCommonInterface& plugin, QString& errorMessage, Body&& body) {
+  return guarded(errorMessage, std::forward<Body>(body),
+                 [&plugin](const std::string& m) { plugin.Log(m); });
 }
 
 // Writes `report` to `path` when it is not empty (throws InvalidInputError

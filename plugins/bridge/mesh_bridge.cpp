@@ -1,6 +1,9 @@
 #include "plugins/bridge/mesh_bridge.h"
 
+#include "common/errors.h"
+
 #include <cmath>
+#include <string>
 
 #include <vcg/complex/algorithms/update/bounding.h>
 #include <vcg/complex/algorithms/update/normal.h>
@@ -30,7 +33,17 @@ Mesh toCore(const CMeshO& cm, const ToCoreOptions& options) {
     const CFaceO& face = cm.face[f];
     if (face.IsD()) continue;
     Triangle t;
-    for (int k = 0; k < 3; ++k) t[k] = coreIndex[vcg::tri::Index(cm, face.cV(k))];
+    for (int k = 0; k < 3; ++k) {
+      // A corrupt file can leave pointers outside the vertex array (MeshLab's
+      // OFF importer does not check face indices): refuse, do not read them.
+      const CVertexO* v = face.cV(k);
+      const bool inside = !cm.vert.empty() && v >= &cm.vert.front() && v <= &cm.vert.back();
+      if (!inside || v->IsD())
+        throw InvalidInputError("face " + std::to_string(f) + " refers to a vertex that " +
+                                (inside ? "was deleted" : "does not exist") +
+                                ": the mesh is corrupt (check the file's face indices)");
+      t[k] = coreIndex[vcg::tri::Index(cm, v)];
+    }
     triangles.push_back(t);
     faceSlot.push_back(int(f));
   }

@@ -78,7 +78,7 @@ void InspectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& pa
 
 bool InspectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterList& parameters,
                                 vcg::CallBackPos* cb) {
-  return guarded(errorMessage, [&] {
+  return guarded(*this, errorMessage, [&] {
     MeshModel* model = md.mm();
     if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
     const int selection = parameters.getEnum("select_defects");

@@ -30,7 +30,7 @@ vcg::Color4b toColor(const std::array<float, 3>& rgb, float alpha = 1) {
 
 bool ObjImportPlugin::open(const QString&, const QString& fileName, MeshModel& m, int& mask,
                            const RichParameterList&, vcg::CallBackPos* cb, QWidget*) {
-  return guarded(errorMessage, [&] {
+  return guarded(*this, errorMessage, [&] {
     if (cb) cb(0, "Reading OBJ");
     const ObjData obj = readObj(toStd(fileName));
 
