@@ -4,6 +4,7 @@
 // for a document holding one small mesh. Tests use it to check that every
 // filter registers and that every sample script lists every parameter.
 #include <QApplication>
+#include <QDomDocument>
 #include <QFileInfo>
 #include <QPluginLoader>
 #include <common/interfaces.h>
@@ -45,11 +46,16 @@ int main(int argc, char** argv) {
         RichParameterList parameters;
         filter->initParameterSet(action, document, parameters);
         std::vector<meshmend::JsonObject> params;
-        for (const RichParameter& p : parameters)
+        for (const RichParameter& p : parameters) {
+          // The <Param> element MeshLab itself writes into a script (default value).
+          QDomDocument doc;
+          doc.appendChild(p.fillToXMLDocument(doc, true));
           params.push_back(meshmend::JsonObject()
                                .set("name", p.name().toStdString())
                                .set("type", p.stringType().toStdString())
-                               .set("tooltip", p.toolTip().toStdString()));
+                               .set("tooltip", p.toolTip().toStdString())
+                               .set("xml", doc.toString(-1).trimmed().toStdString()));
+        }
         filters.push_back(meshmend::JsonObject()
                               .set("name", action->text().toStdString())
                               .set("class", int(filter->getClass(action)))

@@ -1,6 +1,7 @@
 #include "io_mend_obj.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <QFileInfo>
 #include <vcg/complex/algorithms/update/bounding.h>
@@ -30,7 +31,10 @@ vcg::Color4b toColor(const std::array<float, 3>& rgb, float alpha = 1) {
 
 bool ObjImportPlugin::open(const QString&, const QString& fileName, MeshModel& m, int& mask,
                            const RichParameterList&, vcg::CallBackPos* cb, QWidget*) {
-  return guarded(*this, errorMessage, [&] {
+  // meshlabserver neither shows an importer's error message nor gives it a
+  // log: errors also go to standard error.
+  auto toStderr = [](const std::string& m) { std::fprintf(stderr, "%s\n", m.c_str()); };
+  return guarded(errorMessage, [&] {
     if (cb) cb(0, "Reading OBJ");
     const ObjData obj = readObj(toStd(fileName));
 
@@ -107,7 +111,7 @@ bool ObjImportPlugin::open(const QString&, const QString& fileName, MeshModel& m
     if (!notes.isEmpty())  // MeshLab shows a non-empty message of a successful open as a warning
       errorMessage = "While opening '" + QFileInfo(fileName).fileName() + "': " + notes.join("; ");
     if (cb) cb(100, "Reading OBJ");
-  });
+  }, toStderr);
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(ObjImportPlugin)

@@ -1,0 +1,159 @@
+"""Helpers of the integration tests: the real meshlabserver from the private
+prefix (scripts/meshlabserver), .mlx scripts built from the filters' own
+parameter declarations, small meshes written in every format, and the
+independent checker `meshcheck` from ../shared/tools."""
+import json
+import os
+import subprocess
+import xml.etree.ElementTree as ET
+from xml.sax.saxutils import escape
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
+SHARED = Path(os.environ.get("MESHMEND_SHARED_DIR", ROOT.parent / "shared"))
+DATA = SHARED / "data"
+MESHCHECK = Path(os.environ.get("MESHMEND_MESHCHECK", BUILD / "shared-tools" / "meshcheck"))
+PLUGIN_DIR = BUILD / "plugins-out"
+
+
+def require_shared_data():
+    if not DATA.is_dir():
+        pytest.skip(f"corpus absent: {DATA} not found (the real meshes live in ../shared beside the project)")
+    if not MESHCHECK.is_file():
+        pytest.fail(f"{MESHCHECK} is missing: scripts/test builds it from ../shared/tools")
+
+
+_probe_cache = None
+
+
+def probe():
+    """Every MeshMend plugin's filters and parameters, as the plugins declare them."""
+    global _probe_cache
+    if _probe_cache is None:
+        plugins = sorted(str(p) for p in PLUGIN_DIR.glob("*.so"))
+        out = subprocess.run([str(BUILD / "tests" / "plugin_probe"), *plugins],
+                             capture_output=True, text=True, check=True).stdout
+        _probe_cache = json.loads(out)["plugins"]
+    return _probe_cache
+
+
+def filters():
+    return {f["name"]: f for p in probe() for f in p["filters"]}
+
+
+def mlx(*steps):
+    """A filter script. Each step is (filter name, {param: value}); every
+    declared parameter is written as MeshLab itself writes it (as Debian's
+    meshlabserver requires), with the filter's default unless given."""
+    lines = ["<!DOCTYPE FilterScript>", "<FilterScript>"]
+    for name, values in steps:
+        declared = filters()[name]["parameters"]
+        unknown = set(values) - {p["name"] for p in declared}
+        assert not unknown, f"{name} has no parameters {unknown}"
+        lines.append(f' <filter name="{escape(name, {chr(34): "&quot;"})}">')
+        for p in declared:
+            element = ET.fromstring(p["xml"])
+            if p["name"] in values:
+                v = values[p["name"]]
+                element.set("value", ("true" if v else "false") if isinstance(v, bool) else str(v))
+            lines.append("  " + ET.tostring(element, encoding="unicode"))
+        lines.append(" </filter>")
+    lines.append("</FilterScript>")
+    return "\n".join(lines) + "\n"
+
+
+class Run:
+    def __init__(self, proc, reports):
+        self.returncode = proc.returncode
+        self.log = proc.stdout + proc.stderr
+        self.reports = reports
+
+    @property
+    def report(self):
+        assert self.reports, f"no report written; log:\n{self.log[-3000:]}"
+        return self.reports[-1]
+
+
+def run_server(tmp_path, inputs, script_text, outputs=(), timeout=600):
+    """Runs scripts/meshlabserver on `inputs` with the script text; returns the
+    exit code, the whole log and the JSON reports the filters wrote (report
+    paths are {report0}, {report1}... placeholders in the script text)."""
+    reports = []
+    for i in range(script_text.count("{report")):
+        path = tmp_path / f"report{i}.json"
+        if path.exists():
+            path.unlink()
+        script_text = script_text.replace("{report%d}" % i, str(path))
+        reports.append(path)
+    script = tmp_path / "script.mlx"
+    script.write_text(script_text)
+    cmd = [str(ROOT / "scripts" / "meshlabserver")]
+    for i in inputs:
+        cmd += ["-i", str(i)]
+    for o in outputs:
+        cmd += ["-o", str(o)]
+    cmd += ["-s", str(script)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    return Run(proc, [json.loads(p.read_text()) for p in reports if p.exists()])
+
+
+def meshcheck(path, *args):
+    out = subprocess.run([str(MESHCHECK), str(path), *args], capture_output=True, text=True)
+    return json.loads(out.stdout) if out.stdout.strip() else {"exit": out.returncode}
+
+
+# ---- small meshes in every format ------------------------------------------
+
+def write_off(path, V, F):
+    with open(path, "w") as f:
+        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
+        for v in V:
+            f.write(" ".join(repr(float(c)) for c in v) + "\n")
+        for t in F:
+            f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
+    return path
+
+
+def write_ply(path, V, F):
+    with open(path, "w") as f:
+        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"
+                f"property float z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
+        for v in V:
+            f.write(" ".join(repr(float(c)) for c in v) + "\n")
+        for t in F:
+            f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
+    return path
+
+
+def write_obj(path, V, F):
+    with open(path, "w") as f:
+        for v in V:
+            f.write("v " + " ".join(repr(float(c)) for c in v) + "\n")
+        for t in F:
+            f.write("f " + " ".join(str(i + 1) for i in t) + "\n")
+    return path
+
+
+def write_stl(path, V, F):
+    with open(path, "w") as f:
+        f.write("solid m\n")
+        for t in F:
+            f.write(" facet normal 0 0 0\n  outer loop\n")
+            for i in t:
+                f.write("   vertex " + " ".join(repr(float(c)) for c in V[i]) + "\n")
+            f.write("  endloop\n endfacet\n")
+        f.write("endsolid m\n")
+    return path
+
+
+WRITERS = {"off": write_off, "ply": write_ply, "obj": write_obj, "stl": write_stl}
+
+
+def cube():
+    V = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+    F = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4),
+         (2, 6, 3), (3, 6, 7), (0, 4, 2), (2, 4, 6), (1, 3, 5), (3, 7, 5)]
+    return V, F
