@@ -32,6 +32,8 @@ class Mesh : public vcg::tri::TriMesh<std::vector<Vertex>, std::vector<Face>> {
     if (this != &other) copyFrom(other);
     return *this;
   }
+  // vcglib 2020.09's TriMesh does not free its attributes.
+  ~Mesh() { ClearAttributes(); }
 
  private:
   void copyFrom(const Mesh& other);
