@@ -1,11 +1,11 @@
 # Finds the MeshLab source tree unpacked by scripts/setup (`apt-get source
-# meshlab=<installed version>` into .deps/), which provides the vcglib and
+# meshlab=<installed version>` into .deps/meshlab-source/), which provides the vcglib and
 # MeshLab headers of exactly the installed MeshLab. Debian ships no headers.
 #
 # Sets MESHLAB_SOURCE_DIR, VCGLIB_DIR, MESHLAB_VERSION, and the imported
 # target meshmend::vcglib (header-only). Override with -DMESHLAB_SOURCE_DIR=...
 if(NOT MESHLAB_SOURCE_DIR)
-  file(GLOB _meshlab_candidates "${CMAKE_SOURCE_DIR}/.deps/meshlab-*")
+  file(GLOB _meshlab_candidates "${CMAKE_SOURCE_DIR}/.deps/meshlab-source/meshlab-*")
   list(SORT _meshlab_candidates)
   foreach(_dir ${_meshlab_candidates})
     if(IS_DIRECTORY "${_dir}/src/common" AND IS_DIRECTORY "${_dir}/vcglib/vcg")
