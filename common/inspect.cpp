@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/errors.h"
+#include "common/parallel.h"
 #include "common/predicates.h"
 
 namespace meshmend {
@@ -29,17 +30,29 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
-// One side of a face along an undirected edge.
-struct EdgeSide {
-  std::uint64_t key;  // (smaller index << 32) | larger index
-  std::uint32_t face;
-  bool forward;  // the face runs the edge from the smaller to the larger index
+// Face corners grouped by vertex (compressed rows): the corners of vertex v
+// are corners[offsets[v] .. offsets[v+1]), corner c = 3 * face + position.
+struct VertexCorners {
+  std::vector<std::uint32_t> offsets, corners;
+  VertexCorners(std::size_t vertices, const std::vector<Triangle>& triangles)
+      : offsets(vertices + 1, 0), corners(3 * triangles.size()) {
+    for (const Triangle& t : triangles)
+      for (int v : t) ++offsets[v + 1];
+    for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+    std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+      for (int i = 0; i < 3; ++i) corners[next[triangles[f][i]]++] = std::uint32_t(3 * f + i);
+  }
 };
 
-std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
-  if (a > b) std::swap(a, b);
-  return (std::uint64_t(a) << 32) | b;
-}
+// What one worker finds around its range of vertices.
+struct StarFindings {
+  std::size_t edges = 0, border = 0, nonManifold = 0, inconsistent = 0, nonManifoldVertices = 0;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> facePairs;    // faces sharing an edge
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> borderEdges;  // (v, w)
+  std::vector<std::pair<std::uint32_t, std::uint8_t>> faceMarks, vertexMarks;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> duplicateFaces;  // (face, earlier face)
+};
 
 class Inspector {
  public:
@@ -55,9 +68,8 @@ class Inspector {
   InspectResult run() {
     r_.vertices = P_.size();
     r_.faces = T_.size();
-    edgesAndComponents();
-    nonManifoldVertices();
-    duplicates();
+    topology();
+    duplicatePoints();
     geometry();
     return std::move(r_);
   }
@@ -70,51 +82,116 @@ class Inspector {
     if (options_.mark_defects) r_.vertex_defects[v] |= bit;
   }
 
-  void edgesAndComponents() {
-    std::vector<EdgeSide> sides;
-    sides.reserve(3 * T_.size());
-    std::vector<bool> used(P_.size(), false);
-    for (std::size_t f = 0; f < T_.size(); ++f)
-      for (int i = 0; i < 3; ++i) {
-        const std::uint32_t a = T_[f][i], b = T_[f][(i + 1) % 3];
-        used[a] = true;
-        if (a != b) sides.push_back({edgeKey(a, b), std::uint32_t(f), a < b});
+  // Edges, components, border loops, non-manifold vertices and duplicate
+  // faces, all from the star of each vertex (its corners): every undirected
+  // edge is examined at its smaller endpoint, every face at its smallest vertex.
+  void topology() {
+    const VertexCorners star(P_.size(), T_);
+    std::vector<StarFindings> found(workerCount());
+    parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+      StarFindings& out = found[worker];
+      struct Side { std::uint32_t other, face; bool forward; };
+      struct Link { std::uint32_t other, corner; };
+      std::vector<Side> sides;
+      std::vector<Link> links;
+      std::vector<std::uint32_t> group;
+      std::vector<std::pair<Triangle, std::uint32_t>> owned;
+      for (std::size_t v = begin; v < end; ++v) {
+        const std::uint32_t first = star.offsets[v], last = star.offsets[v + 1];
+        sides.clear();
+        links.clear();
+        owned.clear();
+        for (std::uint32_t k = first; k < last; ++k) {
+          const std::uint32_t c = star.corners[k], f = c / 3, i = c % 3;
+          const std::uint32_t next = T_[f][(i + 1) % 3], prev = T_[f][(i + 2) % 3];
+          if (next != v) {
+            links.push_back({next, k - first});
+            if (next > v) sides.push_back({next, f, true});
+          }
+          if (prev != v) {
+            links.push_back({prev, k - first});
+            if (prev > v) sides.push_back({prev, f, false});
+          }
+          Triangle sorted = T_[f];
+          std::sort(sorted.begin(), sorted.end());
+          if (std::uint32_t(sorted[0]) == v) owned.emplace_back(sorted, f);
+        }
+        // Edges at their smaller endpoint.
+        std::sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
+          return a.other < b.other || (a.other == b.other && a.face < b.face);
+        });
+        for (std::size_t a = 0; a < sides.size();) {
+          std::size_t b = a, forward = 0;
+          while (b < sides.size() && sides[b].other == sides[a].other) {
+            forward += sides[b].forward;
+            if (b > a) out.facePairs.emplace_back(sides[a].face, sides[b].face);
+            ++b;
+          }
+          const std::size_t count = b - a;
+          ++out.edges;
+          if (count == 1) {
+            ++out.border;
+            out.borderEdges.emplace_back(std::uint32_t(v), sides[a].other);
+            out.faceMarks.emplace_back(sides[a].face, kFaceOnBorder);
+            out.vertexMarks.emplace_back(std::uint32_t(v), kVertexOnBorder);
+            out.vertexMarks.emplace_back(sides[a].other, kVertexOnBorder);
+          } else if (count > 2) {
+            ++out.nonManifold;
+            for (std::size_t k = a; k < b; ++k)
+              out.faceMarks.emplace_back(sides[k].face, kFaceOnNonManifoldEdge);
+          } else if (forward != 1) {
+            ++out.inconsistent;
+            out.faceMarks.emplace_back(sides[a].face, kFaceOrientationFlip);
+            out.faceMarks.emplace_back(sides[a + 1].face, kFaceOrientationFlip);
+          }
+          a = b;
+        }
+        // Fans: corners are grouped when their faces share an edge at v.
+        const std::uint32_t n = last - first;
+        if (n > 1) {
+          group.resize(n);
+          for (std::uint32_t k = 0; k < n; ++k) group[k] = k;
+          auto root = [&](std::uint32_t x) {
+            while (group[x] != x) x = group[x] = group[group[x]];
+            return x;
+          };
+          std::sort(links.begin(), links.end(),
+                    [](const Link& a, const Link& b) { return a.other < b.other; });
+          for (std::size_t k = 1; k < links.size(); ++k)
+            if (links[k].other == links[k - 1].other)
+              group[root(links[k].corner)] = root(links[k - 1].corner);
+          std::uint32_t fans = 0;
+          for (std::uint32_t k = 0; k < n; ++k) fans += root(k) == k;
+          if (fans > 1) {
+            ++out.nonManifoldVertices;
+            out.vertexMarks.emplace_back(std::uint32_t(v), kVertexNonManifold);
+          }
+        }
+        // Duplicate faces share their smallest vertex: compare them there.
+        std::sort(owned.begin(), owned.end());
+        owned.erase(std::unique(owned.begin(), owned.end()), owned.end());  // a face seen twice
+        for (std::size_t k = 1; k < owned.size(); ++k)
+          if (owned[k].first == owned[k - 1].first)
+            out.duplicateFaces.emplace_back(owned[k].second, owned[k - 1].second);
       }
-    std::sort(sides.begin(), sides.end(), [](const EdgeSide& x, const EdgeSide& y) {
-      return x.key < y.key || (x.key == y.key && x.face < y.face);
     });
 
-    DisjointSets faceSets(T_.size());
-    DisjointSets borderSets(P_.size());
-    std::vector<std::uint64_t> borderKeys;
-    for (std::size_t i = 0; i < sides.size();) {
-      std::size_t j = i;
-      std::size_t forward = 0;
-      while (j < sides.size() && sides[j].key == sides[i].key) {
-        forward += sides[j].forward;
-        if (j > i) faceSets.unite(sides[i].face, sides[j].face);
-        ++j;
-      }
-      const std::size_t count = j - i;
-      const std::uint32_t a = std::uint32_t(sides[i].key >> 32);
-      const std::uint32_t b = std::uint32_t(sides[i].key & 0xffffffffu);
-      ++r_.edges;
-      if (count == 1) {
-        ++r_.border_edges;
-        borderSets.unite(a, b);
-        borderKeys.push_back(sides[i].key);
-        markFace(sides[i].face, kFaceOnBorder);
-        markVertex(a, kVertexOnBorder);
-        markVertex(b, kVertexOnBorder);
-      } else if (count > 2) {
-        ++r_.non_manifold_edges;
-        for (std::size_t k = i; k < j; ++k) markFace(sides[k].face, kFaceOnNonManifoldEdge);
-      } else if (forward != 1) {
-        ++r_.orientation_inconsistent_edges;
-        markFace(sides[i].face, kFaceOrientationFlip);
-        markFace(sides[i + 1].face, kFaceOrientationFlip);
-      }
-      i = j;
+    DisjointSets faceSets(T_.size()), borderSets(P_.size());
+    std::vector<bool> used(P_.size(), false);
+    for (std::size_t v = 0; v < P_.size(); ++v) used[v] = star.offsets[v + 1] > star.offsets[v];
+    for (const StarFindings& out : found) {
+      r_.edges += out.edges;
+      r_.border_edges += out.border;
+      r_.non_manifold_edges += out.nonManifold;
+      r_.orientation_inconsistent_edges += out.inconsistent;
+      r_.non_manifold_vertices += out.nonManifoldVertices;
+      r_.duplicate_faces += out.duplicateFaces.size();
+      for (const auto& [a, b] : out.facePairs) faceSets.unite(a, b);
+      for (const auto& [a, b] : out.borderEdges) borderSets.unite(a, b);
+      for (const auto& [f, bit] : out.faceMarks) markFace(f, bit);
+      for (const auto& [v, bit] : out.vertexMarks) markVertex(v, bit);
+      for (const auto& [f, earlier] : out.duplicateFaces)
+        markFace(std::max(f, earlier), kFaceDuplicate);  // the later one is the duplicate
     }
     for (std::size_t f = 0; f < T_.size(); ++f) r_.connected_components += faceSets.find(f) == f;
     for (std::size_t v = 0; v < P_.size(); ++v)
@@ -122,12 +199,13 @@ class Inspector {
         ++r_.isolated_vertices;
         markVertex(v, kVertexIsolated);
       }
-    usedVertices_ = std::size_t(std::count(used.begin(), used.end(), true));
+    const std::size_t usedVertices = std::size_t(std::count(used.begin(), used.end(), true));
 
     // Border loops: connected components of the graph of border edges (for a
     // valid mesh these are exactly its halfedge border cycles).
     std::vector<std::size_t> loopEdges(P_.size(), 0);
-    for (std::uint64_t key : borderKeys) ++loopEdges[borderSets.find(std::size_t(key >> 32))];
+    for (const StarFindings& out : found)
+      for (const auto& [a, b] : out.borderEdges) ++loopEdges[borderSets.find(a)];
     for (std::size_t n : loopEdges)
       if (n > 0) {
         ++r_.border_loops;
@@ -135,51 +213,11 @@ class Inspector {
       }
     r_.consistently_oriented = r_.orientation_inconsistent_edges == 0;
     r_.is_closed = r_.border_edges == 0 && !T_.empty();
-    r_.euler_characteristic = long(usedVertices_) - long(r_.edges) + long(r_.faces);
-  }
-
-  // A vertex is non-manifold when its corners (the face corners at it) fall
-  // into more than one group, corners being grouped when their faces share an
-  // edge at that vertex.
-  void nonManifoldVertices() {
-    struct Side {
-      std::uint32_t vertex, other;
-      std::uint32_t corner;
-    };
-    std::vector<Side> sides;
-    sides.reserve(6 * T_.size());
-    for (std::size_t f = 0; f < T_.size(); ++f)
-      for (int i = 0; i < 3; ++i) {
-        const std::uint32_t v = T_[f][i], prev = T_[f][(i + 2) % 3], next = T_[f][(i + 1) % 3];
-        const std::uint32_t corner = std::uint32_t(3 * f + i);
-        if (prev != v) sides.push_back({v, prev, corner});
-        if (next != v) sides.push_back({v, next, corner});
-      }
-    std::sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
-      return a.vertex < b.vertex || (a.vertex == b.vertex && a.other < b.other);
-    });
-    DisjointSets corners(3 * T_.size());
-    for (std::size_t i = 1; i < sides.size(); ++i)
-      if (sides[i].vertex == sides[i - 1].vertex && sides[i].other == sides[i - 1].other)
-        corners.unite(sides[i].corner, sides[i - 1].corner);
-
-    // Corners by vertex: count distinct groups per vertex.
-    std::vector<std::pair<std::uint32_t, std::size_t>> groups;  // (vertex, group root)
-    groups.reserve(3 * T_.size());
-    for (std::size_t c = 0; c < 3 * T_.size(); ++c)
-      groups.emplace_back(std::uint32_t(T_[c / 3][c % 3]), corners.find(c));
-    std::sort(groups.begin(), groups.end());
-    groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
-    for (std::size_t i = 1; i < groups.size(); ++i)
-      if (groups[i].first == groups[i - 1].first &&
-          (i < 2 || groups[i - 2].first != groups[i].first)) {
-        ++r_.non_manifold_vertices;  // counted once, at the vertex's second group
-        markVertex(groups[i].first, kVertexNonManifold);
-      }
+    r_.euler_characteristic = long(usedVertices) - long(r_.edges) + long(r_.faces);
     vertexManifold_ = r_.non_manifold_vertices == 0;
   }
 
-  void duplicates() {
+  void duplicatePoints() {
     std::vector<std::uint32_t> order(P_.size());
     std::iota(order.begin(), order.end(), 0u);
     auto lexLess = [this](std::uint32_t a, std::uint32_t b) {
@@ -196,19 +234,6 @@ class Inspector {
         markVertex(order[i], kVertexDuplicate);
       }
 
-    std::vector<std::pair<Triangle, std::uint32_t>> sorted;
-    sorted.reserve(T_.size());
-    for (std::size_t f = 0; f < T_.size(); ++f) {
-      Triangle t = T_[f];
-      std::sort(t.begin(), t.end());
-      sorted.emplace_back(t, std::uint32_t(f));
-    }
-    std::sort(sorted.begin(), sorted.end());
-    for (std::size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i].first == sorted[i - 1].first) {
-        ++r_.duplicate_faces;
-        markFace(sorted[i].second, kFaceDuplicate);
-      }
   }
 
   void geometry() {
@@ -272,7 +297,6 @@ class Inspector {
   const std::vector<Triangle>& T_;
   InspectOptions options_;
   InspectResult r_;
-  std::size_t usedVertices_ = 0;
   bool vertexManifold_ = true;
 };
 

@@ -1,7 +1,7 @@
 """MeshMend: Inspect Mesh Defects, through the real meshlabserver."""
 import pytest
 
-from conftest import ROOT, WRITERS, cube, meshcheck, mlx, run_server, write_off
+from conftest import ROOT, WRITERS, cube, meshcheck, mlx, require_shared_data, run_server, write_off
 
 INSPECT = "MeshMend: Inspect Mesh Defects"
 
@@ -48,6 +48,7 @@ def test_sample_script_prints_the_report(tmp_path):
 
 def test_counts_agree_with_meshcheck_on_a_defective_soup(tmp_path):
     # Non-manifold fin, flipped face, duplicate face, unreferenced and duplicate points.
+    require_shared_data()  # meshcheck is built from ../shared/tools
     V, F = cube()
     V = V + [(0.5, -1, 0.5), (9, 9, 9), (1, 1, 1)]
     F = F + [(0, 1, 8), (F[3][0], F[3][2], F[3][1]), F[5]]
