@@ -90,8 +90,13 @@ class Inspector {
     std::vector<StarFindings> found(workerCount());
     parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
       StarFindings& out = found[worker];
-      struct Side { std::uint32_t other, face; bool forward; };
-      struct Link { std::uint32_t other, corner; };
+      struct Side {
+        std::uint32_t other, face;
+        bool forward;
+      };
+      struct Link {
+        std::uint32_t other, corner;
+      };
       std::vector<Side> sides;
       std::vector<Link> links;
       std::vector<std::uint32_t> group;
@@ -233,7 +238,6 @@ class Inspector {
         ++r_.duplicate_points;
         markVertex(order[i], kVertexDuplicate);
       }
-
   }
 
   void geometry() {
@@ -272,8 +276,8 @@ class Inspector {
       if (!finite[t[0]] || !finite[t[1]] || !finite[t[2]]) continue;  // no geometry to judge
       const Point3 &a = P_[t[0]], &b = P_[t[1]], &c = P_[t[2]];
       volume6 += (a - center) * ((b - center) ^ (c - center));
-      const bool repeated = t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || a == b || b == c ||
-                            c == a;
+      const bool repeated =
+          t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || a == b || b == c || c == a;
       if (repeated || collinear(a, b, c)) {
         ++r_.degenerate_faces;
         markFace(f, kFaceDegenerate);

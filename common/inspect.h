@@ -37,31 +37,31 @@ enum VertexDefect : std::uint8_t {
 };
 
 struct InspectResult {
-  std::size_t vertices = 0;                        // vertex records
-  std::size_t faces = 0;                           // triangles
-  std::size_t edges = 0;                           // undirected edges between distinct indices
-  std::size_t connected_components = 0;            // faces joined through shared edges
-  std::size_t border_edges = 0;                    // edges used by exactly one face
-  std::size_t border_loops = 0;                    // connected components of the border edges
-  std::size_t longest_border_loop = 0;             // edges of the largest border loop
-  std::size_t non_manifold_edges = 0;              // edges used by more than two faces
-  std::size_t non_manifold_vertices = 0;           // pinch / bow-tie vertices
-  std::size_t isolated_vertices = 0;               // vertices used by no face
-  std::size_t duplicate_points = 0;                // vertices repeating an earlier one's coordinates
-  std::size_t non_finite_vertices = 0;             // NaN or infinite coordinates (geometry skips them)
-  std::size_t degenerate_faces = 0;                // exact: repeated vertex or collinear
-  std::size_t duplicate_faces = 0;                 // same vertex set as an earlier face
+  std::size_t vertices = 0;               // vertex records
+  std::size_t faces = 0;                  // triangles
+  std::size_t edges = 0;                  // undirected edges between distinct indices
+  std::size_t connected_components = 0;   // faces joined through shared edges
+  std::size_t border_edges = 0;           // edges used by exactly one face
+  std::size_t border_loops = 0;           // connected components of the border edges
+  std::size_t longest_border_loop = 0;    // edges of the largest border loop
+  std::size_t non_manifold_edges = 0;     // edges used by more than two faces
+  std::size_t non_manifold_vertices = 0;  // pinch / bow-tie vertices
+  std::size_t isolated_vertices = 0;      // vertices used by no face
+  std::size_t duplicate_points = 0;       // vertices repeating an earlier one's coordinates
+  std::size_t non_finite_vertices = 0;    // NaN or infinite coordinates (geometry skips them)
+  std::size_t degenerate_faces = 0;       // exact: repeated vertex or collinear
+  std::size_t duplicate_faces = 0;        // same vertex set as an earlier face
   std::size_t orientation_inconsistent_edges = 0;  // two faces run the edge the same way
   bool is_closed = false;                          // no border edge, at least one face
   bool consistently_oriented = true;               // orientation_inconsistent_edges == 0
-  std::optional<double> volume;  // signed; closed, oriented, edge-manifold, finite meshes only
+  std::optional<double> volume;   // signed; closed, oriented, edge-manifold, finite meshes only
   long euler_characteristic = 0;  // used vertices - edges + faces
   std::optional<long> genus;      // closed, edge- and vertex-manifold, oriented meshes only
   std::array<double, 6> bbox{};   // min x, y, z, max x, y, z over all finite vertices
   double bbox_diagonal = 0;
-  double min_angle_deg = 180;       // smallest interior angle
-  double mean_min_angle_deg = 0;    // mean over triangles of their smallest angle
-  double time_ms = 0;               // compute time of inspect()
+  double min_angle_deg = 180;                // smallest interior angle
+  double mean_min_angle_deg = 0;             // mean over triangles of their smallest angle
+  double time_ms = 0;                        // compute time of inspect()
   std::vector<std::uint8_t> face_defects;    // per face FaceDefect bits (mark_defects)
   std::vector<std::uint8_t> vertex_defects;  // per vertex VertexDefect bits (mark_defects)
 };

@@ -12,11 +12,21 @@ std::string jsonQuote(const std::string& text) {
   std::string out = "\"";
   for (unsigned char c : text) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -80,7 +90,9 @@ JsonObject& JsonObject::set(const std::string& key, const std::vector<JsonObject
   for (std::size_t i = 0; i < values.size(); ++i) out += (i ? ", " : "") + values[i].str(false);
   return setRaw(key, out + "]");
 }
-JsonObject& JsonObject::setNull(const std::string& key) { return setRaw(key, "null"); }
+JsonObject& JsonObject::setNull(const std::string& key) {
+  return setRaw(key, "null");
+}
 
 std::string JsonObject::str(bool multiline) const {
   if (members_.empty()) return "{}";
@@ -95,8 +107,9 @@ std::string JsonObject::str(bool multiline) const {
 
 void writeJsonFile(const std::string& path, const JsonObject& object) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw InvalidInputError("cannot write the report file '" + path +
-                                     "': check that its folder exists and is writable");
+  if (!file)
+    throw InvalidInputError("cannot write the report file '" + path +
+                            "': check that its folder exists and is writable");
   file << object.str(true) << '\n';
   if (!file.flush())
     throw InvalidInputError("writing the report file '" + path + "' failed (disk full?)");

@@ -14,14 +14,20 @@ class JsonObject {
   JsonObject& set(const std::string& key, bool value);
   JsonObject& set(const std::string& key, int value) { return set(key, std::int64_t(value)); }
   JsonObject& set(const std::string& key, long long value) { return set(key, std::int64_t(value)); }
-  JsonObject& set(const std::string& key, unsigned long value) { return set(key, std::int64_t(value)); }
-  JsonObject& set(const std::string& key, unsigned long long value) { return set(key, std::int64_t(value)); }
+  JsonObject& set(const std::string& key, unsigned long value) {
+    return set(key, std::int64_t(value));
+  }
+  JsonObject& set(const std::string& key, unsigned long long value) {
+    return set(key, std::int64_t(value));
+  }
   JsonObject& set(const std::string& key, unsigned value) { return set(key, std::int64_t(value)); }
   JsonObject& set(const std::string& key, std::int64_t value);
   JsonObject& set(const std::string& key, double value);  // non-finite -> null
   JsonObject& set(const std::string& key, const std::optional<double>& value);
   JsonObject& set(const std::string& key, const std::string& value);
-  JsonObject& set(const std::string& key, const char* value) { return set(key, std::string(value)); }
+  JsonObject& set(const std::string& key, const char* value) {
+    return set(key, std::string(value));
+  }
   JsonObject& set(const std::string& key, const JsonObject& value);
   JsonObject& set(const std::string& key, const std::vector<double>& values);
   JsonObject& set(const std::string& key, const std::vector<std::string>& values);

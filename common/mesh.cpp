@@ -12,8 +12,8 @@ void Mesh::copyFrom(const Mesh& other) {
   Clear();
   ClearAttributes();
   // Append copies the attributes present in both meshes: create ours first.
-  if (Allocator::IsValidHandle(source, Allocator::FindPerVertexAttribute<VertexOrigin>(
-                                           source, kVertexOriginAttribute)))
+  if (Allocator::IsValidHandle(
+          source, Allocator::FindPerVertexAttribute<VertexOrigin>(source, kVertexOriginAttribute)))
     vertexOrigins(*this);
   if (Allocator::IsValidHandle(
           source, Allocator::FindPerFaceAttribute<FaceOrigin>(source, kFaceOriginAttribute)))
@@ -45,8 +45,8 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
     for (int v : triangles[f])
       if (v < 0 || v >= n)
         throw InvalidInputError("face " + std::to_string(f) + " refers to vertex " +
-                                std::to_string(v) + ", but the mesh has only " +
-                                std::to_string(n) + " vertices");
+                                std::to_string(v) + ", but the mesh has only " + std::to_string(n) +
+                                " vertices");
 
   Mesh mesh;
   auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
@@ -79,8 +79,7 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh) {
 }
 
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what) {
-  if (mesh.fn == 0)
-    throw InvalidInputError(what + " has no faces: load or select a triangle mesh");
+  if (mesh.fn == 0) throw InvalidInputError(what + " has no faces: load or select a triangle mesh");
   for (std::size_t i = 0; i < mesh.vert.size(); ++i)
     if (!mesh.vert[i].IsD() && !isFinite(mesh.vert[i].cP()))
       throw InvalidInputError(what + ": vertex " + std::to_string(i) +

@@ -12,15 +12,15 @@ namespace meshmend {
 
 class Vertex;
 class Face;
-struct UsedTypes : public vcg::UsedTypes<vcg::Use<Vertex>::AsVertexType,
-                                         vcg::Use<Face>::AsFaceType> {};
+struct UsedTypes
+    : public vcg::UsedTypes<vcg::Use<Vertex>::AsVertexType, vcg::Use<Face>::AsFaceType> {};
 
 class Vertex : public vcg::Vertex<UsedTypes, vcg::vertex::Coord3d, vcg::vertex::Normal3d,
                                   vcg::vertex::BitFlags, vcg::vertex::VFAdj, vcg::vertex::Mark> {};
 
-class Face : public vcg::Face<UsedTypes, vcg::face::VertexRef, vcg::face::Normal3d,
-                              vcg::face::BitFlags, vcg::face::FFAdj, vcg::face::VFAdj,
-                              vcg::face::Mark> {};
+class Face
+    : public vcg::Face<UsedTypes, vcg::face::VertexRef, vcg::face::Normal3d, vcg::face::BitFlags,
+                       vcg::face::FFAdj, vcg::face::VFAdj, vcg::face::Mark> {};
 
 // vcglib meshes are not copyable; this one copies its elements and every
 // per-element attribute (provenance included) through vcg::tri::Append.
@@ -47,9 +47,9 @@ using Triangle = std::array<int, 3>;
 // `barycentric` (weights of that face's three corners), so that the MeshLab
 // bridge can interpolate colours, quality, normals and texture coordinates.
 struct VertexOrigin {
-  int layer = -1;       // input layer (index into the inputs of the operation)
-  int vertex = -1;      // input vertex index, or -1 for a new vertex
-  int face = -1;        // for a new vertex: the input face it lies on
+  int layer = -1;   // input layer (index into the inputs of the operation)
+  int vertex = -1;  // input vertex index, or -1 for a new vertex
+  int face = -1;    // for a new vertex: the input face it lies on
   Point3 barycentric{0, 0, 0};
 };
 

@@ -21,7 +21,8 @@ namespace {
 std::string extensionOf(const std::string& path) {
   const std::size_t dot = path.find_last_of('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -91,7 +92,8 @@ void writeMesh(const std::string& path, const Mesh& mesh) {
   if (ext == "off") {
     error = vcg::tri::io::ExporterOFF<Mesh>::Save(m, path.c_str(), vcg::tri::io::Mask::IOM_NONE);
   } else if (ext == "ply") {
-    error = vcg::tri::io::ExporterPLY<Mesh>::Save(m, path.c_str(), vcg::tri::io::Mask::IOM_NONE, true);
+    error =
+        vcg::tri::io::ExporterPLY<Mesh>::Save(m, path.c_str(), vcg::tri::io::Mask::IOM_NONE, true);
   } else {
     throw InvalidInputError("'" + path + "': write OFF or PLY");
   }

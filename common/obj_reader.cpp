@@ -37,8 +37,8 @@ class ObjParser {
     checkIndices();
     if (skippedLines_ > 0)
       data_.warnings.push_back(std::to_string(skippedLines_) +
-                               " lines with unsupported statements were skipped (" +
-                               firstSkipped_ + ")");
+                               " lines with unsupported statements were skipped (" + firstSkipped_ +
+                               ")");
     return std::move(data_);
   }
 
@@ -131,8 +131,8 @@ class ObjParser {
     } else if (keyword == "o" || keyword == "g" || keyword == "s" || keyword == "vp") {
       // grouping and smoothing statements carry no geometry we keep
     } else {
-      if (skippedLines_++ == 0) firstSkipped_ = "'" + keyword + "' at line " +
-                                                std::to_string(lineNumber_);
+      if (skippedLines_++ == 0)
+        firstSkipped_ = "'" + keyword + "' at line " + std::to_string(lineNumber_);
     }
   }
 
@@ -182,8 +182,8 @@ class ObjParser {
     auto check = [&](std::size_t polygon, int index, std::size_t count, const char* what) {
       if (index < 0 || std::size_t(index) >= count)
         throw InvalidInputError("'" + path_ + "': face " + std::to_string(polygon) + " refers to " +
-                                what + " " + std::to_string(long(index) + 1) + ", but the file has " +
-                                std::to_string(count));
+                                what + " " + std::to_string(long(index) + 1) +
+                                ", but the file has " + std::to_string(count));
     };
     for (std::size_t p = 0; p < data_.polygons.size(); ++p)
       for (const ObjCorner& c : data_.polygons[p]) {
@@ -206,6 +206,8 @@ class ObjParser {
 
 }  // namespace
 
-ObjData readObj(const std::string& path) { return ObjParser(path).run(); }
+ObjData readObj(const std::string& path) {
+  return ObjParser(path).run();
+}
 
 }  // namespace meshmend

@@ -23,8 +23,8 @@ struct ObjCorner {
 struct ObjMaterial {
   std::string name;
   std::array<float, 3> diffuse{0.8f, 0.8f, 0.8f};  // Kd
-  float opacity = 1;                                // d, or 1 - Tr
-  std::string diffuse_texture;                      // map_Kd, relative to the MTL file
+  float opacity = 1;                               // d, or 1 - Tr
+  std::string diffuse_texture;                     // map_Kd, relative to the MTL file
 };
 
 struct ObjData {
@@ -32,10 +32,10 @@ struct ObjData {
   std::vector<std::array<float, 3>> vertex_colors;  // "v x y z r g b" extension; empty if absent
   std::vector<std::array<double, 2>> texcoords;
   std::vector<Point3> normals;
-  std::vector<std::vector<ObjCorner>> polygons;     // faces with 3 or more corners
-  std::vector<int> polygon_material;                // index into materials, -1 if none
+  std::vector<std::vector<ObjCorner>> polygons;  // faces with 3 or more corners
+  std::vector<int> polygon_material;             // index into materials, -1 if none
   std::vector<ObjMaterial> materials;
-  std::vector<std::string> warnings;                // skipped lines and missing files
+  std::vector<std::string> warnings;  // skipped lines and missing files
 };
 
 // Reads an OBJ file. Throws InvalidInputError (with the file name and line)

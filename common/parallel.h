@@ -10,15 +10,17 @@
 namespace meshmend {
 
 // Number of worker threads used by parallelChunks (at least 1).
-inline unsigned workerCount() { return std::max(1u, std::thread::hardware_concurrency()); }
+inline unsigned workerCount() {
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 // Splits [0, n) into one contiguous chunk per worker and calls
 // body(begin, end, worker) on each, in parallel; small ranges run inline.
 // The first exception thrown by a worker is rethrown after all have joined.
 template <class Body>
 void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4096) {
-  const std::size_t workers =
-      std::max<std::size_t>(1, std::min<std::size_t>(workerCount(), n / std::max<std::size_t>(1, minimumPerWorker)));
+  const std::size_t workers = std::max<std::size_t>(
+      1, std::min<std::size_t>(workerCount(), n / std::max<std::size_t>(1, minimumPerWorker)));
   if (workers == 1) {
     body(std::size_t(0), n, 0u);
     return;

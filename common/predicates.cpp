@@ -16,7 +16,9 @@ constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 // Below this magnitude products may underflow and the bounds no longer hold.
 constexpr double kUnderflowGuard = 1e-250;
 
-int sign(const mpq_class& q) { return sgn(q); }
+int sign(const mpq_class& q) {
+  return sgn(q);
+}
 
 }  // namespace
 

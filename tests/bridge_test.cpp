@@ -2,8 +2,8 @@
 // provenance. Runs without a display (no GL is touched).
 #include "plugins/bridge/mesh_bridge.h"
 
-#include <QCoreApplication>
 #include <gtest/gtest.h>
+#include <QCoreApplication>
 
 #include "common/errors.h"
 #include "plugins/bridge/filter_support.h"
@@ -178,13 +178,16 @@ TEST(Bridge, GuardedTurnsErrorsIntoMessages) {
   QString message;
   std::string logged;
   auto log = [&](const std::string& m) { logged = m; };
-  EXPECT_FALSE(guarded(message, [] { throw InvalidInputError("layer 'x' has no faces"); }, log));
+  EXPECT_FALSE(guarded(
+      message, [] { throw InvalidInputError("layer 'x' has no faces"); }, log));
   EXPECT_EQ(message, "layer 'x' has no faces");
   EXPECT_EQ(logged, "MeshMend error: layer 'x' has no faces");
   logged.clear();
-  EXPECT_TRUE(guarded(message, [] {}, log));
+  EXPECT_TRUE(guarded(
+      message, [] {}, log));
   EXPECT_TRUE(logged.empty());
-  EXPECT_FALSE(guarded(message, [] { throw std::logic_error("boom"); }, log));
+  EXPECT_FALSE(guarded(
+      message, [] { throw std::logic_error("boom"); }, log));
   EXPECT_TRUE(message.contains("internal error: boom"));
 }
 

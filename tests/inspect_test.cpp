@@ -78,10 +78,9 @@ TEST(Inspect, FinOnAnEdgeIsNonManifold) {
 }
 
 TEST(Inspect, BowTieVertexIsNonManifold) {
-  const InspectResult r =
-      inspect(makeMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}},
-                       {{0, 1, 2}, {0, 3, 4}}),
-              {true});
+  const InspectResult r = inspect(
+      makeMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}}, {{0, 1, 2}, {0, 3, 4}}),
+      {true});
   EXPECT_EQ(r.non_manifold_vertices, 1u);
   EXPECT_EQ(r.connected_components, 2u);  // a pinch vertex does not join
   EXPECT_EQ(r.border_edges, 6u);
@@ -144,10 +143,10 @@ TEST(Inspect, NonFiniteVerticesAreCountedNotFatal) {
   const InspectResult r = inspect(makeMesh(p, trianglesOf(tetrahedron())), {true});
   EXPECT_EQ(r.non_finite_vertices, 1u);
   EXPECT_TRUE(r.vertex_defects[3] & kVertexNonFinite);
-  EXPECT_TRUE(r.is_closed);               // topology is still known
-  EXPECT_FALSE(r.volume.has_value());     // geometry is not
+  EXPECT_TRUE(r.is_closed);            // topology is still known
+  EXPECT_FALSE(r.volume.has_value());  // geometry is not
   EXPECT_EQ(r.degenerate_faces, 0u);
-  EXPECT_EQ(r.bbox[5], 0.0);              // the box ignores the NaN vertex
+  EXPECT_EQ(r.bbox[5], 0.0);  // the box ignores the NaN vertex
   EXPECT_NE(summarize(r).find("1 vertices with NaN"), std::string::npos);
 }
 
@@ -166,12 +165,12 @@ TEST(Inspect, RejectsMeshWithDeletedElements) {
 
 TEST(Inspect, JsonUsesMeshcheckKeys) {
   const std::string json = toJson(inspect(tetrahedron())).str();
-  for (const char* key : {"\"vertices\": 4", "\"faces\": 4", "\"connected_components\": 1",
-                          "\"border_edges\": 0", "\"border_loops\": 0", "\"non_manifold_edges\": 0",
-                          "\"non_manifold_vertices\": 0", "\"degenerate_faces\": 0",
-                          "\"duplicate_faces\": 0", "\"isolated_vertices\": 0",
-                          "\"is_closed\": true", "\"consistently_oriented\": true",
-                          "\"volume\": 0.1666666667", "\"time_ms\": "})
+  for (const char* key :
+       {"\"vertices\": 4", "\"faces\": 4", "\"connected_components\": 1", "\"border_edges\": 0",
+        "\"border_loops\": 0", "\"non_manifold_edges\": 0", "\"non_manifold_vertices\": 0",
+        "\"degenerate_faces\": 0", "\"duplicate_faces\": 0", "\"isolated_vertices\": 0",
+        "\"is_closed\": true", "\"consistently_oriented\": true", "\"volume\": 0.1666666667",
+        "\"time_ms\": "})
     EXPECT_NE(json.find(key), std::string::npos) << key << " missing in " << json;
 }
 

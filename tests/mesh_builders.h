@@ -18,8 +18,18 @@ inline Mesh tetrahedron() {
 inline Mesh box(double sx = 1, double sy = 1, double sz = 1) {
   std::vector<Point3> p;
   for (int i = 0; i < 8; ++i) p.emplace_back(i & 1 ? sx : 0, i & 2 ? sy : 0, i & 4 ? sz : 0);
-  return makeMesh(p, {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}});
+  return makeMesh(p, {{0, 2, 1},
+                      {1, 2, 3},
+                      {4, 5, 6},
+                      {5, 7, 6},
+                      {0, 1, 4},
+                      {1, 5, 4},
+                      {2, 6, 3},
+                      {3, 6, 7},
+                      {0, 4, 2},
+                      {2, 4, 6},
+                      {1, 3, 5},
+                      {3, 7, 5}});
 }
 
 // Latitude-longitude sphere of radius r: `rings` latitude bands, `segments`

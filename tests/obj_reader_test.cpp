@@ -17,10 +17,11 @@ std::string writeTemp(const std::string& name, const std::string& text) {
 }
 
 TEST(ObjReader, ReadsPositionsTexcoordsNormalsAndPolygons) {
-  const std::string path = writeTemp("quad.obj",
-                                     "# a quad\r\nmtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-                                     "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
-                                     "usemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+  const std::string path =
+      writeTemp("quad.obj",
+                "# a quad\r\nmtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+                "usemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
   writeTemp("quad.mtl", "newmtl red\nKd 1 0 0\nmap_Kd -s 1 1 1 tex.png\n");
   const ObjData d = readObj(path);
   ASSERT_EQ(d.positions.size(), 4u);
@@ -37,8 +38,9 @@ TEST(ObjReader, ReadsPositionsTexcoordsNormalsAndPolygons) {
 }
 
 TEST(ObjReader, NegativeIndicesAndVertexColours) {
-  const ObjData d = readObj(writeTemp("neg.obj", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n"
-                                                 "f -3 -2 -1\nf 1//1 2//1 3//1\nvn 0 0 1\n"));
+  const ObjData d = readObj(writeTemp("neg.obj",
+                                      "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n"
+                                      "f -3 -2 -1\nf 1//1 2//1 3//1\nvn 0 0 1\n"));
   EXPECT_EQ(d.polygons[0][0].vertex, 0);
   EXPECT_EQ(d.polygons[0][2].vertex, 2);
   EXPECT_EQ(d.polygons[1][1].normal, 0);
@@ -56,8 +58,9 @@ TEST(ObjReader, ContinuationLinesAndUnsupportedStatements) {
 }
 
 TEST(ObjReader, MissingMaterialLibraryIsAWarning) {
-  const ObjData d = readObj(writeTemp("nomtl.obj", "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\n"
-                                                   "v 0 1 0\nusemtl x\nf 1 2 3\n"));
+  const ObjData d = readObj(writeTemp("nomtl.obj",
+                                      "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\n"
+                                      "v 0 1 0\nusemtl x\nf 1 2 3\n"));
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_NE(d.warnings[0].find("nowhere.mtl"), std::string::npos);
   EXPECT_EQ(d.polygon_material[0], 0);

@@ -3,12 +3,12 @@
 // class, arity and parameters (name and type) as the plugin declares them
 // for a document holding one small mesh. Tests use it to check that every
 // filter registers and that every sample script lists every parameter.
+#include <common/interfaces.h>
+#include <common/meshmodel.h>
 #include <QApplication>
 #include <QDomDocument>
 #include <QFileInfo>
 #include <QPluginLoader>
-#include <common/interfaces.h>
-#include <common/meshmodel.h>
 
 #include <cstdio>
 #include <string>

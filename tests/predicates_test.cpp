@@ -38,16 +38,15 @@ TEST(Predicates, Orient2dNearlyCollinearNeedsExactness) {
 TEST(Predicates, CollinearIsExact) {
   EXPECT_TRUE(collinear(Point3(0, 0, 0), Point3(1, 1, 1), Point3(3, 3, 3)));
   EXPECT_TRUE(collinear(Point3(1, 2, 3), Point3(1, 2, 3), Point3(4, 5, 6)));
-  EXPECT_FALSE(
-      collinear(Point3(0, 0, 0), Point3(1, 1, 1), Point3(3, 3, std::nextafter(3.0, 4.0))));
+  EXPECT_FALSE(collinear(Point3(0, 0, 0), Point3(1, 1, 1), Point3(3, 3, std::nextafter(3.0, 4.0))));
 }
 
 TEST(Predicates, HandlesHugeAndTinyCoordinates) {
   const double big = FLT_MAX;
   EXPECT_EQ(orient2d(-big, -big, big, -big, 0, big), 1);
-  EXPECT_EQ(orient3d(Point3(-big, -big, 0), Point3(big, -big, 0), Point3(0, big, 0),
-                     Point3(0, 0, big)),
-            1);
+  EXPECT_EQ(
+      orient3d(Point3(-big, -big, 0), Point3(big, -big, 0), Point3(0, big, 0), Point3(0, 0, big)),
+      1);
   const double tiny = 1e-300;  // products underflow: must fall back to exact
   EXPECT_EQ(orient2d(0, 0, tiny, 0, 0, tiny), 1);
   EXPECT_EQ(orient3d(Point3(0, 0, 0), Point3(tiny, 0, 0), Point3(0, tiny, 0), Point3(0, 0, tiny)),
@@ -68,11 +67,16 @@ TEST(Predicates, FilteredAgreesWithExactOnNearDegenerateInput) {
   };
   auto scaleOf = [&](int kind) {
     switch (kind) {
-      case 0: return 1.0;
-      case 1: return 1e-3;
-      case 2: return double(FLT_MAX) / 4;
-      case 3: return 1e6;
-      default: return 1e-30;
+      case 0:
+        return 1.0;
+      case 1:
+        return 1e-3;
+      case 2:
+        return double(FLT_MAX) / 4;
+      case 3:
+        return 1e6;
+      default:
+        return 1e-30;
     }
   };
   long disagreements = 0, exactZeros = 0;
@@ -94,8 +98,8 @@ TEST(Predicates, FilteredAgreesWithExactOnNearDegenerateInput) {
     // 2-D: c near the line a-b.
     const double t = unit(rng);
     const double cx = perturb(a[0] + (b[0] - a[0]) * t), cy = perturb(a[1] + (b[1] - a[1]) * t);
-    disagreements += orient2d(a[0], a[1], b[0], b[1], cx, cy) !=
-                     exact::orient2d(a[0], a[1], b[0], b[1], cx, cy);
+    disagreements +=
+        orient2d(a[0], a[1], b[0], b[1], cx, cy) != exact::orient2d(a[0], a[1], b[0], b[1], cx, cy);
   }
   EXPECT_EQ(disagreements, 0);
   EXPECT_GT(exactZeros, 0);  // the generator does reach exact degeneracy

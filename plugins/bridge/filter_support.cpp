@@ -100,11 +100,16 @@ ImportNotes importNotes(const MeshModel& model) {
   const QString ext = info.suffix().toLower();
   FileCounts c;
   std::ifstream in(path, std::ios::binary);
-  if (ext == "off") c = offCounts(in);
-  else if (ext == "ply") c = plyCounts(in);
-  else if (ext == "obj") c = objCounts(in);
-  else if (ext == "stl") c = stlCounts(path);
-  else return r;
+  if (ext == "off")
+    c = offCounts(in);
+  else if (ext == "ply")
+    c = plyCounts(in);
+  else if (ext == "obj")
+    c = objCounts(in);
+  else if (ext == "stl")
+    c = stlCounts(path);
+  else
+    return r;
   r.file_vertices = c.vertices;
   r.file_faces = c.faces;
   const long vn = model.cm.vn, fn = model.cm.fn;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include <QString>
 #include <common/interfaces.h>
 #include <common/meshmodel.h>
+#include <QString>
 
 #include "common/errors.h"
 #include "common/json.h"
@@ -18,11 +18,17 @@
 
 namespace meshmend::bridge {
 
-inline std::string toStd(const QString& s) { return s.toStdString(); }
-inline QString toQ(const std::string& s) { return QString::fromStdString(s); }
+inline std::string toStd(const QString& s) {
+  return s.toStdString();
+}
+inline QString toQ(const std::string& s) {
+  return QString::fromStdString(s);
+}
 
 // The layer's name as users see it in the layer dialog, quoted.
-inline std::string layerName(const MeshModel& m) { return "layer '" + toStd(m.label()) + "'"; }
+inline std::string layerName(const MeshModel& m) {
+  return "layer '" + toStd(m.label()) + "'";
+}
 
 // MeshLab's progress callback as a core Progress (null callback: no reports).
 inline Progress progressFrom(vcg::CallBackPos* cb) {

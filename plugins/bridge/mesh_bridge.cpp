@@ -109,8 +109,7 @@ vcg::Point3d barycentricOf(const vcg::Point3d& p, const vcg::Point3d& a, const v
   const double d00 = e0 * e0, d01 = e0 * e1, d11 = e1 * e1, d20 = d * e0, d21 = d * e1;
   const double denom = d00 * d11 - d01 * d01;
   if (!(std::fabs(denom) > 0)) {
-    const double da = (p - a).SquaredNorm(), db = (p - b).SquaredNorm(),
-                 dc = (p - c).SquaredNorm();
+    const double da = (p - a).SquaredNorm(), db = (p - b).SquaredNorm(), dc = (p - c).SquaredNorm();
     if (da <= db && da <= dc) return {1, 0, 0};
     return db <= dc ? vcg::Point3d(0, 1, 0) : vcg::Point3d(0, 0, 1);
   }

@@ -13,7 +13,7 @@
 namespace meshmend::bridge {
 
 struct ToCoreOptions {
-  int layer = 0;                // recorded as the origin layer of every element
+  int layer = 0;                 // recorded as the origin layer of every element
   bool apply_transform = false;  // apply the layer's matrix (cm.Tr): needed between layers
 };
 

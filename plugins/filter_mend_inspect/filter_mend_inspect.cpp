@@ -12,8 +12,14 @@ using namespace meshmend::bridge;
 namespace {
 
 // Values of the select_defects parameter.
-enum Selection { kSelectNone, kSelectAll, kSelectNonManifold, kSelectBorder, kSelectDegenerate,
-                 kSelectOrientation };
+enum Selection {
+  kSelectNone,
+  kSelectAll,
+  kSelectNonManifold,
+  kSelectBorder,
+  kSelectDegenerate,
+  kSelectOrientation
+};
 
 struct SelectionBits {
   std::uint8_t face, vertex;
@@ -21,13 +27,18 @@ struct SelectionBits {
 
 SelectionBits bitsFor(int selection) {
   switch (selection) {
-    case kSelectAll: return {0xff, kVertexNonManifold | kVertexOnBorder | kVertexIsolated |
-                                       kVertexDuplicate};
-    case kSelectNonManifold: return {kFaceOnNonManifoldEdge, kVertexNonManifold};
-    case kSelectBorder: return {kFaceOnBorder, kVertexOnBorder};
-    case kSelectDegenerate: return {kFaceDegenerate | kFaceDuplicate, 0};
-    case kSelectOrientation: return {kFaceOrientationFlip, 0};
-    default: return {0, 0};
+    case kSelectAll:
+      return {0xff, kVertexNonManifold | kVertexOnBorder | kVertexIsolated | kVertexDuplicate};
+    case kSelectNonManifold:
+      return {kFaceOnNonManifoldEdge, kVertexNonManifold};
+    case kSelectBorder:
+      return {kFaceOnBorder, kVertexOnBorder};
+    case kSelectDegenerate:
+      return {kFaceDegenerate | kFaceDuplicate, 0};
+    case kSelectOrientation:
+      return {kFaceOrientationFlip, 0};
+    default:
+      return {0, 0};
   }
 }
 
@@ -38,7 +49,9 @@ InspectPlugin::InspectPlugin() {
   for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
 }
 
-QString InspectPlugin::filterName(FilterIDType) const { return "MeshMend: Inspect Mesh Defects"; }
+QString InspectPlugin::filterName(FilterIDType) const {
+  return "MeshMend: Inspect Mesh Defects";
+}
 
 QString InspectPlugin::filterInfo(FilterIDType) const {
   return "Reports the defects of the current layer: vertices, faces, connected components, "
@@ -61,8 +74,11 @@ int InspectPlugin::postCondition(QAction*) const {
 void InspectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& parameters) {
   parameters.addParam(RichEnum(
       "select_defects", kSelectNone,
-      QStringList() << "None" << "All defects" << "Non-manifold edges and vertices"
-                    << "Border edges and vertices" << "Degenerate and duplicate faces"
+      QStringList() << "None"
+                    << "All defects"
+                    << "Non-manifold edges and vertices"
+                    << "Border edges and vertices"
+                    << "Degenerate and duplicate faces"
                     << "Orientation flips",
       "Select defects",
       "Replaces the face and vertex selection with the elements involved in the chosen kind of "
@@ -107,8 +123,8 @@ bool InspectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterL
     Log("  degenerate faces %zu, duplicate faces %zu", r.degenerate_faces, r.duplicate_faces);
     Log("  duplicate points %zu, unreferenced vertices %zu", r.duplicate_points,
         r.isolated_vertices);
-    Log("  orientation: %s (%zu inconsistent edges); %s", r.consistently_oriented
-        ? "consistent" : "inconsistent", r.orientation_inconsistent_edges,
+    Log("  orientation: %s (%zu inconsistent edges); %s",
+        r.consistently_oriented ? "consistent" : "inconsistent", r.orientation_inconsistent_edges,
         r.is_closed ? "closed" : "open");
     if (r.volume) Log("  volume %.10g", *r.volume);
     if (r.genus) Log("  genus %ld", *r.genus);
@@ -127,7 +143,8 @@ bool InspectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterL
         if (r.vertex_defects[i] & bits.vertex) cm.vert[vo[i].vertex].SetS();
       for (std::size_t f = 0; f < r.face_defects.size(); ++f)
         if (r.face_defects[f] & bits.face) cm.face[fo[f].face].SetS();
-      Log("  selected %d faces and %d vertices", int(vcg::tri::UpdateSelection<CMeshO>::FaceCount(cm)),
+      Log("  selected %d faces and %d vertices",
+          int(vcg::tri::UpdateSelection<CMeshO>::FaceCount(cm)),
           int(vcg::tri::UpdateSelection<CMeshO>::VertexCount(cm)));
     }
     reportProgress(progress, 100, "MeshMend: done");
