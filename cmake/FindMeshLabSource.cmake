@@ -4,7 +4,9 @@
 #
 # Sets MESHLAB_SOURCE_DIR, VCGLIB_DIR, MESHLAB_VERSION, and the imported
 # target meshmend::vcglib (header-only). Override with -DMESHLAB_SOURCE_DIR=...
-if(NOT MESHLAB_SOURCE_DIR)
+if(NOT MESHLAB_SOURCE_DIR OR NOT EXISTS "${MESHLAB_SOURCE_DIR}/ML_VERSION")
+  unset(MESHLAB_SOURCE_DIR CACHE)
+  unset(MESHLAB_SOURCE_DIR)
   file(GLOB _meshlab_candidates "${CMAKE_SOURCE_DIR}/.deps/meshlab-source/meshlab-*")
   list(SORT _meshlab_candidates)
   foreach(_dir ${_meshlab_candidates})

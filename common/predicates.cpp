@@ -1,5 +1,6 @@
 #include "common/predicates.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -75,6 +76,16 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
     if (-det > bound) return -1;
   }
   return exact::orient3d(a, b, c, d);
+}
+
+int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 normal = (b - a) ^ (c - a);  // component k = orientation dropping axis k
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3,
+            [&](int x, int y) { return std::fabs(normal[x]) > std::fabs(normal[y]); });
+  for (int axis : order)
+    if (orient2dDropping(a, b, c, axis) != 0) return axis;
+  return -1;
 }
 
 bool collinear(const Point3& a, const Point3& b, const Point3& c) {

@@ -23,6 +23,19 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
 // Exact: are the three points collinear (including coincident points)?
 bool collinear(const Point3& a, const Point3& b, const Point3& c);
 
+// Exact: the coordinate axis (0, 1, 2) to drop so that the projection of the
+// non-degenerate triangle (a, b, c) onto the other two axes is non-degenerate;
+// among the valid axes, the one along which its normal is largest. -1 when
+// the triangle is degenerate.
+int projectionAxis(const Point3& a, const Point3& b, const Point3& c);
+
+// orient2d of the projections of a, b, c onto the plane that drops `axis`
+// (coordinates (axis+1)%3, (axis+2)%3).
+inline int orient2dDropping(const Point3& a, const Point3& b, const Point3& c, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return orient2d(a[u], a[v], b[u], b[v], c[u], c[v]);
+}
+
 namespace exact {
 // Pure-GMP evaluations, used as the fallback and as the reference in tests.
 int orient2d(double ax, double ay, double bx, double by, double cx, double cy);

@@ -1,0 +1,389 @@
+#include "common/triangle_intersection.h"
+
+#include <algorithm>
+
+#include <gmpxx.h>
+
+#include "common/predicates.h"
+
+namespace meshmend {
+
+namespace {
+
+// ---- 2-D tests on the projection that drops `axis` ---------------------------
+
+// r is known to be collinear with p, q: is it within the closed segment?
+bool onSegment(const Point3& p, const Point3& q, const Point3& r, int axis) {
+  for (int k = 0; k < 3; ++k) {
+    if (k == axis) continue;
+    if (r[k] < std::min(p[k], q[k]) || r[k] > std::max(p[k], q[k])) return false;
+  }
+  return true;
+}
+
+bool segmentsIntersect2(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                        int axis) {
+  const int o1 = orient2dDropping(p, q, r, axis), o2 = orient2dDropping(p, q, s, axis);
+  const int o3 = orient2dDropping(r, s, p, axis), o4 = orient2dDropping(r, s, q, axis);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  return (o1 == 0 && onSegment(p, q, r, axis)) || (o2 == 0 && onSegment(p, q, s, axis)) ||
+         (o3 == 0 && onSegment(r, s, p, axis)) || (o4 == 0 && onSegment(r, s, q, axis));
+}
+
+bool pointInTriangle2(const Point3& p, const TrianglePoints& t, int axis) {
+  const int s = orient2dDropping(t[0], t[1], t[2], axis);
+  for (int i = 0; i < 3; ++i)
+    if (orient2dDropping(t[i], t[(i + 1) % 3], p, axis) * s < 0) return false;
+  return true;
+}
+
+bool segmentIntersectsTriangle2(const Point3& p, const Point3& q, const TrianglePoints& t,
+                                int axis) {
+  if (pointInTriangle2(p, t, axis) || pointInTriangle2(q, t, axis)) return true;
+  for (int i = 0; i < 3; ++i)
+    if (segmentsIntersect2(p, q, t[i], t[(i + 1) % 3], axis)) return true;
+  return false;
+}
+
+bool trianglesIntersect2(const TrianglePoints& a, const TrianglePoints& b, int axis) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (segmentsIntersect2(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3], axis)) return true;
+  return pointInTriangle2(a[0], b, axis) || pointInTriangle2(b[0], a, axis);
+}
+
+// ---- 3-D ---------------------------------------------------------------------
+
+// Does segment pq meet triangle t, given sp, sq = orient3d(t, p), orient3d(t, q)
+// (not both of one strict sign)?
+bool edgeMeetsTriangle(const Point3& p, const Point3& q, int sp, int sq,
+                       const TrianglePoints& t) {
+  if (sp == 0 && sq == 0)
+    return segmentIntersectsTriangle2(p, q, t, projectionAxis(t[0], t[1], t[2]));
+  // The segment meets the plane in one point: is it inside the triangle?
+  const int s1 = orient3d(p, q, t[0], t[1]);
+  const int s2 = orient3d(p, q, t[1], t[2]);
+  const int s3 = orient3d(p, q, t[2], t[0]);
+  return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+bool strictlyOneSide(const int s[3]) {
+  return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0);
+}
+
+}  // namespace
+
+bool segmentIntersectsTriangle(const Point3& p, const Point3& q, const TrianglePoints& t) {
+  const int sp = orient3d(t[0], t[1], t[2], p), sq = orient3d(t[0], t[1], t[2], q);
+  if (sp * sq > 0) return false;
+  return edgeMeetsTriangle(p, q, sp, sq, t);
+}
+
+bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b) {
+  int sb[3], sa[3];
+  for (int j = 0; j < 3; ++j) sb[j] = orient3d(a[0], a[1], a[2], b[j]);
+  if (strictlyOneSide(sb)) return false;
+  for (int i = 0; i < 3; ++i) sa[i] = orient3d(b[0], b[1], b[2], a[i]);
+  if (strictlyOneSide(sa)) return false;
+  if (sa[0] == 0 && sa[1] == 0 && sa[2] == 0)
+    return trianglesIntersect2(a, b, projectionAxis(a[0], a[1], a[2]));
+  // Not coplanar: an end point of the common segment lies on an edge of one
+  // triangle inside the other.
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (sa[i] * sa[j] <= 0 && edgeMeetsTriangle(a[i], a[j], sa[i], sa[j], b)) return true;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (sb[i] * sb[j] <= 0 && edgeMeetsTriangle(b[i], b[j], sb[i], sb[j], a)) return true;
+  }
+  return false;
+}
+
+bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int shared, int ia,
+                           int ib) {
+  switch (shared) {
+    case 0:
+      return trianglesIntersect(a, b);
+    case 1:
+      return segmentIntersectsTriangle(a[(ia + 1) % 3], a[(ia + 2) % 3], b) ||
+             segmentIntersectsTriangle(b[(ib + 1) % 3], b[(ib + 2) % 3], a);
+    case 2: {
+      const Point3 &p = a[(ia + 1) % 3], &q = a[(ia + 2) % 3];
+      if (orient3d(p, q, a[ia], b[ib]) != 0) return false;
+      const int axis = projectionAxis(a[0], a[1], a[2]);
+      return orient2dDropping(p, q, a[ia], axis) == orient2dDropping(p, q, b[ib], axis);
+    }
+    default:
+      return true;
+  }
+}
+
+const char* toString(ContactKind kind) {
+  switch (kind) {
+    case ContactKind::kNone: return "none";
+    case ContactKind::kCrossing: return "crossing";
+    case ContactKind::kTouchAtPoint: return "touch at a point";
+    case ContactKind::kTouchAlongEdge: return "touch along an edge";
+    case ContactKind::kCoplanarOverlap: return "coplanar overlap";
+    case ContactKind::kCoplanarTouch: return "coplanar touch";
+  }
+  return "?";
+}
+
+// ---- exact classification ------------------------------------------------------
+
+namespace {
+
+struct Exact3 {
+  mpq_class x[3];
+};
+
+Exact3 exactOf(const Point3& p) { return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}}; }
+
+// The double nearest to q.
+double nearest(const mpq_class& q) {
+  const double d = q.get_d();  // truncated toward zero
+  const double up = std::nextafter(d, q > 0 ? INFINITY : -INFINITY);
+  return abs(q - mpq_class(up)) < abs(q - mpq_class(d)) ? up : d;
+}
+
+Point3 rounded(const Exact3& p) { return {nearest(p.x[0]), nearest(p.x[1]), nearest(p.x[2])}; }
+
+// det[b-a, c-a, d-a], exactly.
+mpq_class orient3dValue(const Exact3& a, const Exact3& b, const Exact3& c, const Exact3& d) {
+  mpq_class m[3][3];
+  for (int k = 0; k < 3; ++k) {
+    m[0][k] = b.x[k] - a.x[k];
+    m[1][k] = c.x[k] - a.x[k];
+    m[2][k] = d.x[k] - a.x[k];
+  }
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+// Orientation of the projections (dropping `axis`), exactly.
+mpq_class orient2Value(const Exact3& a, const Exact3& b, const Exact3& c, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return (b.x[u] - a.x[u]) * (c.x[v] - a.x[v]) - (b.x[v] - a.x[v]) * (c.x[u] - a.x[u]);
+}
+
+// p + t (q - p)
+Exact3 along(const Exact3& p, const Exact3& q, const mpq_class& t) {
+  Exact3 r;
+  for (int k = 0; k < 3; ++k) r.x[k] = p.x[k] + t * (q.x[k] - p.x[k]);
+  return r;
+}
+
+class Classifier {
+ public:
+  Classifier(const TrianglePoints& a, const TrianglePoints& b) {
+    for (int i = 0; i < 3; ++i) {
+      P_[0][i] = exactOf(a[i]);
+      P_[1][i] = exactOf(b[i]);
+    }
+  }
+
+  TriangleContact run() {
+    // side[t][i]: corner i of triangle t against the other triangle's plane.
+    for (int t = 0; t < 2; ++t) {
+      const auto& o = P_[1 - t];
+      for (int i = 0; i < 3; ++i) side_[t][i] = orient3dValue(o[0], o[1], o[2], P_[t][i]);
+    }
+    for (int t = 0; t < 2; ++t) {
+      const int s[3] = {sgn(side_[t][0]), sgn(side_[t][1]), sgn(side_[t][2])};
+      if (strictlyOneSide(s)) return {};
+    }
+    if (sgn(side_[0][0]) == 0 && sgn(side_[0][1]) == 0 && sgn(side_[0][2]) == 0) return coplanar();
+    return transversal();
+  }
+
+ private:
+  struct Point {
+    ContactPoint tag;
+    Exact3 exact;
+  };
+
+  Point vertex(int t, int i) const {
+    ContactPoint c;
+    c.kind = ContactPoint::Kind::kVertex;
+    c.triangle = std::uint8_t(t);
+    c.index = std::uint8_t(i);
+    return {c, P_[t][i]};
+  }
+
+  // Not coplanar: each triangle meets the other's plane in a point or a
+  // segment; the contact is the overlap of the two along the planes' line.
+  TriangleContact transversal() {
+    std::vector<Point> part[2];
+    int zeros[2] = {0, 0};
+    for (int t = 0; t < 2; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        const int si = sgn(side_[t][i]), sj = sgn(side_[t][j]);
+        if (si == 0) {
+          part[t].push_back(vertex(t, i));
+          ++zeros[t];
+        }
+        if (si * sj < 0) {
+          Point p;
+          p.tag.kind = ContactPoint::Kind::kEdgeFace;
+          p.tag.triangle = std::uint8_t(t);
+          p.tag.index = std::uint8_t(i);
+          const mpq_class tt = side_[t][i] / (side_[t][i] - side_[t][j]);
+          p.exact = along(P_[t][i], P_[t][j], tt);
+          part[t].push_back(p);
+        }
+      }
+    // Positions along the line: projections onto d = normal(a) x normal(b).
+    Exact3 n[2];
+    for (int t = 0; t < 2; ++t) {
+      Exact3 e1, e2;
+      for (int k = 0; k < 3; ++k) {
+        e1.x[k] = P_[t][1].x[k] - P_[t][0].x[k];
+        e2.x[k] = P_[t][2].x[k] - P_[t][0].x[k];
+      }
+      for (int k = 0; k < 3; ++k)
+        n[t].x[k] = e1.x[(k + 1) % 3] * e2.x[(k + 2) % 3] - e1.x[(k + 2) % 3] * e2.x[(k + 1) % 3];
+    }
+    Exact3 d;
+    for (int k = 0; k < 3; ++k)
+      d.x[k] = n[0].x[(k + 1) % 3] * n[1].x[(k + 2) % 3] - n[0].x[(k + 2) % 3] * n[1].x[(k + 1) % 3];
+    auto key = [&](const Point& p) -> mpq_class { return d.x[0] * p.exact.x[0] + d.x[1] * p.exact.x[1] + d.x[2] * p.exact.x[2]; };
+    const Point *lo[2], *hi[2];
+    mpq_class loKey[2], hiKey[2];
+    for (int t = 0; t < 2; ++t) {
+      lo[t] = hi[t] = &part[t][0];
+      loKey[t] = hiKey[t] = key(part[t][0]);
+      for (const Point& p : part[t]) {
+        const mpq_class k = key(p);
+        if (k < loKey[t]) lo[t] = &p, loKey[t] = k;
+        if (k > hiKey[t]) hi[t] = &p, hiKey[t] = k;
+      }
+    }
+    // The overlap [max of starts, min of ends]; on a tie a vertex describes
+    // the point best, then triangle a's element.
+    auto better = [](const Point* x, const Point* y) {
+      return y->tag.kind == ContactPoint::Kind::kVertex && x->tag.kind != ContactPoint::Kind::kVertex;
+    };
+    const Point* start = loKey[0] > loKey[1] ? lo[0] : loKey[1] > loKey[0] ? lo[1] : (better(lo[0], lo[1]) ? lo[1] : lo[0]);
+    const mpq_class startKey = std::max(loKey[0], loKey[1]);
+    const Point* end = hiKey[0] < hiKey[1] ? hi[0] : hiKey[1] < hiKey[0] ? hi[1] : (better(hi[0], hi[1]) ? hi[1] : hi[0]);
+    const mpq_class endKey = std::min(hiKey[0], hiKey[1]);
+    TriangleContact c;
+    if (startKey > endKey) return c;
+    if (startKey == endKey) {
+      c.kind = ContactKind::kTouchAtPoint;
+      c.points.push_back(finish(*start));
+      return c;
+    }
+    c.kind = (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
+    c.points.push_back(finish(*start));
+    c.points.push_back(finish(*end));
+    return c;
+  }
+
+  // Coplanar: clip triangle a by the three edge lines of b (Sutherland-
+  // Hodgman). Every clipped edge lies on a line of a's or b's edges, so each
+  // new corner is an edge-edge crossing or a corner of b.
+  TriangleContact coplanar() {
+    const TrianglePoints a{rounded(P_[0][0]), rounded(P_[0][1]), rounded(P_[0][2])};
+    axis_ = projectionAxis(a[0], a[1], a[2]);
+    const int orientation = sgn(orient2Value(P_[1][0], P_[1][1], P_[1][2], axis_));
+    struct Corner {
+      Point point;
+      int line;  // line of the edge leaving this corner: 0..2 edges of a, 3..5 edges of b
+    };
+    std::vector<Corner> polygon;
+    for (int i = 0; i < 3; ++i) polygon.push_back({vertex(0, i), i});
+    for (int j = 0; j < 3 && !polygon.empty(); ++j) {
+      const Exact3 &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
+      auto inside = [&](const Point& p) { return sgn(orient2Value(b0, b1, p.exact, axis_)) * orientation >= 0; };
+      std::vector<Corner> out;
+      for (std::size_t k = 0; k < polygon.size(); ++k) {
+        const Corner& s = polygon[k];
+        const Corner& e = polygon[(k + 1) % polygon.size()];
+        const bool sIn = inside(s.point), eIn = inside(e.point);
+        if (sIn && eIn) {
+          out.push_back(e);
+        } else if (sIn && !eIn) {
+          out.push_back({crossing(s.line, j), 3 + j});
+        } else if (!sIn && eIn) {
+          out.push_back({crossing(s.line, j), s.line});
+          out.push_back(e);
+        }
+      }
+      polygon = std::move(out);
+    }
+    // Drop repeated points (touching configurations repeat corners).
+    std::vector<Point> points;
+    for (const Corner& c : polygon) {
+      bool seen = false;
+      for (const Point& p : points) seen |= p.exact.x[0] == c.point.exact.x[0] && p.exact.x[1] == c.point.exact.x[1] && p.exact.x[2] == c.point.exact.x[2];
+      if (!seen) points.push_back(c.point);
+    }
+    TriangleContact c;
+    if (points.empty()) return c;
+    mpq_class area2 = 0;
+    for (std::size_t k = 0; k + 2 < points.size(); ++k)
+      area2 += orient2Value(points[0].exact, points[k + 1].exact, points[k + 2].exact, axis_);
+    if (sgn(area2) != 0) {
+      c.kind = ContactKind::kCoplanarOverlap;
+      for (const Point& p : points) c.points.push_back(finish(p));
+      return c;
+    }
+    c.kind = ContactKind::kCoplanarTouch;
+    if (points.size() == 1) {
+      c.points.push_back(finish(points[0]));
+      return c;
+    }
+    // Collinear points: keep the two extremes.
+    const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
+    auto less = [&](const Point& x, const Point& y) {
+      return x.exact.x[u] < y.exact.x[u] || (x.exact.x[u] == y.exact.x[u] && x.exact.x[v] < y.exact.x[v]);
+    };
+    const auto [mn, mx] = std::minmax_element(points.begin(), points.end(), less);
+    c.points.push_back(finish(*mn));
+    c.points.push_back(finish(*mx));
+    return c;
+  }
+
+  // Where a clipped edge lying on `line` crosses the line of b's edge j.
+  Point crossing(int line, int j) const {
+    if (line >= 3) {  // two edge lines of b meet at their common corner
+      const int m = line - 3;
+      return vertex(1, (m + 1) % 3 == j ? j : m);
+    }
+    Point p;
+    p.tag.kind = ContactPoint::Kind::kEdgeEdge;
+    p.tag.triangle = 0;
+    p.tag.index = std::uint8_t(line);
+    p.tag.other_index = std::uint8_t(j);
+    // On a's edge `line` (from corner line to line+1), at the parameter where
+    // it crosses b's edge line j.
+    const Exact3 &a0 = P_[0][line], &a1 = P_[0][(line + 1) % 3];
+    const Exact3 &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
+    const mpq_class o0 = orient2Value(b0, b1, a0, axis_), o1 = orient2Value(b0, b1, a1, axis_);
+    p.exact = along(a0, a1, o0 / (o0 - o1));
+    return p;
+  }
+
+  ContactPoint finish(const Point& p) const {
+    ContactPoint c = p.tag;
+    c.position = rounded(p.exact);
+    return c;
+  }
+
+  Exact3 P_[2][3];
+  mpq_class side_[2][3];
+  int axis_ = 2;
+};
+
+}  // namespace
+
+TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b) {
+  return Classifier(a, b).run();
+}
+
+}  // namespace meshmend
