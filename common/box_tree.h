@@ -1,0 +1,162 @@
+// Candidate search for intersecting triangles: a bounding-volume hierarchy
+// over axis-aligned boxes, with parallel self-join and box queries.
+//
+// Boxes are stored in float, rounded outward, so that they stay conservative
+// (two triangles that touch always have overlapping boxes) at half the memory
+// traffic of doubles; touching boxes count as overlapping.
+#pragma once
+
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "common/mesh.h"
+#include "common/parallel.h"
+
+namespace meshmend {
+
+struct Box {
+  float lo[3], hi[3];
+};
+
+// The smallest float box containing the three points (rounded outward).
+Box boxOf(const Point3& a, const Point3& b, const Point3& c);
+
+inline bool overlap(const Box& x, const Box& y) {
+  return x.lo[0] <= y.hi[0] && y.lo[0] <= x.hi[0] && x.lo[1] <= y.hi[1] && y.lo[1] <= x.hi[1] &&
+         x.lo[2] <= y.hi[2] && y.lo[2] <= x.hi[2];
+}
+
+class BoxTree {
+ public:
+  // Builds the hierarchy over `boxes` (primitive i = boxes[i]), using both cores.
+  explicit BoxTree(std::vector<Box> boxes);
+
+  std::size_t size() const { return boxes_.size(); }
+  const Box& bounds() const { return nodes_.empty() ? empty_ : nodes_[0].box; }
+
+  // Calls visit(i, j, worker) once for every pair i < j of overlapping boxes,
+  // from several threads (worker = 0..workerCount()-1).
+  template <class Visit>
+  void selfPairs(Visit&& visit) const;
+
+  // Calls visit(i, worker) for every box of this tree that overlaps `query`.
+  template <class Visit>
+  void query(const Box& query, unsigned worker, Visit&& visit) const;
+
+ private:
+  struct Node {
+    Box box;
+    std::uint32_t a;  // internal: left child; leaf: first index into order_
+    std::uint32_t b;  // internal: right child; leaf: count | kLeaf
+  };
+  static constexpr std::uint32_t kLeaf = 0x80000000u;
+  static constexpr std::uint32_t kLeafSize = 4;
+
+  bool leaf(const Node& n) const { return n.b & kLeaf; }
+  std::uint32_t count(const Node& n) const { return n.b & ~kLeaf; }
+
+  void build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out);
+
+  template <class Visit>
+  void within(std::uint32_t n, unsigned worker, Visit& visit) const;
+  template <class Visit>
+  void between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& visit) const;
+  void tasks(std::uint32_t n, int depth, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+  void pairTasks(std::uint32_t x, std::uint32_t y, int depth,
+                 std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+
+  std::vector<Box> boxes_;
+  std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
+  std::vector<Node> nodes_;
+  Box empty_{{1, 1, 1}, {0, 0, 0}};
+};
+
+// ---- templates -----------------------------------------------------------------
+
+template <class Visit>
+void BoxTree::within(std::uint32_t n, unsigned worker, Visit& visit) const {
+  const Node& node = nodes_[n];
+  if (leaf(node)) {
+    const std::uint32_t first = node.a, last = node.a + count(node);
+    for (std::uint32_t i = first; i < last; ++i)
+      for (std::uint32_t j = i + 1; j < last; ++j) {
+        const std::uint32_t p = order_[i], q = order_[j];
+        if (overlap(boxes_[p], boxes_[q])) visit(std::min(p, q), std::max(p, q), worker);
+      }
+    return;
+  }
+  within(node.a, worker, visit);
+  within(node.b, worker, visit);
+  between(node.a, node.b, worker, visit);
+}
+
+template <class Visit>
+void BoxTree::between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& visit) const {
+  const Node &nx = nodes_[x], &ny = nodes_[y];
+  if (!overlap(nx.box, ny.box)) return;
+  if (leaf(nx) && leaf(ny)) {
+    for (std::uint32_t i = nx.a; i < nx.a + count(nx); ++i) {
+      const std::uint32_t p = order_[i];
+      const Box& bp = boxes_[p];
+      if (!overlap(bp, ny.box)) continue;
+      for (std::uint32_t j = ny.a; j < ny.a + count(ny); ++j) {
+        const std::uint32_t q = order_[j];
+        if (overlap(bp, boxes_[q])) visit(std::min(p, q), std::max(p, q), worker);
+      }
+    }
+    return;
+  }
+  // Descend the larger node (by box extent sum), or the one that is not a leaf.
+  auto extent = [](const Box& b) {
+    return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]);
+  };
+  if (leaf(ny) || (!leaf(nx) && extent(nx.box) >= extent(ny.box))) {
+    between(nx.a, y, worker, visit);
+    between(nx.b, y, worker, visit);
+  } else {
+    between(x, ny.a, worker, visit);
+    between(x, ny.b, worker, visit);
+  }
+}
+
+template <class Visit>
+void BoxTree::selfPairs(Visit&& visit) const {
+  if (nodes_.empty()) return;
+  // Split the traversal into independent tasks: (n, n) = all pairs within
+  // node n, (x, y) = pairs between two nodes; workers take them in turn.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
+  tasks(0, 8, work);
+  std::atomic<std::size_t> next{0};
+  parallelChunks(workerCount(), [&](std::size_t, std::size_t, unsigned worker) {
+    for (std::size_t t; (t = next.fetch_add(1)) < work.size();) {
+      const auto [x, y] = work[t];
+      if (x == y)
+        within(x, worker, visit);
+      else
+        between(x, y, worker, visit);
+    }
+  }, 1);
+}
+
+template <class Visit>
+void BoxTree::query(const Box& q, unsigned worker, Visit&& visit) const {
+  if (nodes_.empty()) return;
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!overlap(n.box, q)) continue;
+    if (leaf(n)) {
+      for (std::uint32_t i = n.a; i < n.a + count(n); ++i)
+        if (overlap(boxes_[order_[i]], q)) visit(order_[i], worker);
+    } else {
+      stack[top++] = n.a;
+      stack[top++] = n.b;
+    }
+  }
+}
+
+}  // namespace meshmend

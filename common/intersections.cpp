@@ -1,0 +1,209 @@
+#include "common/intersections.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "common/box_tree.h"
+#include "common/errors.h"
+#include "common/parallel.h"
+#include "common/predicates.h"
+
+namespace meshmend {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// A mesh flattened for the inner loops.
+struct Soup {
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  std::vector<Box> boxes;
+  std::vector<bool> degenerate;
+
+  explicit Soup(const Mesh& mesh) : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
+    boxes.resize(triangles.size());
+    degenerate.resize(triangles.size());
+    parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const Triangle& t = triangles[f];
+        boxes[f] = boxOf(points[t[0]], points[t[1]], points[t[2]]);
+        degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
+      }
+    });
+  }
+  TrianglePoints at(std::uint32_t f) const {
+    const Triangle& t = triangles[f];
+    return {points[t[0]], points[t[1]], points[t[2]]};
+  }
+};
+
+// The self-intersection rule for two faces of one mesh.
+bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
+  const Triangle &a = s.triangles[f], &b = s.triangles[g];
+  int shared = 0, ia = -1, ib = -1;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (a[i] == b[j]) ++shared, ia = i, ib = j;
+  if (shared == 2) {  // the rule wants the apexes: the corners not shared
+    for (int i = 0; i < 3; ++i)
+      if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) ia = i;
+    for (int j = 0; j < 3; ++j)
+      if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) ib = j;
+  }
+  return intersectBeyondShared(s.at(f), s.at(g), shared, ia, ib);
+}
+
+}  // namespace
+
+FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
+                                          const FindIntersectionsOptions& options) {
+  const auto start = Clock::now();
+  FindIntersectionsResult r;
+  const std::size_t n = meshes.size();
+  for (std::size_t m = 0; m < n; ++m)
+    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+  reportProgress(options.progress, 0, "Preparing boxes");
+  std::vector<Soup> soups;
+  soups.reserve(n);
+  for (const Mesh* mesh : meshes) soups.emplace_back(*mesh);
+  std::vector<std::vector<IntersectingPair>> found(workerCount());
+  std::vector<std::size_t> candidates(workerCount(), 0);
+
+  // A mesh needs a tree for its self-intersections, or when it is the
+  // smaller of a pair (the larger one's faces query it).
+  const auto buildStart = Clock::now();
+  std::vector<bool> needsTree(n, options.self);
+  if (options.cross)
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = m + 1; k < n; ++k)
+        needsTree[soups[m].triangles.size() > soups[k].triangles.size() ? k : m] = true;
+  std::vector<BoxTree> trees;
+  trees.reserve(n);
+  for (std::size_t m = 0; m < n; ++m)
+    trees.emplace_back(needsTree[m] ? soups[m].boxes : std::vector<Box>());
+  r.build_ms = msSince(buildStart);
+
+  const auto searchStart = Clock::now();
+  if (options.self)
+    for (std::size_t m = 0; m < n; ++m) {
+      reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
+      const Soup& s = soups[m];
+      trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
+        if (s.degenerate[f] || s.degenerate[g]) return;
+        ++candidates[worker];
+        if (selfIntersect(s, f, g))
+          found[worker].push_back({{std::uint32_t(m), f}, {std::uint32_t(m), g}});
+      });
+    }
+  if (options.cross)
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = m + 1; k < n; ++k) {
+        reportProgress(options.progress, 50, "Intersections between meshes");
+        // Query the faces of the larger mesh against the tree of the smaller.
+        const bool swap = soups[m].triangles.size() > soups[k].triangles.size();
+        const std::size_t small = swap ? k : m, large = swap ? m : k;
+        const Soup &s = soups[small], &l = soups[large];
+        const Box& smallBounds = trees[small].bounds();
+        parallelChunks(l.triangles.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+          for (std::size_t g = begin; g < end; ++g) {
+            if (l.degenerate[g] || !overlap(l.boxes[g], smallBounds)) continue;
+            const TrianglePoints tg = l.at(std::uint32_t(g));
+            trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
+              if (s.degenerate[f]) return;
+              ++candidates[w];
+              if (!trianglesIntersect(s.at(f), tg)) return;
+              FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
+              if (b < a) std::swap(a, b);
+              found[w].push_back({a, b});
+            });
+          }
+        }, 1024);
+      }
+  r.search_ms = msSince(searchStart);
+
+  for (std::size_t w = 0; w < found.size(); ++w) {
+    r.pairs.insert(r.pairs.end(), found[w].begin(), found[w].end());
+    r.candidate_pairs += candidates[w];
+  }
+  std::sort(r.pairs.begin(), r.pairs.end(), [](const IntersectingPair& x, const IntersectingPair& y) {
+    return x.a < y.a || (x.a == y.a && x.b < y.b);
+  });
+
+  r.self_pairs.assign(n, 0);
+  r.self_faces.assign(n, 0);
+  r.cross_faces.assign(n, 0);
+  r.face_involved.resize(n);
+  std::vector<std::vector<bool>> inSelf(n), inCross(n);
+  for (std::size_t m = 0; m < n; ++m) {
+    const std::size_t faces = soups[m].triangles.size();
+    r.face_involved[m].assign(faces, false);
+    inSelf[m].assign(faces, false);
+    inCross[m].assign(faces, false);
+    r.degenerate_faces.push_back(
+        std::size_t(std::count(soups[m].degenerate.begin(), soups[m].degenerate.end(), true)));
+  }
+  for (const IntersectingPair& p : r.pairs) {
+    auto& flags = p.a.mesh == p.b.mesh ? inSelf : inCross;
+    if (p.a.mesh == p.b.mesh)
+      ++r.self_pairs[p.a.mesh];
+    else
+      ++r.cross_pairs;
+    for (const FaceRef& f : {p.a, p.b}) {
+      flags[f.mesh][f.face] = true;
+      r.face_involved[f.mesh][f.face] = true;
+    }
+  }
+  for (std::size_t m = 0; m < n; ++m) {
+    r.self_faces[m] = std::size_t(std::count(inSelf[m].begin(), inSelf[m].end(), true));
+    r.cross_faces[m] = std::size_t(std::count(inCross[m].begin(), inCross[m].end(), true));
+  }
+
+  if (options.contacts) {
+    reportProgress(options.progress, 80, "Intersection segments");
+    r.contacts.resize(r.pairs.size());
+    parallelChunks(r.pairs.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const IntersectingPair& p = r.pairs[i];
+        r.contacts[i] = classifyContact(soups[p.a.mesh].at(p.a.face), soups[p.b.mesh].at(p.b.face));
+      }
+    }, 64);
+  }
+  reportProgress(options.progress, 100, "Done");
+  r.time_ms = msSince(start);
+  return r;
+}
+
+JsonObject toJson(const FindIntersectionsResult& r) {
+  std::size_t selfPairs = 0, selfFaces = 0, crossFaces = 0;
+  std::vector<double> perMeshPairs, perMeshFaces, perMeshCross, degenerate;
+  for (std::size_t m = 0; m < r.self_pairs.size(); ++m) {
+    selfPairs += r.self_pairs[m];
+    selfFaces += r.self_faces[m];
+    crossFaces += r.cross_faces[m];
+    perMeshPairs.push_back(double(r.self_pairs[m]));
+    perMeshFaces.push_back(double(r.self_faces[m]));
+    perMeshCross.push_back(double(r.cross_faces[m]));
+    degenerate.push_back(double(r.degenerate_faces[m]));
+  }
+  JsonObject j;
+  j.set("self_intersecting_pairs", selfPairs)
+      .set("self_intersecting_faces", selfFaces)
+      .set("cross_intersecting_pairs", r.cross_pairs)
+      .set("cross_intersecting_faces", crossFaces)
+      .set("self_intersecting_pairs_per_layer", perMeshPairs)
+      .set("self_intersecting_faces_per_layer", perMeshFaces)
+      .set("cross_intersecting_faces_per_layer", perMeshCross)
+      .set("degenerate_faces_skipped_per_layer", degenerate)
+      .set("candidate_pairs", r.candidate_pairs)
+      .set("build_ms", r.build_ms)
+      .set("search_ms", r.search_ms)
+      .set("time_ms", r.time_ms);
+  return j;
+}
+
+}  // namespace meshmend

@@ -1,0 +1,60 @@
+// Finding intersecting triangles, exactly: within each mesh (the rule of
+// CGAL::Polygon_mesh_processing::self_intersections, vertex identity = vertex
+// index) and between meshes (any contact). Candidates come from a box
+// hierarchy (box_tree.h); every decision is exact (triangle_intersection.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/json.h"
+#include "common/mesh.h"
+#include "common/progress.h"
+#include "common/triangle_intersection.h"
+
+namespace meshmend {
+
+struct FindIntersectionsOptions {
+  bool self = true;       // pairs of faces of the same mesh
+  bool cross = true;      // pairs of faces of different meshes
+  bool contacts = false;  // classify every pair and keep its exact contact points
+  Progress progress;      // called between stages
+};
+
+// A face of one of the input meshes.
+struct FaceRef {
+  std::uint32_t mesh = 0;
+  std::uint32_t face = 0;
+  bool operator<(const FaceRef& o) const { return mesh < o.mesh || (mesh == o.mesh && face < o.face); }
+  bool operator==(const FaceRef& o) const { return mesh == o.mesh && face == o.face; }
+};
+
+struct IntersectingPair {
+  FaceRef a, b;  // a < b
+};
+
+struct FindIntersectionsResult {
+  std::vector<IntersectingPair> pairs;    // sorted by (a, b)
+  std::vector<TriangleContact> contacts;  // parallel to pairs (only with options.contacts)
+  std::vector<std::size_t> self_pairs;    // per mesh: pairs within it
+  std::vector<std::size_t> self_faces;    // per mesh: distinct faces in those pairs
+  std::size_t cross_pairs = 0;            // pairs between different meshes
+  std::vector<std::size_t> cross_faces;   // per mesh: distinct faces in cross pairs
+  std::vector<std::vector<bool>> face_involved;  // per mesh, per face: in any pair
+  std::vector<std::size_t> degenerate_faces;     // per mesh: collinear faces (never compared)
+  std::size_t candidate_pairs = 0;               // box pairs tested exactly
+  double build_ms = 0, search_ms = 0, time_ms = 0;
+};
+
+// Finds every intersecting pair among `meshes` (compact, finite coordinates,
+// all in one frame). Degenerate (collinear) faces are skipped, as in CGAL.
+// Throws InvalidInputError for a non-finite coordinate.
+FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
+                                          const FindIntersectionsOptions& options = {});
+
+// The report_file keys: self_intersecting_pairs/faces (summed over meshes),
+// cross_intersecting_pairs, per-mesh lists, candidates and time_ms.
+JsonObject toJson(const FindIntersectionsResult& result);
+
+}  // namespace meshmend
