@@ -1,0 +1,205 @@
+#include "common/intersections.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "common/box_tree.h"
+#include "common/errors.h"
+#include "common/predicates.h"
+#include "mesh_builders.h"
+
+namespace meshmend {
+namespace {
+
+using testing::box;
+using testing::uvSphere;
+
+Mesh moved(const Mesh& m, Point3 by) {
+  std::vector<Point3> p = positionsOf(m);
+  for (Point3& q : p) q += by;
+  return makeMesh(p, trianglesOf(m));
+}
+
+Mesh joined(const Mesh& a, const Mesh& b) {
+  std::vector<Point3> p = positionsOf(a), pb = positionsOf(b);
+  std::vector<Triangle> t = trianglesOf(a);
+  const int offset = int(p.size());
+  p.insert(p.end(), pb.begin(), pb.end());
+  for (Triangle f : trianglesOf(b)) t.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
+  return makeMesh(p, t);
+}
+
+// Brute force over all face pairs with the same exact rules.
+std::size_t bruteForceSelfPairs(const Mesh& m) {
+  const std::vector<Point3> p = positionsOf(m);
+  const std::vector<Triangle> t = trianglesOf(m);
+  std::size_t pairs = 0;
+  for (std::size_t f = 0; f < t.size(); ++f)
+    for (std::size_t g = f + 1; g < t.size(); ++g) {
+      const TrianglePoints a{p[t[f][0]], p[t[f][1]], p[t[f][2]]}, b{p[t[g][0]], p[t[g][1]], p[t[g][2]]};
+      if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) continue;
+      int shared = 0, ia = -1, ib = -1;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (t[f][i] == t[g][j]) ++shared, ia = i, ib = j;
+      if (shared == 2) {
+        for (int i = 0; i < 3; ++i)
+          if (t[f][i] != t[g][0] && t[f][i] != t[g][1] && t[f][i] != t[g][2]) ia = i;
+        for (int j = 0; j < 3; ++j)
+          if (t[g][j] != t[f][0] && t[g][j] != t[f][1] && t[g][j] != t[f][2]) ib = j;
+      }
+      pairs += intersectBeyondShared(a, b, shared, ia, ib);
+    }
+  return pairs;
+}
+
+TEST(Intersections, CleanClosedMeshHasNone) {
+  const Mesh s = uvSphere(16, 24);
+  const FindIntersectionsResult r = findIntersections({&s});
+  EXPECT_EQ(r.self_pairs[0], 0u);
+  EXPECT_GT(r.candidate_pairs, 0u);  // neighbours' boxes touch: tested, rejected
+}
+
+TEST(Intersections, TwoOverlappingCubesInOneMesh) {
+  // The unit cube and a copy moved by (0.5, 0.5, 0.5): 18 intersecting pairs
+  // (the count meshcheck and CGAL give).
+  const Mesh both = joined(box(), moved(box(), {0.5, 0.5, 0.5}));
+  const FindIntersectionsResult r = findIntersections({&both});
+  EXPECT_EQ(r.self_pairs[0], 18u);
+  EXPECT_EQ(r.self_pairs[0], bruteForceSelfPairs(both));
+}
+
+TEST(Intersections, TwoOverlappingCubesAsTwoMeshes) {
+  const Mesh a = box(), b = moved(box(), {0.5, 0.5, 0.5});
+  const FindIntersectionsResult r = findIntersections({&a, &b});
+  EXPECT_EQ(r.cross_pairs, 18u);
+  EXPECT_EQ(r.self_pairs[0] + r.self_pairs[1], 0u);
+  EXPECT_EQ(r.cross_faces[0], 6u);
+  EXPECT_EQ(r.cross_faces[1], 6u);
+  for (const IntersectingPair& p : r.pairs) EXPECT_LT(p.a.mesh, p.b.mesh);
+  FindIntersectionsOptions selfOnly;
+  selfOnly.cross = false;
+  EXPECT_EQ(findIntersections({&a, &b}, selfOnly).cross_pairs, 0u);
+}
+
+TEST(Intersections, SharedVertexAndSharedEdgeRules) {
+  // Folded: two coplanar triangles on one edge, apexes on the same side.
+  const Mesh fold = makeMesh({{0, 0, 0}, {2, 0, 0}, {1, 1, 0}, {1, 2, 0}}, {{0, 1, 2}, {1, 0, 3}});
+  EXPECT_EQ(findIntersections({&fold}).self_pairs[0], 1u);
+  // A fan around one vertex with one triangle's far edge piercing the other.
+  const Mesh pierce = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {2, 1, -1}, {2, 1, 1}},
+                               {{0, 1, 2}, {0, 3, 4}});
+  EXPECT_EQ(findIntersections({&pierce}).self_pairs[0], 1u);
+  // The same fan, not piercing: only the shared vertex.
+  const Mesh fan = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {-2, -1, -1}, {-2, -1, 1}},
+                            {{0, 1, 2}, {0, 3, 4}});
+  EXPECT_EQ(findIntersections({&fan}).self_pairs[0], 0u);
+}
+
+TEST(Intersections, DuplicatePointsAreDifferentVertices) {
+  // Two triangles that share an edge geometrically but not by index touch.
+  const Mesh seam = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}},
+                             {{0, 1, 2}, {3, 5, 4}});
+  EXPECT_EQ(findIntersections({&seam}).self_pairs[0], 1u);
+}
+
+TEST(Intersections, DegenerateFacesAreSkipped) {
+  const Mesh m = makeMesh({{0, 0, 0}, {2, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, -1, -1}, {1, -1, 1}},
+                          {{0, 1, 2}, {0, 1, 3}, {2, 4, 5}});
+  const FindIntersectionsResult r = findIntersections({&m});
+  EXPECT_EQ(r.degenerate_faces[0], 1u);
+}
+
+// The candidate search misses nothing: random soups against brute force.
+TEST(Intersections, AgreesWithBruteForceOnRandomSoups) {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Point3> p;
+    std::vector<Triangle> t;
+    for (int f = 0; f < 300; ++f) {
+      const Point3 c(u(rng), u(rng), u(rng));
+      for (int k = 0; k < 3; ++k) p.push_back(c + Point3(u(rng), u(rng), u(rng)) * 0.15);
+      t.push_back({3 * f, 3 * f + 1, 3 * f + 2});
+    }
+    // Share some vertices so that every rule is exercised.
+    for (int f = 1; f < 300; f += 7) t[f][0] = t[f - 1][1];
+    const Mesh m = makeMesh(p, t);
+    EXPECT_EQ(findIntersections({&m}).self_pairs[0], bruteForceSelfPairs(m)) << "trial " << trial;
+  }
+}
+
+TEST(Intersections, LargeMeshSelfJoinMatchesBruteForceOnAPushedSphere) {
+  // A sphere whose north cap is pushed through its south side.
+  Mesh s = uvSphere(20, 30);
+  for (Vertex& v : s.vert)
+    if (v.P()[2] > 0.7) v.P()[2] -= 1.5;
+  const FindIntersectionsResult r = findIntersections({&s});
+  EXPECT_GT(r.self_pairs[0], 0u);
+  EXPECT_EQ(r.self_pairs[0], bruteForceSelfPairs(s));
+}
+
+TEST(Intersections, ContactsAreClassified) {
+  const Mesh a = box(), b = moved(box(), {0.5, 0.5, 0.5});
+  FindIntersectionsOptions o;
+  o.contacts = true;
+  const FindIntersectionsResult r = findIntersections({&a, &b}, o);
+  ASSERT_EQ(r.contacts.size(), r.pairs.size());
+  for (const TriangleContact& c : r.contacts) {
+    EXPECT_NE(c.kind, ContactKind::kNone);
+    EXPECT_GE(c.points.size(), 1u);
+  }
+}
+
+TEST(Intersections, BadInput) {
+  const Mesh empty;
+  EXPECT_THROW(findIntersections({&empty}), InvalidInputError);
+  Mesh nan = box();
+  nan.vert[0].P()[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(findIntersections({&nan}), InvalidInputError);
+}
+
+TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 10);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 30000; ++i) {
+    const Point3 a(u(rng), u(rng), u(rng));
+    boxes.push_back(boxOf(a, a + Point3(0.1, 0.2, 0.1), a + Point3(0.2, 0.05, 0.15)));
+  }
+  const BoxTree tree(boxes);
+  std::vector<std::size_t> perWorker(workerCount(), 0);
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned w) {
+    EXPECT_LT(i, j);
+    ++perWorker[w];
+  });
+  std::size_t pairs = 0;
+  for (std::size_t n : perWorker) pairs += n;
+  // Brute force over a sorted sweep on x.
+  std::vector<std::uint32_t> order(boxes.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](auto x, auto y) { return boxes[x].lo[0] < boxes[y].lo[0]; });
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo[0] <= boxes[order[i]].hi[0]; ++j)
+      expected += overlap(boxes[order[i]], boxes[order[j]]);
+  EXPECT_EQ(pairs, expected);
+  std::size_t hits = 0;
+  tree.query(boxes[17], 0, [&](std::uint32_t, unsigned) { ++hits; });
+  std::size_t expectedHits = 0;
+  for (const Box& b : boxes) expectedHits += overlap(b, boxes[17]);
+  EXPECT_EQ(hits, expectedHits);
+}
+
+TEST(BoxTree, BoxesAreConservative) {
+  const double x = 0.1;  // not a float: the box must still contain it
+  const Box b = boxOf({x, x, x}, {x, x, x}, {x, x, x});
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(double(b.lo[k]), x);
+    EXPECT_GE(double(b.hi[k]), x);
+  }
+}
+
+}  // namespace
+}  // namespace meshmend
