@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
+#include <set>
 
 #include "common/box_tree.h"
 #include "common/errors.h"
@@ -176,6 +178,30 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);
   return r;
+}
+
+SegmentSoup contactSegments(const FindIntersectionsResult& result) {
+  SegmentSoup soup;
+  std::map<std::array<double, 3>, int> index;
+  auto at = [&](const Point3& p) {
+    const auto [it, added] = index.emplace(std::array<double, 3>{p[0], p[1], p[2]}, int(soup.points.size()));
+    if (added) soup.points.push_back(p);
+    return it->second;
+  };
+  std::set<std::array<int, 2>> seen;
+  auto add = [&](const Point3& p, const Point3& q) {
+    std::array<int, 2> e{at(p), at(q)};
+    if (e[0] == e[1]) return;
+    if (e[0] > e[1]) std::swap(e[0], e[1]);
+    if (seen.insert(e).second) soup.edges.push_back(e);
+  };
+  for (const TriangleContact& c : result.contacts) {
+    const std::size_t n = c.points.size();
+    if (n == 2) add(c.points[0].position, c.points[1].position);
+    if (n > 2)
+      for (std::size_t i = 0; i < n; ++i) add(c.points[i].position, c.points[(i + 1) % n].position);
+  }
+  return soup;
 }
 
 JsonObject toJson(const FindIntersectionsResult& r) {

@@ -53,6 +53,15 @@ struct FindIntersectionsResult {
 FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
                                           const FindIntersectionsOptions& options = {});
 
+// The contact segments of every pair (a coplanar overlap contributes its
+// outline, a single touching point nothing), with coinciding end points
+// merged: the intersection curves as a polyline soup. Needs options.contacts.
+struct SegmentSoup {
+  std::vector<Point3> points;
+  std::vector<std::array<int, 2>> edges;
+};
+SegmentSoup contactSegments(const FindIntersectionsResult& result);
+
 // The report_file keys: self_intersecting_pairs/faces (summed over meshes),
 // cross_intersecting_pairs, per-mesh lists, candidates and time_ms.
 JsonObject toJson(const FindIntersectionsResult& result);

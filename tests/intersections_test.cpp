@@ -150,6 +150,12 @@ TEST(Intersections, ContactsAreClassified) {
     EXPECT_NE(c.kind, ContactKind::kNone);
     EXPECT_GE(c.points.size(), 1u);
   }
+  // The curves of two crossing cubes: closed polylines, every point on two edges.
+  const SegmentSoup soup = contactSegments(r);
+  ASSERT_GT(soup.edges.size(), 0u);
+  std::vector<int> degree(soup.points.size(), 0);
+  for (const auto& e : soup.edges) ++degree[e[0]], ++degree[e[1]];
+  for (int d : degree) EXPECT_EQ(d % 2, 0);
 }
 
 TEST(Intersections, BadInput) {
