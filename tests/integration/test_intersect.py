@@ -1,0 +1,85 @@
+"""MeshMend: Select Intersecting Faces, through the real meshlabserver."""
+import pytest
+
+from conftest import ROOT, cube, mlx, run_server, write_off, write_ply
+
+SELECT = "MeshMend: Select Intersecting Faces"
+
+
+def shifted(V, d):
+    return [(x + d, y + d, z + d) for x, y, z in V]
+
+
+def test_two_overlapping_cubes_in_one_layer(tmp_path):
+    V, F = cube()
+    n = len(V)
+    path = write_off(tmp_path / "two.off", V + shifted(V, 0.5), F + [(a + n, b + n, c + n) for a, b, c in F])
+    run = run_server(tmp_path, [path], mlx((SELECT, {"mode": 0, "report_file": "{report0}"})))
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["self_intersecting_pairs"] == 18 and r["self_intersecting_faces"] == 12
+    assert r["cross_intersecting_pairs"] == 0
+    assert "selected 12 faces" in run.log
+
+
+def test_between_two_layers_with_segments_layer(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out = tmp_path / "segments.ply"
+    script = mlx((SELECT, {"mode": 1, "first_layer": 0, "second_layer": 1, "segments_layer": True,
+                           "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    assert run.report["cross_intersecting_pairs"] == 18
+    assert run.report["cross_intersecting_faces_per_layer"] == [6, 6]
+    assert "created layer 'intersection segments'" in run.log
+
+
+def test_all_visible_layers_counts_self_and_cross(tmp_path):
+    V, F = cube()
+    n = len(V)
+    a = write_off(tmp_path / "a.off", V + shifted(V, 0.5), F + [(x + n, y + n, z + n) for x, y, z in F])
+    b = write_off(tmp_path / "b.off", shifted(V, 3.0), F)  # far away
+    run = run_server(tmp_path, [a, b], mlx((SELECT, {"mode": 2, "report_file": "{report0}"})))
+    assert run.returncode == 0, run.log
+    assert run.report["self_intersecting_pairs_per_layer"] == [18, 0]
+    assert run.report["cross_intersecting_pairs"] == 0
+
+
+def test_samples_run(tmp_path):
+    V, F = cube()
+    a = write_ply(tmp_path / "a.ply", V, F)
+    b = write_ply(tmp_path / "b.ply", shifted(V, 0.5), F)
+    run = run_server(tmp_path, [a], (ROOT / "samples" / "select_intersecting.mlx").read_text())
+    assert run.returncode == 0 and "0 self-intersecting pairs" in run.log, run.log
+    run = run_server(tmp_path, [a, b], (ROOT / "samples" / "select_intersecting_layers.mlx").read_text())
+    assert run.returncode == 0 and "18 intersecting pairs between layers" in run.log, run.log
+
+
+# ---- bad input ------------------------------------------------------------
+
+def test_same_layer_twice_is_refused(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    run = run_server(tmp_path, [a], mlx((SELECT, {"mode": 1, "first_layer": 0, "second_layer": 0,
+                                                  "report_file": "{report0}"})))
+    assert run.returncode != 0
+    assert "chosen twice" in run.log
+    assert not run.reports
+
+
+def test_empty_layer_is_refused(tmp_path):
+    path = tmp_path / "points.off"
+    path.write_text("OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n")
+    run = run_server(tmp_path, [path], mlx((SELECT, {"mode": 0, "report_file": ""})))
+    assert run.returncode != 0
+    assert "has no faces" in run.log
+
+
+def test_nan_coordinates_are_refused(tmp_path):
+    path = tmp_path / "nan.off"
+    path.write_text("OFF\n4 2 0\n0 0 0\n1 0 0\nnan 1 0\n0 0 1\n3 0 1 2\n3 0 3 1\n")
+    run = run_server(tmp_path, [path], mlx((SELECT, {"mode": 0, "report_file": ""})))
+    assert run.returncode != 0
+    assert "non-finite coordinate" in run.log
