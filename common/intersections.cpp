@@ -25,37 +25,71 @@ struct Soup {
   std::vector<Point3> points;
   std::vector<Triangle> triangles;
   std::vector<Box> boxes;
-  std::vector<bool> degenerate;
+  std::vector<char> degenerate;
+  std::vector<PlaneSide> planes;  // per face: exact side of points against its plane
 
   explicit Soup(const Mesh& mesh) : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
     boxes.resize(triangles.size());
     degenerate.resize(triangles.size());
+    planes.resize(triangles.size());
     parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
-        boxes[f] = boxOf(points[t[0]], points[t[1]], points[t[2]]);
-        degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
+        const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
+        boxes[f] = boxOf(a, b, c);
+        degenerate[f] = collinear(a, b, c);
+        planes[f] = PlaneSide(a, b, c);
       }
     });
   }
+  const Point3& corner(std::uint32_t f, int i) const { return points[triangles[f][i]]; }
   TrianglePoints at(std::uint32_t f) const {
     const Triangle& t = triangles[f];
     return {points[t[0]], points[t[1]], points[t[2]]};
   }
 };
 
-// The self-intersection rule for two faces of one mesh.
+// Are all three corners of face g of `gs` strictly on one side of the plane
+// of face f of `fs`?
+bool strictlyBeside(const Soup& fs, std::uint32_t f, const Soup& gs, std::uint32_t g) {
+  const int s0 = fs.planes[f](gs.corner(g, 0));
+  if (s0 == 0) return false;
+  return fs.planes[f](gs.corner(g, 1)) == s0 && fs.planes[f](gs.corner(g, 2)) == s0;
+}
+
+// Exact: can the segment from corner i to corner j of face g meet face f?
+// False when both ends lie strictly on one side of f's plane.
+bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
+  return s.planes[f](s.corner(g, i)) * s.planes[f](s.corner(g, j)) <= 0;
+}
+
+// The self-intersection rule for two faces of one mesh. Cheap exact plane
+// tests settle almost every pair of neighbours; the rest get the full test.
 bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
   const Triangle &a = s.triangles[f], &b = s.triangles[g];
   int shared = 0, ia = -1, ib = -1;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (a[i] == b[j]) ++shared, ia = i, ib = j;
-  if (shared == 2) {  // the rule wants the apexes: the corners not shared
-    for (int i = 0; i < 3; ++i)
-      if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) ia = i;
-    for (int j = 0; j < 3; ++j)
-      if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) ib = j;
+  switch (shared) {
+    case 0:
+      if (strictlyBeside(s, f, s, g) || strictlyBeside(s, g, s, f)) return false;
+      break;
+    case 1:
+      // The edge opposite the shared corner, in either face, must meet the other.
+      if (!edgeMayMeet(s, f, (ia + 1) % 3, (ia + 2) % 3, g) &&
+          !edgeMayMeet(s, g, (ib + 1) % 3, (ib + 2) % 3, f))
+        return false;
+      break;
+    case 2:  // the rule wants the apexes: the corners not shared; coplanar first
+      for (int i = 0; i < 3; ++i)
+        if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) ia = i;
+      for (int j = 0; j < 3; ++j)
+        if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) ib = j;
+      if (s.planes[f](s.corner(g, ib)) != 0) return false;
+      break;
+    default:
+      return true;
   }
   return intersectBeyondShared(s.at(f), s.at(g), shared, ia, ib);
 }
@@ -73,8 +107,12 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   std::vector<Soup> soups;
   soups.reserve(n);
   for (const Mesh* mesh : meshes) soups.emplace_back(*mesh);
-  std::vector<std::vector<IntersectingPair>> found(workerCount());
-  std::vector<std::size_t> candidates(workerCount(), 0);
+  // Per-worker results, each on its own cache line (no false sharing).
+  struct alignas(64) WorkerFindings {
+    std::vector<IntersectingPair> pairs;
+    std::size_t candidates = 0;
+  };
+  std::vector<WorkerFindings> found(workerCount());
 
   // A mesh needs a tree for its self-intersections, or when it is the
   // smaller of a pair (the larger one's faces query it).
@@ -97,9 +135,9 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
       const Soup& s = soups[m];
       trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
         if (s.degenerate[f] || s.degenerate[g]) return;
-        ++candidates[worker];
+        ++found[worker].candidates;
         if (selfIntersect(s, f, g))
-          found[worker].push_back({{std::uint32_t(m), f}, {std::uint32_t(m), g}});
+          found[worker].pairs.push_back({{std::uint32_t(m), f}, {std::uint32_t(m), g}});
       });
     }
   if (options.cross)
@@ -117,11 +155,13 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
             const TrianglePoints tg = l.at(std::uint32_t(g));
             trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
               if (s.degenerate[f]) return;
-              ++candidates[w];
-              if (!trianglesIntersect(s.at(f), tg)) return;
+              ++found[w].candidates;
+              if (strictlyBeside(s, f, l, std::uint32_t(g)) || strictlyBeside(l, std::uint32_t(g), s, f) ||
+                  !trianglesIntersect(s.at(f), tg))
+                return;
               FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
               if (b < a) std::swap(a, b);
-              found[w].push_back({a, b});
+              found[w].pairs.push_back({a, b});
             });
           }
         }, 1024);
@@ -129,8 +169,8 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   r.search_ms = msSince(searchStart);
 
   for (std::size_t w = 0; w < found.size(); ++w) {
-    r.pairs.insert(r.pairs.end(), found[w].begin(), found[w].end());
-    r.candidate_pairs += candidates[w];
+    r.pairs.insert(r.pairs.end(), found[w].pairs.begin(), found[w].pairs.end());
+    r.candidate_pairs += found[w].candidates;
   }
   std::sort(r.pairs.begin(), r.pairs.end(), [](const IntersectingPair& x, const IntersectingPair& y) {
     return x.a < y.a || (x.a == y.a && x.b < y.b);

@@ -1,7 +1,10 @@
 #include "common/predicates.h"
 
+#include "common/expansion.h"
+
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 
 #include <gmpxx.h>
@@ -58,6 +61,8 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
   } else if (left == 0 && right == 0 && ((ax == cx || by == cy) && (ay == cy || bx == cx))) {
     return 0;  // both products exactly zero because a factor is exactly zero
   }
+  if (expansion::safe({ax, ay, bx, by, cx, cy}))
+    return expansion::orient2d(ax, ay, bx, by, cx, cy);
   return exact::orient2d(ax, ay, bx, by, cx, cy);
 }
 
@@ -75,7 +80,33 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
     if (det > bound) return 1;
     if (-det > bound) return -1;
   }
+  if (expansion::safe({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2]}))
+    return expansion::orient3d(a, b, c, d);
   return exact::orient3d(a, b, c, d);
+}
+
+PlaneSide::PlaneSide(const Point3& a, const Point3& b, const Point3& c) : a_(a), b_(b), c_(c) {
+  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+  n_[0] = by * cz - bz * cy;
+  n_[1] = bz * cx - bx * cz;
+  n_[2] = bx * cy - by * cx;
+  nAbs_[0] = std::fabs(by * cz) + std::fabs(bz * cy);
+  nAbs_[1] = std::fabs(bz * cx) + std::fabs(bx * cz);
+  nAbs_[2] = std::fabs(bx * cy) + std::fabs(by * cx);
+}
+
+int PlaneSide::operator()(const Point3& p) const {
+  const double dx = p[0] - a_[0], dy = p[1] - a_[1], dz = p[2] - a_[2];
+  const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
+  const double permanent =
+      std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
+  const double bound = kOrient3dBound * permanent;
+  if (std::isfinite(det) && permanent > kUnderflowGuard) {
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return orient3d(a_, b_, c_, p);
 }
 
 int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {

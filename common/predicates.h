@@ -36,6 +36,22 @@ inline int orient2dDropping(const Point3& a, const Point3& b, const Point3& c, i
   return orient2d(a[u], a[v], b[u], b[v], c[u], c[v]);
 }
 
+// orient3d(a, b, c, p) for one triangle (a, b, c) against many points p: the
+// triangle's edge cross products are computed once. It evaluates the same
+// determinant with the same error bound (expanded along p's row), so its
+// sign is exact: the filter falls back to orient3d when it cannot decide.
+class PlaneSide {
+ public:
+  PlaneSide() = default;
+  PlaneSide(const Point3& a, const Point3& b, const Point3& c);
+  int operator()(const Point3& p) const;
+
+ private:
+  Point3 a_, b_, c_;
+  double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded
+  double nAbs_[3] = {0, 0, 0};  // the matching sums of absolute products
+};
+
 namespace exact {
 // Pure-GMP evaluations, used as the fallback and as the reference in tests.
 int orient2d(double ax, double ay, double bx, double by, double cx, double cy);

@@ -1,5 +1,7 @@
 #include "common/predicates.h"
 
+#include "common/expansion.h"
+
 #include <cfloat>
 #include <cmath>
 #include <random>
@@ -80,7 +82,7 @@ TEST(Predicates, FilteredAgreesWithExactOnNearDegenerateInput) {
     }
   };
   long disagreements = 0, exactZeros = 0;
-  const int rounds = 1000000;  // 2 million predicate evaluations
+  const int rounds = 1000000;  // 3 million predicate evaluations
   for (int i = 0; i < rounds; ++i) {
     const double s = scaleOf(pick(rng));
     const Point3 a(unit(rng) * s, unit(rng) * s, unit(rng) * s);
@@ -94,6 +96,7 @@ TEST(Predicates, FilteredAgreesWithExactOnNearDegenerateInput) {
     d = Point3(perturb(d[0]), perturb(d[1]), perturb(d[2]));
     const int f3 = orient3d(a, b, c, d), e3 = exact::orient3d(a, b, c, d);
     disagreements += f3 != e3;
+    disagreements += PlaneSide(a, b, c)(d) != e3;
     exactZeros += e3 == 0;
     // 2-D: c near the line a-b.
     const double t = unit(rng);
@@ -103,6 +106,36 @@ TEST(Predicates, FilteredAgreesWithExactOnNearDegenerateInput) {
   }
   EXPECT_EQ(disagreements, 0);
   EXPECT_GT(exactZeros, 0);  // the generator does reach exact degeneracy
+}
+
+// The expansion stage alone (what the filter falls back to) against GMP, on
+// exactly degenerate and nearly degenerate input of mixed magnitudes.
+TEST(Predicates, ExpansionStageAgreesWithGmp) {
+  std::mt19937_64 rng(777);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::uniform_int_distribution<int> grid(-3, 3), pick(0, 3);
+  long disagreements = 0, zeros = 0;
+  for (int i = 0; i < 300000; ++i) {
+    const double s = pick(rng) == 0 ? 1e-20 : pick(rng) == 1 ? 1e20 : 1.0;
+    auto coord = [&] {
+      double v = pick(rng) < 3 ? grid(rng) * s : unit(rng) * s;
+      if (v != 0 && pick(rng) == 0) v = std::nextafter(v, 1e300);
+      return v;
+    };
+    const Point3 a(coord(), coord(), coord()), b(coord(), coord(), coord());
+    const Point3 c(coord(), coord(), coord()), d(coord(), coord(), coord());
+    // The stage's contract: magnitudes where no product can underflow (the
+    // filtered predicates route other input to GMP).
+    if (!expansion::safe({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2]}))
+      continue;
+    const int e3 = exact::orient3d(a, b, c, d);
+    disagreements += expansion::orient3d(a, b, c, d) != e3;
+    zeros += e3 == 0;
+    disagreements += expansion::orient2d(a[0], a[1], b[0], b[1], c[0], c[1]) !=
+                     exact::orient2d(a[0], a[1], b[0], b[1], c[0], c[1]);
+  }
+  EXPECT_EQ(disagreements, 0);
+  EXPECT_GT(zeros, 500);  // exact degeneracies are reached
 }
 
 }  // namespace

@@ -1,0 +1,103 @@
+#include "benchmarks/harness.h"
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <sstream>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace meshmend::bench {
+
+namespace {
+
+double maxRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
+}
+
+}  // namespace
+
+Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
+  Measurement m;
+  m.name = method.name;
+  m.role = method.role;
+  int fds[2];
+  if (pipe(fds) != 0) {
+    m.error = "pipe failed";
+    return m;
+  }
+  const pid_t pid = fork();
+  if (pid == 0) {  // child: prepare, run, write "result baseline peak t1 t2 ..."
+    close(fds[0]);
+    alarm(unsigned(timeLimitSeconds));
+    std::ostringstream out;
+    try {
+      std::function<long()> work = method.prepare();
+      const double baseline = maxRssMb();
+      long result = 0;
+      std::vector<double> times;
+      for (int i = 0; i < repeat; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        result = work();
+        times.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      }
+      out << "ok " << result << ' ' << baseline << ' ' << maxRssMb();
+      for (double t : times) out << ' ' << t;
+    } catch (const std::exception& e) {
+      out << "error " << e.what();
+    }
+    const std::string s = out.str();
+    ssize_t written = write(fds[1], s.data(), s.size());
+    (void)written;
+    close(fds[1]);
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, std::size_t(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (WIFSIGNALED(status)) {
+    m.error = WTERMSIG(status) == SIGALRM ? "time limit of " + std::to_string(timeLimitSeconds) + " s"
+                                          : std::string("crashed: ") + strsignal(WTERMSIG(status));
+    return m;
+  }
+  std::istringstream in(text);
+  std::string word;
+  in >> word;
+  if (word != "ok") {
+    std::getline(in, m.error);
+    if (m.error.empty()) m.error = "no result";
+    return m;
+  }
+  m.ok = true;
+  in >> m.result >> m.baseline_rss_mb >> m.peak_rss_mb;
+  for (double t; in >> t;) m.times_ms.push_back(t);
+  std::vector<double> sorted = m.times_ms;
+  std::sort(sorted.begin(), sorted.end());
+  m.median_ms = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+  m.min_ms = sorted.empty() ? 0 : sorted.front();
+  return m;
+}
+
+JsonObject toJson(const Measurement& m) {
+  JsonObject j;
+  j.set("method", m.name).set("role", m.role).set("ok", m.ok);
+  if (!m.ok) return j.set("error", m.error);
+  return j.set("result", long(m.result))
+      .set("median_ms", m.median_ms)
+      .set("min_ms", m.min_ms)
+      .set("times_ms", m.times_ms)
+      .set("peak_rss_mb", m.peak_rss_mb)
+      .set("baseline_rss_mb", m.baseline_rss_mb);
+}
+
+}  // namespace meshmend::bench
