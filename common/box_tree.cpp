@@ -41,15 +41,29 @@ Box boxOf(const Point3& a, const Point3& b, const Point3& c) {
   return box;
 }
 
-BoxTree::BoxTree(std::vector<Box> boxes) : boxes_(std::move(boxes)), order_(boxes_.size()) {
+BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
+    : boxes_(std::move(boxes)), order_(boxes_.size()) {
   std::iota(order_.begin(), order_.end(), 0u);
   if (boxes_.empty()) return;
+  if (layout == Layout::kMorton) sortByMorton();
+  buildParallel(layout == Layout::kMedianSplit);
+}
+
+// Builds the two halves of the root in parallel (for large inputs), then joins
+// them under the root. With `splitByMedian`, the halves are the two sides of
+// the median along the widest axis; otherwise the current order is kept.
+void BoxTree::buildParallel(bool splitByMedian) {
   const std::uint32_t n = std::uint32_t(boxes_.size());
+  auto one = [&](std::uint32_t b, std::uint32_t e, std::vector<Node>& out) {
+    if (splitByMedian)
+      build(b, e, out);
+    else
+      buildInOrder(b, e, out);
+  };
   if (n < 20000) {
-    build(0, n, nodes_);
+    one(0, n, nodes_);
     return;
   }
-  // Two halves in parallel, then joined under a common root.
   Box all{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
   Box centers = all;
   for (const Box& b : boxes_) {
@@ -60,18 +74,20 @@ BoxTree::BoxTree(std::vector<Box> boxes) : boxes_(std::move(boxes)), order_(boxe
       centers.hi[k] = std::max(centers.hi[k], c);
     }
   }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
   const std::uint32_t mid = n / 2;
-  std::nth_element(order_.begin(), order_.begin() + mid, order_.end(),
-                   [&](std::uint32_t x, std::uint32_t y) {
-                     return boxes_[x].lo[axis] + boxes_[x].hi[axis] <
-                            boxes_[y].lo[axis] + boxes_[y].hi[axis];
-                   });
+  if (splitByMedian) {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
+    std::nth_element(order_.begin(), order_.begin() + mid, order_.end(),
+                     [&](std::uint32_t x, std::uint32_t y) {
+                       return boxes_[x].lo[axis] + boxes_[x].hi[axis] <
+                              boxes_[y].lo[axis] + boxes_[y].hi[axis];
+                     });
+  }
   std::vector<Node> left, right;
-  std::thread worker([&] { build(0, mid, left); });
-  build(mid, n, right);
+  std::thread worker([&] { one(0, mid, left); });
+  one(mid, n, right);
   worker.join();
   nodes_.reserve(1 + left.size() + right.size());
   nodes_.push_back({all, 1, std::uint32_t(1 + left.size())});
@@ -87,6 +103,76 @@ BoxTree::BoxTree(std::vector<Box> boxes) : boxes_(std::move(boxes)), order_(boxe
   };
   append(left);
   append(right);
+}
+
+namespace {
+
+// Spreads the low 10 bits of x to every third bit.
+std::uint32_t spread(std::uint32_t x) {
+  x &= 0x3ff;
+  x = (x | (x << 16)) & 0x030000ff;
+  x = (x | (x << 8)) & 0x0300f00f;
+  x = (x | (x << 4)) & 0x030c30c3;
+  x = (x | (x << 2)) & 0x09249249;
+  return x;
+}
+
+}  // namespace
+
+// Orders the primitives along a Morton curve through their box centres
+// (10 bits per axis, least-significant-digit radix sort).
+void BoxTree::sortByMorton() {
+  Box centers{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  for (const Box& b : boxes_)
+    for (int k = 0; k < 3; ++k) {
+      const float c = 0.5f * (b.lo[k] + b.hi[k]);
+      centers.lo[k] = std::min(centers.lo[k], c);
+      centers.hi[k] = std::max(centers.hi[k], c);
+    }
+  const std::size_t n = boxes_.size();
+  std::vector<std::uint32_t> code(n), tmpCode(n), tmpOrder(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t q[3];
+    for (int k = 0; k < 3; ++k) {
+      const float extent = centers.hi[k] - centers.lo[k];
+      const float c = 0.5f * (boxes_[i].lo[k] + boxes_[i].hi[k]);
+      const float t = extent > 0 ? (c - centers.lo[k]) / extent : 0.f;
+      q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, t * 1023.f)));
+    }
+    code[i] = spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2);
+  }
+  for (int shift = 0; shift < 30; shift += 10) {  // three passes of 10 bits
+    std::vector<std::uint32_t> count(1025, 0);
+    for (std::size_t i = 0; i < n; ++i) ++count[((code[i] >> shift) & 1023) + 1];
+    for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t slot = count[(code[i] >> shift) & 1023]++;
+      tmpCode[slot] = code[i];
+      tmpOrder[slot] = order_[i];
+    }
+    code.swap(tmpCode);
+    order_.swap(tmpOrder);
+  }
+}
+
+// A balanced hierarchy over the current order: split every range at its middle.
+void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const {
+  const std::uint32_t self = std::uint32_t(out.size());
+  out.push_back({});
+  if (end - begin <= kLeafSize) {
+    Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+    for (std::uint32_t i = begin; i < end; ++i) grow(box, boxes_[order_[i]]);
+    out[self] = {box, begin, (end - begin) | kLeaf};
+    return;
+  }
+  const std::uint32_t mid = begin + (end - begin) / 2;
+  const std::uint32_t left = std::uint32_t(out.size());
+  buildInOrder(begin, mid, out);
+  const std::uint32_t right = std::uint32_t(out.size());
+  buildInOrder(mid, end, out);
+  Box box = out[left].box;
+  grow(box, out[right].box);
+  out[self] = {box, left, right};
 }
 
 // Median split along the longest axis of the box centres; children indices

@@ -30,8 +30,14 @@ inline bool overlap(const Box& x, const Box& y) {
 
 class BoxTree {
  public:
+  // How the hierarchy is built (both are measured in benchmarks/):
+  enum class Layout {
+    kMedianSplit,  // top-down: split at the median of the box centres along the widest axis
+    kMorton,       // sort the centres along a Morton (Z-order) curve, split at the middle
+  };
+
   // Builds the hierarchy over `boxes` (primitive i = boxes[i]), using both cores.
-  explicit BoxTree(std::vector<Box> boxes);
+  explicit BoxTree(std::vector<Box> boxes, Layout layout = Layout::kMedianSplit);
 
   std::size_t size() const { return boxes_.size(); }
   const Box& bounds() const { return nodes_.empty() ? empty_ : nodes_[0].box; }
@@ -58,6 +64,9 @@ class BoxTree {
   std::uint32_t count(const Node& n) const { return n.b & ~kLeaf; }
 
   void build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out);
+  void buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const;
+  void sortByMorton();
+  void buildParallel(bool splitByMedian);
 
   template <class Visit>
   void within(std::uint32_t n, unsigned worker, Visit& visit) const;

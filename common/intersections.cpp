@@ -28,17 +28,19 @@ struct Soup {
   std::vector<char> degenerate;
   std::vector<PlaneSide> planes;  // per face: exact side of points against its plane
 
-  explicit Soup(const Mesh& mesh) : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
+  // `withPlanes`: also prepare the exact plane sides of every face (needed
+  // for faces that are tested against many others).
+  Soup(const Mesh& mesh, bool withPlanes) : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
     boxes.resize(triangles.size());
     degenerate.resize(triangles.size());
-    planes.resize(triangles.size());
+    if (withPlanes) planes.resize(triangles.size());
     parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
         const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
         boxes[f] = boxOf(a, b, c);
         degenerate[f] = collinear(a, b, c);
-        planes[f] = PlaneSide(a, b, c);
+        if (withPlanes) planes[f] = PlaneSide(a, b, c);
       }
     });
   }
@@ -104,9 +106,16 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   for (std::size_t m = 0; m < n; ++m)
     requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
   reportProgress(options.progress, 0, "Preparing boxes");
+  // A mesh needs a tree (and exact plane sides) for its self-intersections,
+  // or when it is the smaller of a pair: the larger one's faces query it.
+  std::vector<bool> needsTree(n, options.self);
+  if (options.cross)
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = m + 1; k < n; ++k)
+        needsTree[meshes[m]->fn > meshes[k]->fn ? k : m] = true;
   std::vector<Soup> soups;
   soups.reserve(n);
-  for (const Mesh* mesh : meshes) soups.emplace_back(*mesh);
+  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m], needsTree[m]);
   // Per-worker results, each on its own cache line (no false sharing).
   struct alignas(64) WorkerFindings {
     std::vector<IntersectingPair> pairs;
@@ -114,18 +123,12 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   };
   std::vector<WorkerFindings> found(workerCount());
 
-  // A mesh needs a tree for its self-intersections, or when it is the
-  // smaller of a pair (the larger one's faces query it).
   const auto buildStart = Clock::now();
-  std::vector<bool> needsTree(n, options.self);
-  if (options.cross)
-    for (std::size_t m = 0; m < n; ++m)
-      for (std::size_t k = m + 1; k < n; ++k)
-        needsTree[soups[m].triangles.size() > soups[k].triangles.size() ? k : m] = true;
   std::vector<BoxTree> trees;
   trees.reserve(n);
   for (std::size_t m = 0; m < n; ++m)
-    trees.emplace_back(needsTree[m] ? soups[m].boxes : std::vector<Box>());
+    trees.emplace_back(needsTree[m] ? soups[m].boxes : std::vector<Box>(),
+                       options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
   r.build_ms = msSince(buildStart);
 
   const auto searchStart = Clock::now();
@@ -145,7 +148,7 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
       for (std::size_t k = m + 1; k < n; ++k) {
         reportProgress(options.progress, 50, "Intersections between meshes");
         // Query the faces of the larger mesh against the tree of the smaller.
-        const bool swap = soups[m].triangles.size() > soups[k].triangles.size();
+        const bool swap = meshes[m]->fn > meshes[k]->fn;
         const std::size_t small = swap ? k : m, large = swap ? m : k;
         const Soup &s = soups[small], &l = soups[large];
         const Box& smallBounds = trees[small].bounds();
@@ -156,8 +159,7 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
             trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
               if (s.degenerate[f]) return;
               ++found[w].candidates;
-              if (strictlyBeside(s, f, l, std::uint32_t(g)) || strictlyBeside(l, std::uint32_t(g), s, f) ||
-                  !trianglesIntersect(s.at(f), tg))
+              if (strictlyBeside(s, f, l, std::uint32_t(g)) || !trianglesIntersect(s.at(f), tg))
                 return;
               FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
               if (b < a) std::swap(a, b);

@@ -19,6 +19,7 @@ struct FindIntersectionsOptions {
   bool self = true;       // pairs of faces of the same mesh
   bool cross = true;      // pairs of faces of different meshes
   bool contacts = false;  // classify every pair and keep its exact contact points
+  int layout = 0;         // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
   Progress progress;      // called between stages
 };
 
