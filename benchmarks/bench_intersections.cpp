@@ -3,9 +3,10 @@
 // inputs in the same run. Prints one JSON object.
 //
 // With two meshes: cross pairs (ours; CGAL box_intersection_d + do_intersect;
-// a sort-and-sweep layout), and the self-intersections of the two joined into
-// one mesh (ours; CGAL PMP::self_intersections), which is the same job for
-// both. With one mesh: its self-intersections (ours; CGAL; sweep).
+// ours with the alternative Morton-order hierarchy), and the self-
+// intersections of the two joined into one mesh (ours; CGAL
+// PMP::self_intersections; the alternative layout), which is the same job for
+// all. With one mesh: its self-intersections (ours; CGAL; alternative).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -18,11 +19,9 @@
 #include <cstring>
 
 #include "benchmarks/harness.h"
-#include "common/box_tree.h"
 #include "common/intersections.h"
 #include "common/mesh_io.h"
 #include "common/parallel.h"
-#include "common/predicates.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
@@ -49,82 +48,6 @@ K::Triangle_3 cgalTriangle(const Mesh& m, std::size_t f) {
   return {p(0), p(1), p(2)};
 }
 
-// ---- the alternative layout: sort-and-sweep along x --------------------------
-
-struct Swept {
-  std::vector<Box> boxes;
-  std::vector<std::uint32_t> order;  // by lo.x
-  std::vector<bool> degenerate;
-  std::vector<Point3> points;
-  std::vector<Triangle> triangles;
-  explicit Swept(const Mesh& m) : points(positionsOf(m)), triangles(trianglesOf(m)) {
-    for (const Triangle& t : triangles) {
-      boxes.push_back(boxOf(points[t[0]], points[t[1]], points[t[2]]));
-      degenerate.push_back(collinear(points[t[0]], points[t[1]], points[t[2]]));
-    }
-    order.resize(boxes.size());
-    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(),
-              [&](std::uint32_t x, std::uint32_t y) { return boxes[x].lo[0] < boxes[y].lo[0]; });
-  }
-  TrianglePoints at(std::uint32_t f) const {
-    return {points[triangles[f][0]], points[triangles[f][1]], points[triangles[f][2]]};
-  }
-};
-
-bool selfRule(const Swept& s, std::uint32_t f, std::uint32_t g) {
-  const Triangle &a = s.triangles[f], &b = s.triangles[g];
-  int shared = 0, ia = -1, ib = -1;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (a[i] == b[j]) ++shared, ia = i, ib = j;
-  if (shared == 2) {
-    for (int i = 0; i < 3; ++i)
-      if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) ia = i;
-    for (int j = 0; j < 3; ++j)
-      if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) ib = j;
-  }
-  return intersectBeyondShared(s.at(f), s.at(g), shared, ia, ib);
-}
-
-long sweepSelf(const Swept& s) {
-  std::atomic<long> found{0};
-  parallelChunks(s.order.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-    long local = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::uint32_t f = s.order[i];
-      if (s.degenerate[f]) continue;
-      for (std::size_t j = i + 1; j < s.order.size() && s.boxes[s.order[j]].lo[0] <= s.boxes[f].hi[0]; ++j) {
-        const std::uint32_t g = s.order[j];
-        if (!s.degenerate[g] && overlap(s.boxes[f], s.boxes[g]) && selfRule(s, std::min(f, g), std::max(f, g)))
-          ++local;
-      }
-    }
-    found += local;
-  });
-  return found;
-}
-
-long sweepCross(const Swept& a, const Swept& b) {
-  // Every box of b against the boxes of a whose x-interval overlaps it.
-  std::atomic<long> found{0};
-  parallelChunks(b.boxes.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-    long local = 0;
-    for (std::size_t g = begin; g < end; ++g) {
-      if (b.degenerate[g]) continue;
-      const Box& bg = b.boxes[g];
-      // a's boxes starting at or before bg's end; those ending before bg's start fail overlap().
-      const auto last = std::upper_bound(a.order.begin(), a.order.end(), bg.hi[0],
-                                         [&](float x, std::uint32_t f) { return x < a.boxes[f].lo[0]; });
-      for (auto it = a.order.begin(); it != last; ++it)
-        if (!a.degenerate[*it] && overlap(a.boxes[*it], bg) && trianglesIntersect(a.at(*it), b.at(std::uint32_t(g))))
-          ++local;
-    }
-    found += local;
-  });
-  return found;
-}
-
 // ---- CGAL ------------------------------------------------------------------------
 
 long cgalSelfIntersections(const SurfaceMesh& tm) {
@@ -132,6 +55,50 @@ long cgalSelfIntersections(const SurfaceMesh& tm) {
   PMP::self_intersections(tm, std::back_inserter(out));
   long pairs = 0;
   for (const auto& [f, g] : out) pairs += f != g;  // (f, f) marks a degenerate face
+  return pairs;
+}
+
+// For inputs that are not a valid Surface_mesh (non-manifold edges): CGAL's
+// box_self_intersection_d on the face boxes, then the same rule as
+// PMP::self_intersections, decided with CGAL's exact predicates (Epick).
+long cgalSoupSelfIntersections(const Mesh& m) {
+  using CgalBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
+  std::vector<K::Triangle_3> tris;
+  std::vector<CgalBox> boxes;
+  const std::vector<Triangle> idx = trianglesOf(m);
+  for (std::size_t f = 0; f < m.face.size(); ++f) {
+    tris.push_back(cgalTriangle(m, f));
+    if (!tris.back().is_degenerate()) boxes.emplace_back(tris.back().bbox(), f);
+  }
+  long pairs = 0;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const CgalBox& x, const CgalBox& y) {
+    const std::size_t f = x.info(), g = y.info();
+    const Triangle &a = idx[f], &b = idx[g];
+    int shared = 0, ia = -1, ib = -1;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (a[i] == b[j]) ++shared, ia = i, ib = j;
+    const K::Triangle_3 &ta = tris[f], &tb = tris[g];
+    bool hit = false;
+    if (shared == 0) {
+      hit = CGAL::do_intersect(ta, tb);
+    } else if (shared == 1) {
+      hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
+            CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
+    } else if (shared == 2) {
+      int apexA = 0, apexB = 0;
+      for (int i = 0; i < 3; ++i)
+        if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) apexA = i;
+      for (int j = 0; j < 3; ++j)
+        if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) apexB = j;
+      const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
+      hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
+            CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
+    } else {
+      hit = true;
+    }
+    pairs += hit;
+  });
   return pairs;
 }
 
@@ -196,9 +163,14 @@ int main(int argc, char** argv) {
       auto ma = std::make_shared<Mesh>(readMesh(a)), mb = std::make_shared<Mesh>(readMesh(b));
       return std::function<long()>([=] { return cgalCross(*ma, *mb); });
     }});
-    methods.push_back({"sweep_cross", "alternative", [=] {
-      auto sa = std::make_shared<Swept>(readMesh(a)), sb = std::make_shared<Swept>(readMesh(b));
-      return std::function<long()>([=] { return sweepCross(*sa, *sb); });
+    methods.push_back({"meshmend_cross_morton_layout", "alternative", [=] {
+      auto ma = std::make_shared<Mesh>(readMesh(a)), mb = std::make_shared<Mesh>(readMesh(b));
+      return std::function<long()>([=] {
+        FindIntersectionsOptions o;
+        o.self = false;
+        o.layout = 1;
+        return long(findIntersections({ma.get(), mb.get()}, o).cross_pairs);
+      });
     }});
   }
   const bool join = !b.empty();
@@ -211,14 +183,26 @@ int main(int argc, char** argv) {
     });
   }});
   methods.push_back({join ? "cgal_self_intersections_joined" : "cgal_self_intersections", "peer", [=] {
-    auto tm = std::make_shared<SurfaceMesh>(toSurfaceMesh(join ? joined(readMesh(a), readMesh(b)) : readMesh(a)));
-    return std::function<long()>([=] { return cgalSelfIntersections(*tm); });
+    // PMP::self_intersections needs a valid Surface_mesh; other inputs get
+    // CGAL's box_self_intersection_d with the same rule (as meshcheck does).
+    auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
+    std::shared_ptr<SurfaceMesh> tm;
+    try {
+      tm = std::make_shared<SurfaceMesh>(toSurfaceMesh(*m));
+    } catch (const std::exception&) {
+    }
+    return std::function<long()>([=] { return tm ? cgalSelfIntersections(*tm) : cgalSoupSelfIntersections(*m); });
   }});
-  if (!join)
-    methods.push_back({"sweep_self", "alternative", [=] {
-      auto s = std::make_shared<Swept>(readMesh(a));
-      return std::function<long()>([=] { return sweepSelf(*s); });
-    }});
+  methods.push_back({join ? "meshmend_self_joined_morton_layout" : "meshmend_self_morton_layout",
+                     "alternative", [=] {
+    auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
+    return std::function<long()>([=] {
+      FindIntersectionsOptions o;
+      o.cross = false;
+      o.layout = 1;
+      return long(findIntersections({m.get()}, o).self_pairs[0]);
+    });
+  }});
 
   std::vector<JsonObject> results;
   for (const Method& m : methods) {
