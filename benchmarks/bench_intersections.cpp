@@ -71,34 +71,35 @@ long cgalSoupSelfIntersections(const Mesh& m) {
     if (!tris.back().is_degenerate()) boxes.emplace_back(tris.back().bbox(), f);
   }
   long pairs = 0;
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const CgalBox& x, const CgalBox& y) {
-    const std::size_t f = x.info(), g = y.info();
-    const Triangle &a = idx[f], &b = idx[g];
-    int shared = 0, ia = -1, ib = -1;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (a[i] == b[j]) ++shared, ia = i, ib = j;
-    const K::Triangle_3 &ta = tris[f], &tb = tris[g];
-    bool hit = false;
-    if (shared == 0) {
-      hit = CGAL::do_intersect(ta, tb);
-    } else if (shared == 1) {
-      hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
-            CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
-    } else if (shared == 2) {
-      int apexA = 0, apexB = 0;
-      for (int i = 0; i < 3; ++i)
-        if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) apexA = i;
-      for (int j = 0; j < 3; ++j)
-        if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) apexB = j;
-      const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
-      hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
-            CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
-    } else {
-      hit = true;
-    }
-    pairs += hit;
-  });
+  CGAL::box_self_intersection_d(
+      boxes.begin(), boxes.end(), [&](const CgalBox& x, const CgalBox& y) {
+        const std::size_t f = x.info(), g = y.info();
+        const Triangle &a = idx[f], &b = idx[g];
+        int shared = 0, ia = -1, ib = -1;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (a[i] == b[j]) ++shared, ia = i, ib = j;
+        const K::Triangle_3 &ta = tris[f], &tb = tris[g];
+        bool hit = false;
+        if (shared == 0) {
+          hit = CGAL::do_intersect(ta, tb);
+        } else if (shared == 1) {
+          hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
+                CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
+        } else if (shared == 2) {
+          int apexA = 0, apexB = 0;
+          for (int i = 0; i < 3; ++i)
+            if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) apexA = i;
+          for (int j = 0; j < 3; ++j)
+            if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) apexB = j;
+          const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
+          hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
+                CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
+        } else {
+          hit = true;
+        }
+        pairs += hit;
+      });
   return pairs;
 }
 
@@ -106,7 +107,8 @@ SurfaceMesh toSurfaceMesh(const Mesh& m) {
   std::vector<K::Point_3> points;
   for (const Point3& p : positionsOf(m)) points.emplace_back(p[0], p[1], p[2]);
   std::vector<std::vector<std::size_t>> polygons;
-  for (const Triangle& t : trianglesOf(m)) polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  for (const Triangle& t : trianglesOf(m))
+    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
   if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
     throw std::runtime_error("not a polygon mesh for CGAL's Surface_mesh");
   SurfaceMesh tm;
@@ -127,9 +129,10 @@ long cgalCross(const Mesh& a, const Mesh& b) {
     if (!tb.back().is_degenerate()) bb.emplace_back(tb.back().bbox(), f);
   }
   long pairs = 0;
-  CGAL::box_intersection_d(ba.begin(), ba.end(), bb.begin(), bb.end(), [&](const CgalBox& x, const CgalBox& y) {
-    pairs += CGAL::do_intersect(ta[x.info()], tb[y.info()]);
-  });
+  CGAL::box_intersection_d(ba.begin(), ba.end(), bb.begin(), bb.end(),
+                           [&](const CgalBox& x, const CgalBox& y) {
+                             pairs += CGAL::do_intersect(ta[x.info()], tb[y.info()]);
+                           });
   return pairs;
 }
 
@@ -152,57 +155,64 @@ int main(int argc, char** argv) {
   std::vector<Method> methods;
   if (!b.empty()) {
     methods.push_back({"meshmend_cross", "ours", [=] {
-      auto ma = std::make_shared<Mesh>(readMesh(a)), mb = std::make_shared<Mesh>(readMesh(b));
-      return std::function<long()>([=] {
-        FindIntersectionsOptions o;
-        o.self = false;
-        return long(findIntersections({ma.get(), mb.get()}, o).cross_pairs);
-      });
-    }});
+                         auto ma = std::make_shared<Mesh>(readMesh(a)),
+                              mb = std::make_shared<Mesh>(readMesh(b));
+                         return std::function<long()>([=] {
+                           FindIntersectionsOptions o;
+                           o.self = false;
+                           return long(findIntersections({ma.get(), mb.get()}, o).cross_pairs);
+                         });
+                       }});
     methods.push_back({"cgal_box_intersection_d_cross", "peer", [=] {
-      auto ma = std::make_shared<Mesh>(readMesh(a)), mb = std::make_shared<Mesh>(readMesh(b));
-      return std::function<long()>([=] { return cgalCross(*ma, *mb); });
-    }});
+                         auto ma = std::make_shared<Mesh>(readMesh(a)),
+                              mb = std::make_shared<Mesh>(readMesh(b));
+                         return std::function<long()>([=] { return cgalCross(*ma, *mb); });
+                       }});
     methods.push_back({"meshmend_cross_morton_layout", "alternative", [=] {
-      auto ma = std::make_shared<Mesh>(readMesh(a)), mb = std::make_shared<Mesh>(readMesh(b));
-      return std::function<long()>([=] {
-        FindIntersectionsOptions o;
-        o.self = false;
-        o.layout = 1;
-        return long(findIntersections({ma.get(), mb.get()}, o).cross_pairs);
-      });
-    }});
+                         auto ma = std::make_shared<Mesh>(readMesh(a)),
+                              mb = std::make_shared<Mesh>(readMesh(b));
+                         return std::function<long()>([=] {
+                           FindIntersectionsOptions o;
+                           o.self = false;
+                           o.layout = 1;
+                           return long(findIntersections({ma.get(), mb.get()}, o).cross_pairs);
+                         });
+                       }});
   }
   const bool join = !b.empty();
   methods.push_back({join ? "meshmend_self_joined" : "meshmend_self", "ours", [=] {
-    auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
-    return std::function<long()>([=] {
-      FindIntersectionsOptions o;
-      o.cross = false;
-      return long(findIntersections({m.get()}, o).self_pairs[0]);
-    });
-  }});
-  methods.push_back({join ? "cgal_self_intersections_joined" : "cgal_self_intersections", "peer", [=] {
-    // PMP::self_intersections needs a valid Surface_mesh; other inputs get
-    // CGAL's box_self_intersection_d with the same rule (as meshcheck does).
-    auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
-    std::shared_ptr<SurfaceMesh> tm;
-    try {
-      tm = std::make_shared<SurfaceMesh>(toSurfaceMesh(*m));
-    } catch (const std::exception&) {
-    }
-    return std::function<long()>([=] { return tm ? cgalSelfIntersections(*tm) : cgalSoupSelfIntersections(*m); });
-  }});
+                       auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b))
+                                                            : readMesh(a));
+                       return std::function<long()>([=] {
+                         FindIntersectionsOptions o;
+                         o.cross = false;
+                         return long(findIntersections({m.get()}, o).self_pairs[0]);
+                       });
+                     }});
+  methods.push_back(
+      {join ? "cgal_self_intersections_joined" : "cgal_self_intersections", "peer", [=] {
+         // PMP::self_intersections needs a valid Surface_mesh; other inputs get
+         // CGAL's box_self_intersection_d with the same rule (as meshcheck does).
+         auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
+         std::shared_ptr<SurfaceMesh> tm;
+         try {
+           tm = std::make_shared<SurfaceMesh>(toSurfaceMesh(*m));
+         } catch (const std::exception&) {
+         }
+         return std::function<long()>(
+             [=] { return tm ? cgalSelfIntersections(*tm) : cgalSoupSelfIntersections(*m); });
+       }});
   methods.push_back({join ? "meshmend_self_joined_morton_layout" : "meshmend_self_morton_layout",
                      "alternative", [=] {
-    auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
-    return std::function<long()>([=] {
-      FindIntersectionsOptions o;
-      o.cross = false;
-      o.layout = 1;
-      return long(findIntersections({m.get()}, o).self_pairs[0]);
-    });
-  }});
+                       auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b))
+                                                            : readMesh(a));
+                       return std::function<long()>([=] {
+                         FindIntersectionsOptions o;
+                         o.cross = false;
+                         o.layout = 1;
+                         return long(findIntersections({m.get()}, o).self_pairs[0]);
+                       });
+                     }});
 
   std::vector<JsonObject> results;
   for (const Method& m : methods) {
@@ -211,6 +221,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "  %-34s %s\n", m.name.c_str(), toJson(r).str().c_str());
   }
   JsonObject out;
-  out.set("a", a).set("b", b).set("repeat", repeat).set("workers", long(workerCount())).set("methods", results);
+  out.set("a", a)
+      .set("b", b)
+      .set("repeat", repeat)
+      .set("workers", long(workerCount()))
+      .set("methods", results);
   std::printf("%s\n", out.str(true).c_str());
 }

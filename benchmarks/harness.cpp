@@ -45,7 +45,8 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
         const auto t0 = std::chrono::steady_clock::now();
         result = work();
         times.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count());
       }
       out << "ok " << result << ' ' << baseline << ' ' << maxRssMb();
       for (double t : times) out << ' ' << t;
@@ -61,13 +62,15 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
   close(fds[1]);
   std::string text;
   char buffer[4096];
-  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, std::size_t(n));
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;)
+    text.append(buffer, std::size_t(n));
   close(fds[0]);
   int status = 0;
   waitpid(pid, &status, 0);
   if (WIFSIGNALED(status)) {
-    m.error = WTERMSIG(status) == SIGALRM ? "time limit of " + std::to_string(timeLimitSeconds) + " s"
-                                          : std::string("crashed: ") + strsignal(WTERMSIG(status));
+    m.error = WTERMSIG(status) == SIGALRM
+                  ? "time limit of " + std::to_string(timeLimitSeconds) + " s"
+                  : std::string("crashed: ") + strsignal(WTERMSIG(status));
     return m;
   }
   std::istringstream in(text);

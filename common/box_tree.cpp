@@ -79,11 +79,10 @@ void BoxTree::buildParallel(bool splitByMedian) {
     int axis = 0;
     for (int k = 1; k < 3; ++k)
       if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
-    std::nth_element(order_.begin(), order_.begin() + mid, order_.end(),
-                     [&](std::uint32_t x, std::uint32_t y) {
-                       return boxes_[x].lo[axis] + boxes_[x].hi[axis] <
-                              boxes_[y].lo[axis] + boxes_[y].hi[axis];
-                     });
+    std::nth_element(
+        order_.begin(), order_.begin() + mid, order_.end(), [&](std::uint32_t x, std::uint32_t y) {
+          return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
+        });
   }
   std::vector<Node> left, right;
   std::thread worker([&] { one(0, mid, left); });

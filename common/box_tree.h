@@ -72,7 +72,8 @@ class BoxTree {
   void within(std::uint32_t n, unsigned worker, Visit& visit) const;
   template <class Visit>
   void between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& visit) const;
-  void tasks(std::uint32_t n, int depth, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+  void tasks(std::uint32_t n, int depth,
+             std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
   void pairTasks(std::uint32_t x, std::uint32_t y, int depth,
                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
 
@@ -138,15 +139,18 @@ void BoxTree::selfPairs(Visit&& visit) const {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work;
   tasks(0, 8, work);
   std::atomic<std::size_t> next{0};
-  parallelChunks(workerCount(), [&](std::size_t, std::size_t, unsigned worker) {
-    for (std::size_t t; (t = next.fetch_add(1)) < work.size();) {
-      const auto [x, y] = work[t];
-      if (x == y)
-        within(x, worker, visit);
-      else
-        between(x, y, worker, visit);
-    }
-  }, 1);
+  parallelChunks(
+      workerCount(),
+      [&](std::size_t, std::size_t, unsigned worker) {
+        for (std::size_t t; (t = next.fetch_add(1)) < work.size();) {
+          const auto [x, y] = work[t];
+          if (x == y)
+            within(x, worker, visit);
+          else
+            between(x, y, worker, visit);
+        }
+      },
+      1);
 }
 
 template <class Visit>

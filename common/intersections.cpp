@@ -30,7 +30,8 @@ struct Soup {
 
   // `withPlanes`: also prepare the exact plane sides of every face (needed
   // for faces that are tested against many others).
-  Soup(const Mesh& mesh, bool withPlanes) : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
+  Soup(const Mesh& mesh, bool withPlanes)
+      : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
     boxes.resize(triangles.size());
     degenerate.resize(triangles.size());
     if (withPlanes) planes.resize(triangles.size());
@@ -127,8 +128,9 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   std::vector<BoxTree> trees;
   trees.reserve(n);
   for (std::size_t m = 0; m < n; ++m)
-    trees.emplace_back(needsTree[m] ? soups[m].boxes : std::vector<Box>(),
-                       options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
+    trees.emplace_back(
+        needsTree[m] ? soups[m].boxes : std::vector<Box>(),
+        options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
   r.build_ms = msSince(buildStart);
 
   const auto searchStart = Clock::now();
@@ -152,21 +154,24 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
         const std::size_t small = swap ? k : m, large = swap ? m : k;
         const Soup &s = soups[small], &l = soups[large];
         const Box& smallBounds = trees[small].bounds();
-        parallelChunks(l.triangles.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-          for (std::size_t g = begin; g < end; ++g) {
-            if (l.degenerate[g] || !overlap(l.boxes[g], smallBounds)) continue;
-            const TrianglePoints tg = l.at(std::uint32_t(g));
-            trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
-              if (s.degenerate[f]) return;
-              ++found[w].candidates;
-              if (strictlyBeside(s, f, l, std::uint32_t(g)) || !trianglesIntersect(s.at(f), tg))
-                return;
-              FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
-              if (b < a) std::swap(a, b);
-              found[w].pairs.push_back({a, b});
-            });
-          }
-        }, 1024);
+        parallelChunks(
+            l.triangles.size(),
+            [&](std::size_t begin, std::size_t end, unsigned worker) {
+              for (std::size_t g = begin; g < end; ++g) {
+                if (l.degenerate[g] || !overlap(l.boxes[g], smallBounds)) continue;
+                const TrianglePoints tg = l.at(std::uint32_t(g));
+                trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
+                  if (s.degenerate[f]) return;
+                  ++found[w].candidates;
+                  if (strictlyBeside(s, f, l, std::uint32_t(g)) || !trianglesIntersect(s.at(f), tg))
+                    return;
+                  FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
+                  if (b < a) std::swap(a, b);
+                  found[w].pairs.push_back({a, b});
+                });
+              }
+            },
+            1024);
       }
   r.search_ms = msSince(searchStart);
 
@@ -174,9 +179,10 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
     r.pairs.insert(r.pairs.end(), found[w].pairs.begin(), found[w].pairs.end());
     r.candidate_pairs += found[w].candidates;
   }
-  std::sort(r.pairs.begin(), r.pairs.end(), [](const IntersectingPair& x, const IntersectingPair& y) {
-    return x.a < y.a || (x.a == y.a && x.b < y.b);
-  });
+  std::sort(r.pairs.begin(), r.pairs.end(),
+            [](const IntersectingPair& x, const IntersectingPair& y) {
+              return x.a < y.a || (x.a == y.a && x.b < y.b);
+            });
 
   r.self_pairs.assign(n, 0);
   r.self_faces.assign(n, 0);
@@ -210,12 +216,16 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   if (options.contacts) {
     reportProgress(options.progress, 80, "Intersection segments");
     r.contacts.resize(r.pairs.size());
-    parallelChunks(r.pairs.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const IntersectingPair& p = r.pairs[i];
-        r.contacts[i] = classifyContact(soups[p.a.mesh].at(p.a.face), soups[p.b.mesh].at(p.b.face));
-      }
-    }, 64);
+    parallelChunks(
+        r.pairs.size(),
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const IntersectingPair& p = r.pairs[i];
+            r.contacts[i] =
+                classifyContact(soups[p.a.mesh].at(p.a.face), soups[p.b.mesh].at(p.b.face));
+          }
+        },
+        64);
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);
@@ -226,7 +236,8 @@ SegmentSoup contactSegments(const FindIntersectionsResult& result) {
   SegmentSoup soup;
   std::map<std::array<double, 3>, int> index;
   auto at = [&](const Point3& p) {
-    const auto [it, added] = index.emplace(std::array<double, 3>{p[0], p[1], p[2]}, int(soup.points.size()));
+    const auto [it, added] =
+        index.emplace(std::array<double, 3>{p[0], p[1], p[2]}, int(soup.points.size()));
     if (added) soup.points.push_back(p);
     return it->second;
   };

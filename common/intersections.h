@@ -27,7 +27,9 @@ struct FindIntersectionsOptions {
 struct FaceRef {
   std::uint32_t mesh = 0;
   std::uint32_t face = 0;
-  bool operator<(const FaceRef& o) const { return mesh < o.mesh || (mesh == o.mesh && face < o.face); }
+  bool operator<(const FaceRef& o) const {
+    return mesh < o.mesh || (mesh == o.mesh && face < o.face);
+  }
   bool operator==(const FaceRef& o) const { return mesh == o.mesh && face == o.face; }
 };
 
@@ -36,12 +38,12 @@ struct IntersectingPair {
 };
 
 struct FindIntersectionsResult {
-  std::vector<IntersectingPair> pairs;    // sorted by (a, b)
-  std::vector<TriangleContact> contacts;  // parallel to pairs (only with options.contacts)
-  std::vector<std::size_t> self_pairs;    // per mesh: pairs within it
-  std::vector<std::size_t> self_faces;    // per mesh: distinct faces in those pairs
-  std::size_t cross_pairs = 0;            // pairs between different meshes
-  std::vector<std::size_t> cross_faces;   // per mesh: distinct faces in cross pairs
+  std::vector<IntersectingPair> pairs;           // sorted by (a, b)
+  std::vector<TriangleContact> contacts;         // parallel to pairs (only with options.contacts)
+  std::vector<std::size_t> self_pairs;           // per mesh: pairs within it
+  std::vector<std::size_t> self_faces;           // per mesh: distinct faces in those pairs
+  std::size_t cross_pairs = 0;                   // pairs between different meshes
+  std::vector<std::size_t> cross_faces;          // per mesh: distinct faces in cross pairs
   std::vector<std::vector<bool>> face_involved;  // per mesh, per face: in any pair
   std::vector<std::size_t> degenerate_faces;     // per mesh: collinear faces (never compared)
   std::size_t candidate_pairs = 0;               // box pairs tested exactly

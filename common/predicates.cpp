@@ -61,8 +61,7 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
   } else if (left == 0 && right == 0 && ((ax == cx || by == cy) && (ay == cy || bx == cx))) {
     return 0;  // both products exactly zero because a factor is exactly zero
   }
-  if (expansion::safe({ax, ay, bx, by, cx, cy}))
-    return expansion::orient2d(ax, ay, bx, by, cx, cy);
+  if (expansion::safe({ax, ay, bx, by, cx, cy})) return expansion::orient2d(ax, ay, bx, by, cx, cy);
   return exact::orient2d(ax, ay, bx, by, cx, cy);
 }
 

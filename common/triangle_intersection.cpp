@@ -56,8 +56,7 @@ bool trianglesIntersect2(const TrianglePoints& a, const TrianglePoints& b, int a
 
 // Does segment pq meet triangle t, given sp, sq = orient3d(t, p), orient3d(t, q)
 // (not both of one strict sign)?
-bool edgeMeetsTriangle(const Point3& p, const Point3& q, int sp, int sq,
-                       const TrianglePoints& t) {
+bool edgeMeetsTriangle(const Point3& p, const Point3& q, int sp, int sq, const TrianglePoints& t) {
   if (sp == 0 && sq == 0)
     return segmentIntersectsTriangle2(p, q, t, projectionAxis(t[0], t[1], t[2]));
   // The segment meets the plane in one point: is it inside the triangle?
@@ -121,12 +120,18 @@ bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int
 
 const char* toString(ContactKind kind) {
   switch (kind) {
-    case ContactKind::kNone: return "none";
-    case ContactKind::kCrossing: return "crossing";
-    case ContactKind::kTouchAtPoint: return "touch at a point";
-    case ContactKind::kTouchAlongEdge: return "touch along an edge";
-    case ContactKind::kCoplanarOverlap: return "coplanar overlap";
-    case ContactKind::kCoplanarTouch: return "coplanar touch";
+    case ContactKind::kNone:
+      return "none";
+    case ContactKind::kCrossing:
+      return "crossing";
+    case ContactKind::kTouchAtPoint:
+      return "touch at a point";
+    case ContactKind::kTouchAlongEdge:
+      return "touch along an edge";
+    case ContactKind::kCoplanarOverlap:
+      return "coplanar overlap";
+    case ContactKind::kCoplanarTouch:
+      return "coplanar touch";
   }
   return "?";
 }
@@ -139,7 +144,9 @@ struct Exact3 {
   mpq_class x[3];
 };
 
-Exact3 exactOf(const Point3& p) { return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}}; }
+Exact3 exactOf(const Point3& p) {
+  return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
+}
 
 // The double nearest to q.
 double nearest(const mpq_class& q) {
@@ -148,7 +155,9 @@ double nearest(const mpq_class& q) {
   return abs(q - mpq_class(up)) < abs(q - mpq_class(d)) ? up : d;
 }
 
-Point3 rounded(const Exact3& p) { return {nearest(p.x[0]), nearest(p.x[1]), nearest(p.x[2])}; }
+Point3 rounded(const Exact3& p) {
+  return {nearest(p.x[0]), nearest(p.x[1]), nearest(p.x[2])};
+}
 
 // det[b-a, c-a, d-a], exactly.
 mpq_class orient3dValue(const Exact3& a, const Exact3& b, const Exact3& c, const Exact3& d) {
@@ -249,8 +258,11 @@ class Classifier {
     }
     Exact3 d;
     for (int k = 0; k < 3; ++k)
-      d.x[k] = n[0].x[(k + 1) % 3] * n[1].x[(k + 2) % 3] - n[0].x[(k + 2) % 3] * n[1].x[(k + 1) % 3];
-    auto key = [&](const Point& p) -> mpq_class { return d.x[0] * p.exact.x[0] + d.x[1] * p.exact.x[1] + d.x[2] * p.exact.x[2]; };
+      d.x[k] =
+          n[0].x[(k + 1) % 3] * n[1].x[(k + 2) % 3] - n[0].x[(k + 2) % 3] * n[1].x[(k + 1) % 3];
+    auto key = [&](const Point& p) -> mpq_class {
+      return d.x[0] * p.exact.x[0] + d.x[1] * p.exact.x[1] + d.x[2] * p.exact.x[2];
+    };
     const Point *lo[2], *hi[2];
     mpq_class loKey[2], hiKey[2];
     for (int t = 0; t < 2; ++t) {
@@ -265,11 +277,16 @@ class Classifier {
     // The overlap [max of starts, min of ends]; on a tie a vertex describes
     // the point best, then triangle a's element.
     auto better = [](const Point* x, const Point* y) {
-      return y->tag.kind == ContactPoint::Kind::kVertex && x->tag.kind != ContactPoint::Kind::kVertex;
+      return y->tag.kind == ContactPoint::Kind::kVertex &&
+             x->tag.kind != ContactPoint::Kind::kVertex;
     };
-    const Point* start = loKey[0] > loKey[1] ? lo[0] : loKey[1] > loKey[0] ? lo[1] : (better(lo[0], lo[1]) ? lo[1] : lo[0]);
+    const Point* start = loKey[0] > loKey[1]   ? lo[0]
+                         : loKey[1] > loKey[0] ? lo[1]
+                                               : (better(lo[0], lo[1]) ? lo[1] : lo[0]);
     const mpq_class startKey = std::max(loKey[0], loKey[1]);
-    const Point* end = hiKey[0] < hiKey[1] ? hi[0] : hiKey[1] < hiKey[0] ? hi[1] : (better(hi[0], hi[1]) ? hi[1] : hi[0]);
+    const Point* end = hiKey[0] < hiKey[1]   ? hi[0]
+                       : hiKey[1] < hiKey[0] ? hi[1]
+                                             : (better(hi[0], hi[1]) ? hi[1] : hi[0]);
     const mpq_class endKey = std::min(hiKey[0], hiKey[1]);
     TriangleContact c;
     if (startKey > endKey) return c;
@@ -278,7 +295,8 @@ class Classifier {
       c.points.push_back(finish(*start));
       return c;
     }
-    c.kind = (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
+    c.kind =
+        (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
     c.points.push_back(finish(*start));
     c.points.push_back(finish(*end));
     return c;
@@ -299,7 +317,9 @@ class Classifier {
     for (int i = 0; i < 3; ++i) polygon.push_back({vertex(0, i), i});
     for (int j = 0; j < 3 && !polygon.empty(); ++j) {
       const Exact3 &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
-      auto inside = [&](const Point& p) { return sgn(orient2Value(b0, b1, p.exact, axis_)) * orientation >= 0; };
+      auto inside = [&](const Point& p) {
+        return sgn(orient2Value(b0, b1, p.exact, axis_)) * orientation >= 0;
+      };
       std::vector<Corner> out;
       for (std::size_t k = 0; k < polygon.size(); ++k) {
         const Corner& s = polygon[k];
@@ -320,7 +340,9 @@ class Classifier {
     std::vector<Point> points;
     for (const Corner& c : polygon) {
       bool seen = false;
-      for (const Point& p : points) seen |= p.exact.x[0] == c.point.exact.x[0] && p.exact.x[1] == c.point.exact.x[1] && p.exact.x[2] == c.point.exact.x[2];
+      for (const Point& p : points)
+        seen |= p.exact.x[0] == c.point.exact.x[0] && p.exact.x[1] == c.point.exact.x[1] &&
+                p.exact.x[2] == c.point.exact.x[2];
       if (!seen) points.push_back(c.point);
     }
     TriangleContact c;
@@ -341,7 +363,8 @@ class Classifier {
     // Collinear points: keep the two extremes.
     const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
     auto less = [&](const Point& x, const Point& y) {
-      return x.exact.x[u] < y.exact.x[u] || (x.exact.x[u] == y.exact.x[u] && x.exact.x[v] < y.exact.x[v]);
+      return x.exact.x[u] < y.exact.x[u] ||
+             (x.exact.x[u] == y.exact.x[u] && x.exact.x[v] < y.exact.x[v]);
     };
     const auto [mn, mx] = std::minmax_element(points.begin(), points.end(), less);
     c.points.push_back(finish(*mn));
@@ -384,6 +407,42 @@ class Classifier {
 
 TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b) {
   return Classifier(a, b).run();
+}
+
+RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
+                            const TrianglePoints& b) {
+  const TrianglePoints* t[2] = {&a, &b};
+  auto exact = [](const Point3& p) { return exactOf(p); };
+  Exact3 r;
+  switch (point.kind) {
+    case ContactPoint::Kind::kVertex:
+      r = exact((*t[point.triangle])[point.index]);
+      break;
+    case ContactPoint::Kind::kEdgeFace: {
+      const TrianglePoints &own = *t[point.triangle], &other = *t[1 - point.triangle];
+      const Exact3 p = exact(own[point.index]), q = exact(own[(point.index + 1) % 3]);
+      const Exact3 o0 = exact(other[0]), o1 = exact(other[1]), o2 = exact(other[2]);
+      const mpq_class sp = orient3dValue(o0, o1, o2, p), sq = orient3dValue(o0, o1, o2, q);
+      r = along(p, q, sp / (sp - sq));
+      break;
+    }
+    case ContactPoint::Kind::kEdgeEdge: {
+      const int axis = projectionAxis(a[0], a[1], a[2]);
+      const Exact3 p = exact(a[point.index]), q = exact(a[(point.index + 1) % 3]);
+      const Exact3 b0 = exact(b[point.other_index]), b1 = exact(b[(point.other_index + 1) % 3]);
+      const mpq_class op = orient2Value(b0, b1, p, axis), oq = orient2Value(b0, b1, q, axis);
+      r = along(p, q, op / (op - oq));
+      break;
+    }
+  }
+  return {{r.x[0], r.x[1], r.x[2]}};
+}
+
+int orient3d(const RationalPoint& p, const RationalPoint& q, const RationalPoint& r,
+             const RationalPoint& s) {
+  const Exact3 a{{p.x[0], p.x[1], p.x[2]}}, b{{q.x[0], q.x[1], q.x[2]}};
+  const Exact3 c{{r.x[0], r.x[1], r.x[2]}}, d{{s.x[0], s.x[1], s.x[2]}};
+  return sgn(orient3dValue(a, b, c, d));
 }
 
 }  // namespace meshmend

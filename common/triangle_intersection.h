@@ -10,6 +10,8 @@
 #include <array>
 #include <vector>
 
+#include <gmpxx.h>
+
 #include "common/mesh.h"
 
 namespace meshmend {
@@ -35,12 +37,12 @@ bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int
 
 // How two triangles meet.
 enum class ContactKind {
-  kNone,              // disjoint
-  kCrossing,          // not coplanar; a segment through the interior of both
-  kTouchAtPoint,      // a single common point
-  kTouchAlongEdge,    // not coplanar; a segment on an edge of at least one of them
-  kCoplanarOverlap,   // coplanar; a common region of positive area
-  kCoplanarTouch,     // coplanar; only boundaries meet (a point or a segment)
+  kNone,             // disjoint
+  kCrossing,         // not coplanar; a segment through the interior of both
+  kTouchAtPoint,     // a single common point
+  kTouchAlongEdge,   // not coplanar; a segment on an edge of at least one of them
+  kCoplanarOverlap,  // coplanar; a common region of positive area
+  kCoplanarTouch,    // coplanar; only boundaries meet (a point or a segment)
 };
 
 const char* toString(ContactKind kind);
@@ -67,6 +69,22 @@ struct TriangleContact {
   // point or segment).
   std::vector<ContactPoint> points;
 };
+
+// A point with exact rational coordinates.
+struct RationalPoint {
+  std::array<mpq_class, 3> x;
+};
+
+// The exact position of a contact point of classifyContact(a, b), from its
+// defining elements: an input corner, an edge of one triangle at the
+// parameter where it crosses the other's plane, or (coplanar) an edge of a
+// where it crosses an edge line of b. Predicates on it stay exact.
+RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
+                            const TrianglePoints& b);
+
+// Exact sign of det[q-p, r-p, s-p] for rational points.
+int orient3d(const RationalPoint& p, const RationalPoint& q, const RationalPoint& r,
+             const RationalPoint& s);
 
 // Full classification with exact end points. Slower than trianglesIntersect
 // (it builds exact rational points): meant for pairs known to intersect.

@@ -37,7 +37,8 @@ std::size_t bruteForceSelfPairs(const Mesh& m) {
   std::size_t pairs = 0;
   for (std::size_t f = 0; f < t.size(); ++f)
     for (std::size_t g = f + 1; g < t.size(); ++g) {
-      const TrianglePoints a{p[t[f][0]], p[t[f][1]], p[t[f][2]]}, b{p[t[g][0]], p[t[g][1]], p[t[g][2]]};
+      const TrianglePoints a{p[t[f][0]], p[t[f][1]], p[t[f][2]]},
+          b{p[t[g][0]], p[t[g][1]], p[t[g][2]]};
       if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) continue;
       int shared = 0, ia = -1, ib = -1;
       for (int i = 0; i < 3; ++i)
@@ -88,8 +89,8 @@ TEST(Intersections, SharedVertexAndSharedEdgeRules) {
   const Mesh fold = makeMesh({{0, 0, 0}, {2, 0, 0}, {1, 1, 0}, {1, 2, 0}}, {{0, 1, 2}, {1, 0, 3}});
   EXPECT_EQ(findIntersections({&fold}).self_pairs[0], 1u);
   // A fan around one vertex with one triangle's far edge piercing the other.
-  const Mesh pierce = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {2, 1, -1}, {2, 1, 1}},
-                               {{0, 1, 2}, {0, 3, 4}});
+  const Mesh pierce =
+      makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {2, 1, -1}, {2, 1, 1}}, {{0, 1, 2}, {0, 3, 4}});
   EXPECT_EQ(findIntersections({&pierce}).self_pairs[0], 1u);
   // The same fan, not piercing: only the shared vertex.
   const Mesh fan = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {-2, -1, -1}, {-2, -1, 1}},
@@ -185,10 +186,12 @@ TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
   // Brute force over a sorted sweep on x.
   std::vector<std::uint32_t> order(boxes.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](auto x, auto y) { return boxes[x].lo[0] < boxes[y].lo[0]; });
+  std::sort(order.begin(), order.end(),
+            [&](auto x, auto y) { return boxes[x].lo[0] < boxes[y].lo[0]; });
   std::size_t expected = 0;
   for (std::size_t i = 0; i < order.size(); ++i)
-    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo[0] <= boxes[order[i]].hi[0]; ++j)
+    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo[0] <= boxes[order[i]].hi[0];
+         ++j)
       expected += overlap(boxes[order[i]], boxes[order[j]]);
   EXPECT_EQ(pairs, expected);
   std::size_t hits = 0;

@@ -16,7 +16,9 @@ namespace {
 using Kind = ContactKind;
 using PointKind = ContactPoint::Kind;
 
-TrianglePoints tri(Point3 a, Point3 b, Point3 c) { return {a, b, c}; }
+TrianglePoints tri(Point3 a, Point3 b, Point3 c) {
+  return {a, b, c};
+}
 
 const TrianglePoints kBase = tri({0, 0, 0}, {4, 0, 0}, {0, 4, 0});  // in z = 0
 
@@ -126,11 +128,11 @@ TEST(TriangleIntersection, CoplanarTouchAlongAnEdgeAndAtAPoint) {
 
 TEST(TriangleIntersection, SegmentTriangle) {
   EXPECT_TRUE(segmentIntersectsTriangle({1, 1, -1}, {1, 1, 1}, kBase));
-  EXPECT_TRUE(segmentIntersectsTriangle({1, 1, 0}, {1, 1, 1}, kBase));    // end point on it
-  EXPECT_TRUE(segmentIntersectsTriangle({-1, 1, 0}, {1, 1, 0}, kBase));   // coplanar, enters
-  EXPECT_FALSE(segmentIntersectsTriangle({-2, 1, 0}, {-1, 1, 0}, kBase)); // coplanar, outside
-  EXPECT_FALSE(segmentIntersectsTriangle({3, 3, -1}, {3, 3, 1}, kBase));  // beyond hypotenuse
-  EXPECT_TRUE(segmentIntersectsTriangle({2, 2, -1}, {2, 2, 1}, kBase));   // on hypotenuse
+  EXPECT_TRUE(segmentIntersectsTriangle({1, 1, 0}, {1, 1, 1}, kBase));     // end point on it
+  EXPECT_TRUE(segmentIntersectsTriangle({-1, 1, 0}, {1, 1, 0}, kBase));    // coplanar, enters
+  EXPECT_FALSE(segmentIntersectsTriangle({-2, 1, 0}, {-1, 1, 0}, kBase));  // coplanar, outside
+  EXPECT_FALSE(segmentIntersectsTriangle({3, 3, -1}, {3, 3, 1}, kBase));   // beyond hypotenuse
+  EXPECT_TRUE(segmentIntersectsTriangle({2, 2, -1}, {2, 2, 1}, kBase));    // on hypotenuse
 }
 
 // The rule of PMP::self_intersections for faces sharing vertices.
@@ -201,7 +203,8 @@ TEST(TriangleIntersection, AgreesWithCgalOnDegenerateRandomInput) {
       ++checked;
       const Point3 p = a[0], q = b[1];
       disagreements += segmentIntersectsTriangle(p, q, b) !=
-                       CGAL::do_intersect(cgal<Epick>(b), Epick::Segment_3({p[0], p[1], p[2]}, {q[0], q[1], q[2]}));
+                       CGAL::do_intersect(cgal<Epick>(b),
+                                          Epick::Segment_3({p[0], p[1], p[2]}, {q[0], q[1], q[2]}));
     }
   EXPECT_EQ(disagreements, 0) << "of " << checked;
   EXPECT_GT(intersecting, checked / 10);  // the generator is not trivially disjoint
@@ -220,8 +223,10 @@ TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
     if (!result) continue;
     std::vector<Epeck::Point_3> expected;
     if (const auto* p = boost::get<Epeck::Point_3>(&*result)) expected = {*p};
-    if (const auto* s = boost::get<Epeck::Segment_3>(&*result)) expected = {s->source(), s->target()};
-    if (const auto* t = boost::get<Epeck::Triangle_3>(&*result)) expected = {t->vertex(0), t->vertex(1), t->vertex(2)};
+    if (const auto* s = boost::get<Epeck::Segment_3>(&*result))
+      expected = {s->source(), s->target()};
+    if (const auto* t = boost::get<Epeck::Triangle_3>(&*result))
+      expected = {t->vertex(0), t->vertex(1), t->vertex(2)};
     if (const auto* v = boost::get<std::vector<Epeck::Point_3>>(&*result)) expected = *v;
     ASSERT_EQ(c.points.size(), expected.size()) << toString(c.kind);
     for (const Epeck::Point_3& e : expected) {
@@ -229,22 +234,44 @@ TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
       const Point3 want(CGAL::to_double(CGAL::exact(e.x())), CGAL::to_double(CGAL::exact(e.y())),
                         CGAL::to_double(CGAL::exact(e.z())));
       bool found = false;
-      for (const ContactPoint& p : c.points) found |= (p.position - want).Norm() <= 1e-15 * (1 + want.Norm());
+      for (const ContactPoint& p : c.points)
+        found |= (p.position - want).Norm() <= 1e-15 * (1 + want.Norm());
       EXPECT_TRUE(found) << toString(c.kind) << " want " << want[0] << " " << want[1] << " "
                          << want[2] << " got " << c.points[0].position[0] << " "
                          << c.points[0].position[1] << " " << c.points[0].position[2] << " / "
-                         << c.points.back().position[0] << " " << c.points.back().position[1]
-                         << " " << c.points.back().position[2]
-                         << " a " << a[0][0] << "," << a[0][1] << "," << a[0][2] << " "
-                         << a[1][0] << "," << a[1][1] << "," << a[1][2] << " " << a[2][0]
-                         << "," << a[2][1] << "," << a[2][2] << " b " << b[0][0] << ","
-                         << b[0][1] << "," << b[0][2] << " " << b[1][0] << "," << b[1][1]
-                         << "," << b[1][2] << " " << b[2][0] << "," << b[2][1] << ","
-                         << b[2][2];
+                         << c.points.back().position[0] << " " << c.points.back().position[1] << " "
+                         << c.points.back().position[2] << " a " << a[0][0] << "," << a[0][1] << ","
+                         << a[0][2] << " " << a[1][0] << "," << a[1][1] << "," << a[1][2] << " "
+                         << a[2][0] << "," << a[2][1] << "," << a[2][2] << " b " << b[0][0] << ","
+                         << b[0][1] << "," << b[0][2] << " " << b[1][0] << "," << b[1][1] << ","
+                         << b[1][2] << " " << b[2][0] << "," << b[2][1] << "," << b[2][2];
     }
     ++compared;
   }
   EXPECT_GT(compared, 1000);
+}
+
+// Every contact point, rebuilt exactly from its defining elements, lies
+// exactly on both triangles and rounds to the reported position.
+TEST(TriangleIntersection, ExactPositionsLieOnBothTriangles) {
+  Generator gen(31);
+  auto exactOf = [](const Point3& p) {
+    return RationalPoint{{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
+  };
+  int checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const TrianglePoints a = gen.next(1), b = gen.next(1);
+    const TriangleContact c = classifyContact(a, b);
+    for (const ContactPoint& p : c.points) {
+      const RationalPoint x = exactPosition(p, a, b);
+      for (const TrianglePoints* t : {&a, &b})
+        ASSERT_EQ(orient3d(exactOf((*t)[0]), exactOf((*t)[1]), exactOf((*t)[2]), x), 0)
+            << toString(c.kind);
+      EXPECT_NEAR(x.x[0].get_d(), p.position[0], 1e-15 * (1 + std::fabs(p.position[0])));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 5000);
 }
 
 }  // namespace

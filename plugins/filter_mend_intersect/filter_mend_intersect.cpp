@@ -47,7 +47,8 @@ void IntersectPlugin::initParameterSet(QAction*, MeshDocument& md, RichParameter
     }
   parameters.addParam(RichEnum(
       "mode", kWithinCurrent,
-      QStringList() << "Within the current layer" << "Between two chosen layers"
+      QStringList() << "Within the current layer"
+                    << "Between two chosen layers"
                     << "Among all visible layers",
       "Mode",
       "Within the current layer: its self-intersections. Between two chosen layers: faces of "
@@ -57,10 +58,10 @@ void IntersectPlugin::initParameterSet(QAction*, MeshDocument& md, RichParameter
                                "First layer of the 'between two chosen layers' mode."));
   parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
                                "Second layer of the 'between two chosen layers' mode."));
-  parameters.addParam(RichBool(
-      "segments_layer", false, "Create a layer with the segments",
-      "Adds a layer named 'intersection segments' holding the exact intersection segments "
-      "(rounded to float) as edges, so that the curves can be seen and saved."));
+  parameters.addParam(
+      RichBool("segments_layer", false, "Create a layer with the segments",
+               "Adds a layer named 'intersection segments' holding the exact intersection segments "
+               "(rounded to float) as edges, so that the curves can be seen and saved."));
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
       "When not empty, the result is also written to this path as one JSON object: "
@@ -136,16 +137,18 @@ bool IntersectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParamete
 
     for (std::size_t i = 0; i < layers.size(); ++i)
       if (options.self)
-        Log("MeshMend: %s has %zu self-intersecting pairs (%zu faces)", layerName(*layers[i]).c_str(),
-            r.self_pairs[i], r.self_faces[i]);
+        Log("MeshMend: %s has %zu self-intersecting pairs (%zu faces)",
+            layerName(*layers[i]).c_str(), r.self_pairs[i], r.self_faces[i]);
     if (options.cross)
       Log("MeshMend: %zu intersecting pairs between layers (faces per layer: %s)", r.cross_pairs,
           [&] {
             std::string s;
             for (std::size_t i = 0; i < layers.size(); ++i)
-              s += (i ? ", " : "") + toStd(layers[i]->label()) + " " + std::to_string(r.cross_faces[i]);
+              s += (i ? ", " : "") + toStd(layers[i]->label()) + " " +
+                   std::to_string(r.cross_faces[i]);
             return s;
-          }().c_str());
+          }()
+              .c_str());
     Log("  selected %zu faces; %zu candidate pairs tested exactly in %.1f ms", selected,
         r.candidate_pairs, r.time_ms);
   });
