@@ -22,6 +22,7 @@
 #include "common/intersections.h"
 #include "common/mesh_io.h"
 #include "common/parallel.h"
+#include "common/triangle_intersection.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
@@ -30,15 +31,6 @@ using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
 namespace {
-
-Mesh joined(const Mesh& a, const Mesh& b) {
-  std::vector<Point3> p = positionsOf(a), pb = positionsOf(b);
-  std::vector<Triangle> t = trianglesOf(a);
-  const int offset = int(p.size());
-  p.insert(p.end(), pb.begin(), pb.end());
-  for (Triangle f : trianglesOf(b)) t.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
-  return makeMesh(p, t);
-}
 
 K::Triangle_3 cgalTriangle(const Mesh& m, std::size_t f) {
   auto p = [&](int k) {
@@ -75,10 +67,8 @@ long cgalSoupSelfIntersections(const Mesh& m) {
       boxes.begin(), boxes.end(), [&](const CgalBox& x, const CgalBox& y) {
         const std::size_t f = x.info(), g = y.info();
         const Triangle &a = idx[f], &b = idx[g];
-        int shared = 0, ia = -1, ib = -1;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            if (a[i] == b[j]) ++shared, ia = i, ib = j;
+        const SharedCorners c = sharedCorners(a, b);  // which corners, by index
+        const int shared = c.count, ia = c.ia, ib = c.ib;
         const K::Triangle_3 &ta = tris[f], &tb = tris[g];
         bool hit = false;
         if (shared == 0) {
@@ -87,11 +77,7 @@ long cgalSoupSelfIntersections(const Mesh& m) {
           hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
                 CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
         } else if (shared == 2) {
-          int apexA = 0, apexB = 0;
-          for (int i = 0; i < 3; ++i)
-            if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) apexA = i;
-          for (int j = 0; j < 3; ++j)
-            if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) apexB = j;
+          const int apexA = ia, apexB = ib;
           const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
           hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
                 CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
@@ -181,7 +167,7 @@ int main(int argc, char** argv) {
   }
   const bool join = !b.empty();
   methods.push_back({join ? "meshmend_self_joined" : "meshmend_self", "ours", [=] {
-                       auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b))
+                       auto m = std::make_shared<Mesh>(join ? appended(readMesh(a), readMesh(b))
                                                             : readMesh(a));
                        return std::function<long()>([=] {
                          FindIntersectionsOptions o;
@@ -193,7 +179,7 @@ int main(int argc, char** argv) {
       {join ? "cgal_self_intersections_joined" : "cgal_self_intersections", "peer", [=] {
          // PMP::self_intersections needs a valid Surface_mesh; other inputs get
          // CGAL's box_self_intersection_d with the same rule (as meshcheck does).
-         auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b)) : readMesh(a));
+         auto m = std::make_shared<Mesh>(join ? appended(readMesh(a), readMesh(b)) : readMesh(a));
          std::shared_ptr<SurfaceMesh> tm;
          try {
            tm = std::make_shared<SurfaceMesh>(toSurfaceMesh(*m));
@@ -204,7 +190,7 @@ int main(int argc, char** argv) {
        }});
   methods.push_back({join ? "meshmend_self_joined_morton_layout" : "meshmend_self_morton_layout",
                      "alternative", [=] {
-                       auto m = std::make_shared<Mesh>(join ? joined(readMesh(a), readMesh(b))
+                       auto m = std::make_shared<Mesh>(join ? appended(readMesh(a), readMesh(b))
                                                             : readMesh(a));
                        return std::function<long()>([=] {
                          FindIntersectionsOptions o;

@@ -69,32 +69,24 @@ bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) 
 // The self-intersection rule for two faces of one mesh. Cheap exact plane
 // tests settle almost every pair of neighbours; the rest get the full test.
 bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
-  const Triangle &a = s.triangles[f], &b = s.triangles[g];
-  int shared = 0, ia = -1, ib = -1;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (a[i] == b[j]) ++shared, ia = i, ib = j;
-  switch (shared) {
+  const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
+  switch (c.count) {
     case 0:
       if (strictlyBeside(s, f, s, g) || strictlyBeside(s, g, s, f)) return false;
       break;
     case 1:
       // The edge opposite the shared corner, in either face, must meet the other.
-      if (!edgeMayMeet(s, f, (ia + 1) % 3, (ia + 2) % 3, g) &&
-          !edgeMayMeet(s, g, (ib + 1) % 3, (ib + 2) % 3, f))
+      if (!edgeMayMeet(s, f, (c.ia + 1) % 3, (c.ia + 2) % 3, g) &&
+          !edgeMayMeet(s, g, (c.ib + 1) % 3, (c.ib + 2) % 3, f))
         return false;
       break;
-    case 2:  // the rule wants the apexes: the corners not shared; coplanar first
-      for (int i = 0; i < 3; ++i)
-        if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) ia = i;
-      for (int j = 0; j < 3; ++j)
-        if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) ib = j;
-      if (s.planes[f](s.corner(g, ib)) != 0) return false;
+    case 2:  // folded faces are coplanar: the other's apex must lie in the plane
+      if (s.planes[f](s.corner(g, c.ib)) != 0) return false;
       break;
     default:
       return true;
   }
-  return intersectBeyondShared(s.at(f), s.at(g), shared, ia, ib);
+  return intersectBeyondShared(s.at(f), s.at(g), c.count, c.ia, c.ib);
 }
 
 }  // namespace

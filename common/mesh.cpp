@@ -62,6 +62,12 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
   return mesh;
 }
 
+Mesh appended(const Mesh& a, const Mesh& b) {
+  Mesh out = a;
+  vcg::tri::Append<Mesh, Mesh>::Mesh(out, const_cast<Mesh&>(b));
+  return out;
+}
+
 std::vector<Point3> positionsOf(const Mesh& mesh) {
   std::vector<Point3> out;
   out.reserve(mesh.vert.size());

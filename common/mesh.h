@@ -80,6 +80,9 @@ FaceOriginHandle faceOrigins(Mesh& mesh);
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer = 0);
 
+// The two meshes in one (b's vertices and faces after a's), provenance kept.
+Mesh appended(const Mesh& a, const Mesh& b);
+
 // Vertex positions and face corner indices of a compact mesh (no deleted elements).
 std::vector<Point3> positionsOf(const Mesh& mesh);
 std::vector<Triangle> trianglesOf(const Mesh& mesh);

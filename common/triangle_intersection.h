@@ -35,6 +35,15 @@ bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b);
 bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int shared, int ia,
                            int ib);
 
+// How two faces of one mesh share corners (by vertex index), in the form
+// intersectBeyondShared takes: the shared corner when count == 1, the apexes
+// (unshared corners) when count == 2.
+struct SharedCorners {
+  int count = 0;
+  int ia = -1, ib = -1;
+};
+SharedCorners sharedCorners(const Triangle& a, const Triangle& b);
+
 // How two triangles meet.
 enum class ContactKind {
   kNone,             // disjoint

@@ -21,15 +21,6 @@ Mesh moved(const Mesh& m, Point3 by) {
   return makeMesh(p, trianglesOf(m));
 }
 
-Mesh joined(const Mesh& a, const Mesh& b) {
-  std::vector<Point3> p = positionsOf(a), pb = positionsOf(b);
-  std::vector<Triangle> t = trianglesOf(a);
-  const int offset = int(p.size());
-  p.insert(p.end(), pb.begin(), pb.end());
-  for (Triangle f : trianglesOf(b)) t.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
-  return makeMesh(p, t);
-}
-
 // Brute force over all face pairs with the same exact rules.
 std::size_t bruteForceSelfPairs(const Mesh& m) {
   const std::vector<Point3> p = positionsOf(m);
@@ -40,17 +31,8 @@ std::size_t bruteForceSelfPairs(const Mesh& m) {
       const TrianglePoints a{p[t[f][0]], p[t[f][1]], p[t[f][2]]},
           b{p[t[g][0]], p[t[g][1]], p[t[g][2]]};
       if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) continue;
-      int shared = 0, ia = -1, ib = -1;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          if (t[f][i] == t[g][j]) ++shared, ia = i, ib = j;
-      if (shared == 2) {
-        for (int i = 0; i < 3; ++i)
-          if (t[f][i] != t[g][0] && t[f][i] != t[g][1] && t[f][i] != t[g][2]) ia = i;
-        for (int j = 0; j < 3; ++j)
-          if (t[g][j] != t[f][0] && t[g][j] != t[f][1] && t[g][j] != t[f][2]) ib = j;
-      }
-      pairs += intersectBeyondShared(a, b, shared, ia, ib);
+      const SharedCorners c = sharedCorners(t[f], t[g]);
+      pairs += intersectBeyondShared(a, b, c.count, c.ia, c.ib);
     }
   return pairs;
 }
@@ -65,7 +47,7 @@ TEST(Intersections, CleanClosedMeshHasNone) {
 TEST(Intersections, TwoOverlappingCubesInOneMesh) {
   // The unit cube and a copy moved by (0.5, 0.5, 0.5): 18 intersecting pairs
   // (the count meshcheck and CGAL give).
-  const Mesh both = joined(box(), moved(box(), {0.5, 0.5, 0.5}));
+  const Mesh both = appended(box(), moved(box(), {0.5, 0.5, 0.5}));
   const FindIntersectionsResult r = findIntersections({&both});
   EXPECT_EQ(r.self_pairs[0], 18u);
   EXPECT_EQ(r.self_pairs[0], bruteForceSelfPairs(both));
