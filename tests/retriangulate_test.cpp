@@ -1,0 +1,171 @@
+#include "common/retriangulate.h"
+
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+
+namespace meshmend {
+namespace {
+
+RationalPoint R(mpq_class x, mpq_class y, mpq_class z) {
+  return {{x, y, z}};
+}
+
+// A tilted triangle in 3-D (not axis-aligned), and points on it by their
+// rational barycentric coordinates.
+const std::array<RationalPoint, 3> kTri = {R(0, 0, 0), R(4, 0, 1), R(0, 4, 3)};
+
+RationalPoint on(mpq_class s,
+                 mpq_class t) {  // corner0 + s (corner1 - corner0) + t (corner2 - corner0)
+  RationalPoint p;
+  for (int k = 0; k < 3; ++k)
+    p.x[k] = kTri[0].x[k] + s * (kTri[1].x[k] - kTri[0].x[k]) + t * (kTri[2].x[k] - kTri[0].x[k]);
+  return p;  // not canonical when s, t are not: retriangulate must cope
+}
+
+// Twice the area, projected along z (the triangle's normal has a non-zero z).
+mpq_class area2(const Patch& p, const std::array<int, 3>& t) {
+  const auto& a = p.vertices[t[0]].x;
+  const auto& b = p.vertices[t[1]].x;
+  const auto& c = p.vertices[t[2]].x;
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+// Every triangle turns like the input, none is degenerate, and together they
+// cover exactly the input's area.
+void expectValidTiling(const Patch& p) {
+  const std::array<int, 3> whole{0, 1, 2};
+  const mpq_class total = area2(p, whole);
+  mpq_class sum = 0;
+  for (const auto& t : p.triangles) {
+    const mpq_class a = area2(p, t);
+    EXPECT_EQ(sgn(a), sgn(total));
+    sum += a;
+  }
+  EXPECT_EQ(sum, total);
+}
+
+bool hasEdge(const Patch& p, int a, int b) {
+  for (const auto& t : p.triangles)
+    for (int i = 0; i < 3; ++i)
+      if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a)) return true;
+  return false;
+}
+
+PatchInput input(std::vector<RationalPoint> points, std::vector<std::array<int, 2>> segments) {
+  PatchInput in;
+  in.corners = kTri;
+  in.points = std::move(points);
+  in.segments = std::move(segments);
+  return in;
+}
+
+TEST(Retriangulate, NoPointsKeepsTheTriangle) {
+  const Patch p = retriangulate(input({}, {}));
+  ASSERT_EQ(p.triangles.size(), 1u);
+  EXPECT_EQ(p.triangles[0], (std::array<int, 3>{0, 1, 2}));
+}
+
+TEST(Retriangulate, InteriorPointSplitsIntoThree) {
+  const Patch p = retriangulate(input({on(mpq_class(1, 3), mpq_class(1, 3))}, {}));
+  EXPECT_EQ(p.triangles.size(), 3u);
+  expectValidTiling(p);
+}
+
+TEST(Retriangulate, PointOnAnEdgeSplitsIntoTwo) {
+  const Patch p = retriangulate(input({on(mpq_class(1, 2), 0)}, {}));
+  EXPECT_EQ(p.triangles.size(), 2u);
+  expectValidTiling(p);
+}
+
+TEST(Retriangulate, SegmentAcrossBecomesAConstrainedEdge) {
+  // From a point on edge 0-1 to a point on edge 0-2, plus an interior point
+  // that a Delaunay-like improvement would like to connect across it.
+  const Patch p = retriangulate(input(
+      {on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(mpq_class(1, 10), mpq_class(1, 10))},
+      {{3, 4}}));
+  expectValidTiling(p);
+  EXPECT_TRUE(hasEdge(p, p.vertex_of_input[3], p.vertex_of_input[4]));
+  ASSERT_EQ(p.constrained_edges.size(), 1u);
+}
+
+TEST(Retriangulate, CrossingConstraintsMeetAtTheirExactCrossing) {
+  const Patch p = retriangulate(input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(0, 0),
+                                       on(mpq_class(1, 3), mpq_class(1, 3))},
+                                      {{3, 4}, {5, 6}}));
+  expectValidTiling(p);
+  EXPECT_EQ(p.vertices.size(), 3u + 3u + 1u);  // corner 0 repeated as a point; one crossing
+  EXPECT_EQ(p.constrained_edges.size(), 4u);
+  const RationalPoint& x = p.vertices.back();  // the crossing: (1/4, 1/4) in barycentric terms
+  const RationalPoint want = on(mpq_class(1, 4), mpq_class(1, 4));
+  EXPECT_EQ(x.x, want.x);
+}
+
+TEST(Retriangulate, VertexOnAConstraintSplitsIt) {
+  const Patch p = retriangulate(
+      input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(mpq_class(1, 4), mpq_class(1, 4))},
+            {{3, 4}}));
+  expectValidTiling(p);
+  EXPECT_EQ(p.constrained_edges.size(), 2u);
+}
+
+TEST(Retriangulate, ConstraintAlongATriangleEdge) {
+  const Patch p = retriangulate(input({on(mpq_class(1, 4), 0), on(mpq_class(3, 4), 0)}, {{3, 4}}));
+  expectValidTiling(p);
+  EXPECT_EQ(p.triangles.size(), 3u);
+  EXPECT_TRUE(hasEdge(p, p.vertex_of_input[3], p.vertex_of_input[4]));
+}
+
+TEST(Retriangulate, RejectsPointsOffTheTriangle) {
+  EXPECT_THROW(retriangulate(input({on(1, 1)}, {})), InvalidInputError);  // outside, in the plane
+  PatchInput off = input({R(1, 1, 100)}, {});                             // off the plane
+  EXPECT_THROW(retriangulate(off), InvalidInputError);
+  EXPECT_THROW(retriangulate(input({on(mpq_class(1, 4), 0)}, {{0, 9}})), InvalidInputError);
+}
+
+// Random points and segments (crossing each other freely): always a valid
+// tiling in which every segment is a chain of constrained edges.
+TEST(Retriangulate, RandomConstraintsAlwaysGiveValidTilings) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> num(0, 12);
+  for (int trial = 0; trial < 1000; ++trial) {
+    std::vector<RationalPoint> points;
+    for (int i = 0; i < 10; ++i) {
+      int s = num(rng), t = num(rng);
+      if (s + t > 12) s = 12 - s, t = 12 - t;  // fold into the triangle
+      if (s + t > 12) t = 12 - s;
+      points.push_back(on(mpq_class(s, 12), mpq_class(t, 12)));
+    }
+    std::vector<std::array<int, 2>> segments;
+    std::uniform_int_distribution<int> pick(0, 12);
+    for (int i = 0; i < 6; ++i) segments.push_back({pick(rng), pick(rng)});
+    const Patch p = retriangulate(input(points, segments));
+    expectValidTiling(p);
+    // Each segment's end points are joined by constrained edges along it.
+    std::map<int, std::vector<int>> graph;
+    for (const auto& e : p.constrained_edges) {
+      EXPECT_TRUE(hasEdge(p, e[0], e[1]));
+      graph[e[0]].push_back(e[1]);
+      graph[e[1]].push_back(e[0]);
+    }
+    for (const auto& s : segments) {
+      const int a = p.vertex_of_input[s[0]], b = p.vertex_of_input[s[1]];
+      if (a == b) continue;
+      std::vector<int> stack{a};
+      std::set<int> seen{a};
+      while (!stack.empty()) {
+        const int v = stack.back();
+        stack.pop_back();
+        for (int w : graph[v])
+          if (seen.insert(w).second) stack.push_back(w);
+      }
+      EXPECT_TRUE(seen.count(b)) << "trial " << trial;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace meshmend
