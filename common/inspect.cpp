@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/errors.h"
+#include "common/intersections.h"
 #include "common/parallel.h"
 #include "common/predicates.h"
 
@@ -313,6 +314,16 @@ InspectResult inspect(const Mesh& mesh, const InspectOptions& options) {
   const std::vector<Point3> points = positionsOf(mesh);
   const std::vector<Triangle> triangles = trianglesOf(mesh);
   InspectResult result = Inspector(points, triangles, options).run();
+  if (options.self_intersections && result.non_finite_vertices == 0 && mesh.fn > 0) {
+    FindIntersectionsOptions find;
+    find.cross = false;
+    const FindIntersectionsResult found = findIntersections({&mesh}, find);
+    result.self_intersecting_pairs = found.self_pairs[0];
+    result.self_intersecting_faces = found.self_faces[0];
+    if (options.mark_defects)
+      for (std::size_t f = 0; f < found.face_involved[0].size(); ++f)
+        if (found.face_involved[0][f]) result.face_defects[f] |= kFaceSelfIntersecting;
+  }
   result.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -338,8 +349,11 @@ JsonObject toJson(const InspectResult& r) {
       .set("is_closed", r.is_closed)
       .set("consistently_oriented", r.consistently_oriented)
       .set("orientation_inconsistent_edges", r.orientation_inconsistent_edges)
-      .set("volume", r.volume)
-      .set("euler_characteristic", r.euler_characteristic);
+      .set("volume", r.volume);
+  if (r.self_intersecting_pairs)
+    j.set("self_intersecting_pairs", *r.self_intersecting_pairs)
+        .set("self_intersecting_faces", *r.self_intersecting_faces);
+  j.set("euler_characteristic", r.euler_characteristic);
   if (r.genus)
     j.set("genus", *r.genus);
   else
@@ -370,6 +384,7 @@ std::string summarize(const InspectResult& r) {
   add(r.duplicate_points, "duplicate points");
   add(r.isolated_vertices, "unreferenced vertices");
   add(r.non_finite_vertices, "vertices with NaN or infinite coordinates");
+  if (r.self_intersecting_pairs) add(*r.self_intersecting_pairs, "self-intersecting face pairs");
   if (defects.empty()) {
     s << "no defects";
   } else {

@@ -15,7 +15,8 @@
 namespace meshmend {
 
 struct InspectOptions {
-  bool mark_defects = false;  // fill InspectResult::face_defects / vertex_defects
+  bool mark_defects = false;        // fill InspectResult::face_defects / vertex_defects
+  bool self_intersections = false;  // also count self-intersecting pairs (exact, slower)
 };
 
 // Bits of InspectResult::face_defects.
@@ -25,6 +26,7 @@ enum FaceDefect : std::uint8_t {
   kFaceDegenerate = 4,         // repeated vertex (index or coordinates) or collinear corners
   kFaceDuplicate = 8,          // same vertex set as an earlier face
   kFaceOrientationFlip = 16,   // shares an edge with a face that runs it the same way
+  kFaceSelfIntersecting = 32,  // intersects another face (self_intersections option)
 };
 
 // Bits of InspectResult::vertex_defects.
@@ -59,8 +61,12 @@ struct InspectResult {
   std::optional<long> genus;      // closed, edge- and vertex-manifold, oriented meshes only
   std::array<double, 6> bbox{};   // min x, y, z, max x, y, z over all finite vertices
   double bbox_diagonal = 0;
-  double min_angle_deg = 180;                // smallest interior angle
-  double mean_min_angle_deg = 0;             // mean over triangles of their smallest angle
+  double min_angle_deg = 180;     // smallest interior angle
+  double mean_min_angle_deg = 0;  // mean over triangles of their smallest angle
+  // With the self_intersections option (the rule of CGAL's self_intersections,
+  // as in intersections.h); empty otherwise or with non-finite coordinates.
+  std::optional<std::size_t> self_intersecting_pairs;
+  std::optional<std::size_t> self_intersecting_faces;
   double time_ms = 0;                        // compute time of inspect()
   std::vector<std::uint8_t> face_defects;    // per face FaceDefect bits (mark_defects)
   std::vector<std::uint8_t> vertex_defects;  // per vertex VertexDefect bits (mark_defects)

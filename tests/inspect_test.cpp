@@ -150,6 +150,27 @@ TEST(Inspect, NonFiniteVerticesAreCountedNotFatal) {
   EXPECT_NE(summarize(r).find("1 vertices with NaN"), std::string::npos);
 }
 
+TEST(Inspect, CountsSelfIntersectionsWhenAsked) {
+  // Two overlapping boxes in one mesh: 18 intersecting pairs on 12 faces.
+  std::vector<Point3> p = positionsOf(box());
+  std::vector<Triangle> t = trianglesOf(box());
+  for (const Point3& q : positionsOf(box())) p.push_back(q + Point3(0.5, 0.5, 0.5));
+  for (const Triangle& f : trianglesOf(box())) t.push_back({f[0] + 8, f[1] + 8, f[2] + 8});
+  const Mesh m = makeMesh(p, t);
+  EXPECT_FALSE(inspect(m).self_intersecting_pairs.has_value());
+  InspectOptions o;
+  o.self_intersections = true;
+  o.mark_defects = true;
+  const InspectResult r = inspect(m, o);
+  ASSERT_TRUE(r.self_intersecting_pairs.has_value());
+  EXPECT_EQ(*r.self_intersecting_pairs, 18u);
+  EXPECT_EQ(*r.self_intersecting_faces, 12u);
+  int marked = 0;
+  for (std::uint8_t d : r.face_defects) marked += (d & kFaceSelfIntersecting) != 0;
+  EXPECT_EQ(marked, 12);
+  EXPECT_NE(toJson(r).str().find("\"self_intersecting_pairs\": 18"), std::string::npos);
+}
+
 TEST(Inspect, EmptyMeshIsNotClosed) {
   const InspectResult r = inspect(Mesh());
   EXPECT_EQ(r.faces, 0u);
