@@ -1,0 +1,52 @@
+// Intersect and split (intersection paper §2): the curves where meshes
+// intersect are inserted into every mesh they cross, in place: each crossed
+// face is re-triangulated on its own with its curve segments as constraints
+// (retriangulate.h), points on an edge split that edge in both faces that
+// share it, and every face not crossed stays exactly as it was.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "common/intersections.h"
+#include "common/json.h"
+#include "common/mesh.h"
+#include "common/progress.h"
+
+namespace meshmend {
+
+struct SplitOptions {
+  bool between_meshes = true;  // insert the curves where different meshes meet
+  bool self = false;           // also split each mesh along its own self-intersections
+  bool weld = true;   // merged output: one vertex per curve point (meshes welded along curves)
+  Progress progress;  // called between stages
+};
+
+struct SplitResult {
+  // Per input mesh: the mesh with the curves inserted (input vertices first,
+  // in their order, then the new ones; provenance records every element's
+  // birth), and its curve edges (pairs of vertex indices).
+  std::vector<Mesh> meshes;
+  std::vector<std::vector<std::array<int, 2>>> curve_edges;
+  // All meshes in one, welded along the curves (when options.weld): the
+  // curves become non-manifold edges; provenance keeps the input mesh.
+  Mesh merged;
+  std::vector<std::array<int, 2>> merged_curve_edges;
+  std::size_t intersecting_pairs = 0;     // pairs found (and split)
+  std::size_t faces_split = 0;            // input faces re-triangulated
+  std::size_t faces_added = 0;            // output faces minus input faces
+  std::size_t new_vertices = 0;           // curve points that are not input vertices
+  std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
+  std::size_t curve_loops = 0;            // closed curve components (merged output)
+  std::size_t open_curves = 0;            // curve components with end points
+  double time_ms = 0;
+};
+
+// Throws InvalidInputError for empty meshes or non-finite coordinates.
+SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
+                                    const SplitOptions& options = {});
+
+// The report_file keys: curve_edges, curve_loops, open_curves, faces_split, ...
+JsonObject toJson(const SplitResult& result);
+
+}  // namespace meshmend

@@ -1,0 +1,116 @@
+#include "common/split.h"
+
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "common/inspect.h"
+#include "mesh_builders.h"
+
+namespace meshmend {
+namespace {
+
+using testing::box;
+using testing::uvSphere;
+
+Mesh moved(const Mesh& m, Point3 by) {
+  std::vector<Point3> p = positionsOf(m);
+  for (Point3& q : p) q += by;
+  return makeMesh(p, trianglesOf(m));
+}
+
+InspectResult check(const Mesh& m) {
+  InspectOptions o;
+  o.self_intersections = true;
+  return inspect(m, o);
+}
+
+TEST(Split, TwoSpheresMeetAlongOneClosedCurve) {
+  const Mesh a = uvSphere(24, 32), b = uvSphere(24, 32, 1.0, {0.9, 0.13, 0.07});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_GT(r.intersecting_pairs, 0u);
+  EXPECT_EQ(r.curve_loops, 1u);
+  EXPECT_EQ(r.open_curves, 0u);
+  // Each mesh stays closed and manifold; welded, they share the curve.
+  for (const Mesh& m : r.meshes) {
+    const InspectResult i = check(m);
+    EXPECT_TRUE(i.is_closed);
+    EXPECT_EQ(i.non_manifold_edges, 0u);
+    EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+  }
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
+  EXPECT_EQ(merged.border_edges, 0u);
+  EXPECT_EQ(merged.connected_components, 1u);
+}
+
+TEST(Split, FacesNotCrossedStayBitIdentical) {
+  const Mesh a = uvSphere(16, 20), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  const Mesh& out = r.meshes[0];
+  // Input vertices keep their index and coordinates.
+  for (std::size_t v = 0; v < a.vert.size(); ++v) EXPECT_EQ(out.vert[v].cP(), a.vert[v].cP());
+  // Every face not split appears unchanged (same corner indices), and the
+  // split ones are covered by faces that record them as their birth face.
+  FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(out));
+  std::vector<int> children(a.face.size(), 0);
+  for (std::size_t f = 0; f < out.face.size(); ++f) ++children[fo[f].face];
+  const std::vector<Triangle> in = trianglesOf(a), result = trianglesOf(out);
+  std::size_t unchanged = 0;
+  for (std::size_t f = 0; f < out.face.size(); ++f)
+    if (children[fo[f].face] == 1 && result[f] == in[fo[f].face]) ++unchanged;
+  const std::size_t splitFaces =
+      std::size_t(std::count_if(children.begin(), children.end(), [](int c) { return c > 1; }));
+  EXPECT_EQ(unchanged + splitFaces, a.face.size());
+  EXPECT_GT(unchanged, a.face.size() / 2);
+}
+
+TEST(Split, CurveThroughAVertexAndAlongAnEdge) {
+  // The boxes share the plane x = 1 partly (coplanar contact) and cross
+  // elsewhere: degenerate transitions of the curve.
+  const Mesh a = box(), b = moved(box(2, 0.5, 0.5), {0.5, 0.25, 0.25});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_GT(r.intersecting_pairs, 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  for (const Mesh& m : r.meshes) EXPECT_TRUE(check(m).is_closed);
+}
+
+TEST(Split, SelfIntersectionsOfOneMesh) {
+  // Two overlapping cubes given as one mesh.
+  std::vector<Point3> p = positionsOf(box());
+  std::vector<Triangle> t = trianglesOf(box());
+  for (const Point3& q : positionsOf(box())) p.push_back(q + Point3(0.5, 0.5, 0.5));
+  for (const Triangle& f : trianglesOf(box())) t.push_back({f[0] + 8, f[1] + 8, f[2] + 8});
+  const Mesh m = makeMesh(p, t);
+  SplitOptions o;
+  o.self = true;
+  const SplitResult r = splitAlongIntersections({&m}, o);
+  EXPECT_EQ(r.intersecting_pairs, 18u);
+  EXPECT_EQ(*check(r.meshes[0]).self_intersecting_pairs, 0u);
+  EXPECT_EQ(r.curve_loops, 1u);
+}
+
+TEST(Split, VeryDifferentResolutions) {
+  const Mesh coarse = box(2, 2, 2), fine = uvSphere(40, 60, 0.8, {1.7, 1.0, 1.0});
+  const SplitResult r = splitAlongIntersections({&coarse, &fine});
+  EXPECT_EQ(*check(r.merged).self_intersecting_pairs, 0u);
+  EXPECT_EQ(r.open_curves, 0u);
+  for (const Mesh& m : r.meshes) EXPECT_EQ(check(m).non_manifold_edges, 0u);
+}
+
+TEST(Split, NoIntersectionLeavesTheMeshes) {
+  const Mesh a = box(), b = moved(box(), {5, 0, 0});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(r.intersecting_pairs, 0u);
+  EXPECT_EQ(r.faces_split, 0u);
+  EXPECT_EQ(trianglesOf(r.meshes[0]), trianglesOf(a));
+}
+
+TEST(Split, BadInput) {
+  const Mesh empty, a = box();
+  EXPECT_THROW(splitAlongIntersections({&a, &empty}), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace meshmend
