@@ -291,7 +291,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
 
   reportProgress(options.progress, 90, "Welding along the curves");
-  if (options.weld) {
+  {
     // All meshes in one; curve vertices with the same exact position merge.
     std::vector<Point3> positions;
     std::vector<Triangle> triangles;
@@ -340,17 +340,21 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
     r.merged_curve_edges.assign(curves.begin(), curves.end());
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
-  } else {
-    std::size_t loops = 0, open = 0;
-    for (std::size_t m = 0; m < meshes.size(); ++m) {
-      countCurves(r.meshes[m].vert.size(), r.curve_edges[m], loops, open);
-      r.curve_loops += loops;
-      r.open_curves += open;
-    }
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   return r;
+}
+
+std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
+  if (result.merged.fn == 0) return 0;
+  Mesh check = result.merged;
+  if (asFloat)
+    for (Vertex& v : check.vert)
+      for (int k = 0; k < 3; ++k) v.P()[k] = double(float(v.P()[k]));
+  FindIntersectionsOptions o;
+  o.cross = false;
+  return findIntersections({&check}, o).self_pairs[0];
 }
 
 JsonObject toJson(const SplitResult& r) {

@@ -28,8 +28,8 @@ struct SplitResult {
   // birth), and its curve edges (pairs of vertex indices).
   std::vector<Mesh> meshes;
   std::vector<std::vector<std::array<int, 2>>> curve_edges;
-  // All meshes in one, welded along the curves (when options.weld): the
-  // curves become non-manifold edges; provenance keeps the input mesh.
+  // All meshes in one, welded along the curves: the curves become
+  // non-manifold edges; provenance keeps the input mesh.
   Mesh merged;
   std::vector<std::array<int, 2>> merged_curve_edges;
   std::size_t intersecting_pairs = 0;     // pairs found (and split)
@@ -45,6 +45,12 @@ struct SplitResult {
 // Throws InvalidInputError for empty meshes or non-finite coordinates.
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options = {});
+
+// Intersecting pairs left in the merged output, by the self-intersection
+// rule (faces that meet only along a shared curve edge or vertex do not
+// count), with coordinates as stored in double or, with `asFloat`, rounded
+// to float as MeshLab stores them.
+std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
 
 // The report_file keys: curve_edges, curve_loops, open_curves, faces_split, ...
 JsonObject toJson(const SplitResult& result);

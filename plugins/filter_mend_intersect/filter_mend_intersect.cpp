@@ -1,8 +1,11 @@
 #include "filter_mend_intersect.h"
 
 #include "common/intersections.h"
+#include "common/split.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
+
+#include <vcg/complex/algorithms/clean.h>
 
 using namespace meshmend;
 using namespace meshmend::bridge;
@@ -14,15 +17,32 @@ enum Mode { kWithinCurrent, kBetweenTwo, kAllVisible };
 }  // namespace
 
 IntersectPlugin::IntersectPlugin() {
-  typeList << SELECT_INTERSECTING;
+  typeList << SELECT_INTERSECTING << INTERSECT_AND_SPLIT;
   for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
 }
 
-QString IntersectPlugin::filterName(FilterIDType) const {
-  return "MeshMend: Select Intersecting Faces";
+QString IntersectPlugin::filterName(FilterIDType id) const {
+  return id == SELECT_INTERSECTING ? "MeshMend: Select Intersecting Faces"
+                                   : "MeshMend: Intersect and Split Layers";
 }
 
-QString IntersectPlugin::filterInfo(FilterIDType) const {
+QString IntersectPlugin::filterInfo(FilterIDType id) const {
+  if (id == INTERSECT_AND_SPLIT)
+    return "Inserts the exact intersection curves into the layers that cross, in place: each "
+           "crossed face is re-triangulated on its own with its curve segments as constrained "
+           "edges (a point on an edge splits the edge in both faces that share it), every "
+           "decision exact (the curve points are kept as rationals and rounded only on output), "
+           "and every face not crossed stays exactly as it was. Between two chosen layers, among "
+           "all visible layers, or within the current layer along its own self-intersections "
+           "(optionally also in the same pass). The result keeps the layers separate (the curves "
+           "inserted in each, with identical vertices along them) or merges them into one new "
+           "layer welded along the curves (the curves become non-manifold edges). Colours, "
+           "quality, normals and texture coordinates carry over. The written (float) result is "
+           "checked again and the remaining intersecting pairs are logged.<br>"
+           "Method: <i>McLaurin, Marcum, Remotigue, Blades</i>, <b>\"Repairing unstructured "
+           "triangular mesh intersections\"</b>, IJNME 2013 (local re-triangulation, edge split, "
+           "edge recovery, min-max angle reconnection), with exact instead of tolerance-based "
+           "decisions.";
   return "Selects the faces that intersect, exactly: within the current layer, between two "
          "chosen layers, or among all visible layers (within each and between every two). "
          "Within a layer, faces that share vertices count only when they meet beyond what they "
@@ -37,7 +57,7 @@ QString IntersectPlugin::filterInfo(FilterIDType) const {
          "exact instead of tolerance-based decisions.";
 }
 
-void IntersectPlugin::initParameterSet(QAction*, MeshDocument& md, RichParameterList& parameters) {
+void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   MeshModel* current = md.mm();
   MeshModel* other = current;
   for (MeshModel* m : md.meshList)
@@ -58,45 +78,95 @@ void IntersectPlugin::initParameterSet(QAction*, MeshDocument& md, RichParameter
                                "First layer of the 'between two chosen layers' mode."));
   parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
                                "Second layer of the 'between two chosen layers' mode."));
-  parameters.addParam(
-      RichBool("segments_layer", false, "Create a layer with the segments",
-               "Adds a layer named 'intersection segments' holding the exact intersection segments "
-               "(rounded to float) as edges, so that the curves can be seen and saved."));
+  if (ID(a) == INTERSECT_AND_SPLIT) {
+    parameters.addParam(RichBool(
+        "split_self_intersections", false, "Also split self-intersections",
+        "Also inserts each layer's own self-intersection curves in the same pass, so that the "
+        "result is free of every intersection (real scans often fold through themselves)."));
+    parameters.addParam(RichEnum(
+        "output", 0, QStringList() << "Keep the layers separate" << "Merge into one welded layer",
+        "Output",
+        "Keep the layers separate: the curves are inserted into each layer in place, with "
+        "identical vertices along them. Merge: a new layer holds all faces, welded along the "
+        "curves (which become non-manifold edges); the input layers are left unchanged."));
+    parameters.addParam(RichBool("curves_layer", false, "Create a layer with the curves",
+                                 "Adds a layer named 'intersection curves' with the inserted "
+                                 "curve edges, to see them and save them."));
+    parameters.addParam(RichBool(
+        "verify", true, "Check the written result",
+        "After writing (in float, as MeshLab stores meshes), finds the intersecting pairs that "
+        "remain (faces meeting only along a shared curve do not count) and logs and reports "
+        "them."));
+  } else {
+    parameters.addParam(RichBool(
+        "segments_layer", false, "Create a layer with the segments",
+        "Adds a layer named 'intersection segments' holding the exact intersection segments "
+        "(rounded to float) as edges, so that the curves can be seen and saved."));
+  }
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
-      "When not empty, the result is also written to this path as one JSON object: "
-      "self_intersecting_pairs, self_intersecting_faces, cross_intersecting_pairs, per-layer "
-      "counts, candidate_pairs and time_ms (detection time, file I/O excluded)."));
+      ID(a) == INTERSECT_AND_SPLIT
+          ? "When not empty, the result is also written to this path as one JSON object: "
+            "curve_edges, curve_loops, open_curves, faces_split, faces_added, new_vertices, "
+            "remaining_intersecting_pairs and time_ms (compute time, file I/O excluded)."
+          : "When not empty, the result is also written to this path as one JSON object: "
+            "self_intersecting_pairs, self_intersecting_faces, cross_intersecting_pairs, per-layer "
+            "counts, candidate_pairs and time_ms (detection time, file I/O excluded)."));
 }
 
-bool IntersectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterList& parameters,
+namespace {
+
+// The layers the mode and layer parameters choose (both filters share them).
+std::vector<MeshModel*> chosenLayers(MeshDocument& md, const RichParameterList& parameters) {
+  const int mode = parameters.getEnum("mode");
+  if (mode == kWithinCurrent) {
+    if (!md.mm()) throw InvalidInputError("there is no current layer: open a mesh first");
+    return {md.mm()};
+  }
+  if (mode == kBetweenTwo) {
+    MeshModel* a = parameters.getMesh("first_layer");
+    MeshModel* b = parameters.getMesh("second_layer");
+    if (!a || !b) throw InvalidInputError("choose the two layers to intersect");
+    if (a == b)
+      throw InvalidInputError("the same layer (" + layerName(*a) +
+                              ") was chosen twice: choose two different layers, or use the "
+                              "mode 'Within the current layer'");
+    return {a, b};
+  }
+  std::vector<MeshModel*> layers;
+  for (MeshModel* m : md.meshList)
+    if (m->isVisible() && m->cm.fn > 0) layers.push_back(m);
+  if (layers.empty()) throw InvalidInputError("no visible layer has faces");
+  return layers;
+}
+
+// The chosen layers as core meshes in one frame (layer matrices applied).
+std::vector<Mesh> coresOf(const std::vector<MeshModel*>& layers) {
+  std::vector<Mesh> cores;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    cores.push_back(toCore(layers[i]->cm, {int(i), true}));
+    requireFacesAndFiniteCoordinates(cores.back(), layerName(*layers[i]));
+  }
+  return cores;
+}
+
+}  // namespace
+
+bool IntersectPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
                                   vcg::CallBackPos* cb) {
   return guarded(*this, errorMessage, [&] {
-    const int mode = parameters.getEnum("mode");
-    std::vector<MeshModel*> layers;
-    if (mode == kWithinCurrent) {
-      if (!md.mm()) throw InvalidInputError("there is no current layer: open a mesh first");
-      layers = {md.mm()};
-    } else if (mode == kBetweenTwo) {
-      MeshModel* a = parameters.getMesh("first_layer");
-      MeshModel* b = parameters.getMesh("second_layer");
-      if (!a || !b) throw InvalidInputError("choose the two layers to intersect");
-      if (a == b)
-        throw InvalidInputError("the same layer (" + layerName(*a) +
-                                ") was chosen twice: choose two different layers, or use the "
-                                "mode 'Within the current layer'");
-      layers = {a, b};
-    } else {
-      for (MeshModel* m : md.meshList)
-        if (m->isVisible() && m->cm.fn > 0) layers.push_back(m);
-      if (layers.empty()) throw InvalidInputError("no visible layer has faces");
-    }
+    if (ID(a) == SELECT_INTERSECTING)
+      selectIntersecting(md, parameters, cb);
+    else
+      intersectAndSplit(md, parameters, cb);
+  });
+}
 
-    std::vector<Mesh> cores;
-    for (std::size_t i = 0; i < layers.size(); ++i) {
-      cores.push_back(toCore(layers[i]->cm, {int(i), true}));
-      requireFacesAndFiniteCoordinates(cores.back(), layerName(*layers[i]));
-    }
+void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterList& parameters,
+                                         vcg::CallBackPos* cb) {
+  const int mode = parameters.getEnum("mode");
+  const std::vector<MeshModel*> layers = chosenLayers(md, parameters);
+  const std::vector<Mesh> cores = coresOf(layers);
     std::vector<const Mesh*> inputs;
     for (const Mesh& m : cores) inputs.push_back(&m);
     FindIntersectionsOptions options;
@@ -117,7 +187,7 @@ bool IntersectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParamete
     for (std::size_t i = 0; i < layers.size(); ++i) {
       CMeshO& cm = layers[i]->cm;
       for (CFaceO& f : cm.face) f.ClearS();
-      FaceOriginHandle fo = faceOrigins(cores[i]);
+      FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(cores[i]));
       for (std::size_t f = 0; f < r.face_involved[i].size(); ++f)
         if (r.face_involved[i][f]) {
           cm.face[fo[f].face].SetS();
@@ -151,7 +221,67 @@ bool IntersectPlugin::applyFilter(QAction*, MeshDocument& md, const RichParamete
               .c_str());
     Log("  selected %zu faces; %zu candidate pairs tested exactly in %.1f ms", selected,
         r.candidate_pairs, r.time_ms);
-  });
+}
+
+void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
+                                        vcg::CallBackPos* cb) {
+  const int mode = parameters.getEnum("mode");
+  const std::vector<MeshModel*> layers = chosenLayers(md, parameters);
+  const std::vector<Mesh> cores = coresOf(layers);
+  std::vector<const Mesh*> inputs;
+  for (const Mesh& m : cores) inputs.push_back(&m);
+  SplitOptions options;
+  options.between_meshes = mode != kWithinCurrent;
+  options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
+  options.progress = progressFrom(cb);
+  const SplitResult r = splitAlongIntersections(inputs, options);
+  if (r.intersecting_pairs == 0)
+    throw InvalidInputError(mode == kWithinCurrent
+                                ? layerName(*layers[0]) + " does not intersect itself: nothing to split"
+                                : "the chosen layers do not intersect: nothing to split");
+  const bool merge = parameters.getEnum("output") == 1;
+  JsonObject report = toJson(r);
+  if (parameters.getBool("verify")) {
+    const std::size_t remaining = remainingIntersections(r, true);
+    report.set("remaining_intersecting_pairs", remaining);
+    Log("  check of the written (float) result: %zu intersecting pairs remain", remaining);
+  }
+  std::vector<std::string> names;
+  for (MeshModel* m : layers) names.push_back(toStd(m->label()));
+  report.set("layers", names).set("output", merge ? "merged" : "separate");
+  writeReport(parameters.getString("report_file"), report);
+
+  // The document changes only from here on.
+  std::vector<LayerAttributes> attributes;
+  for (MeshModel* m : layers) attributes.push_back(snapshot(*m));
+  if (merge) {
+    MeshModel* out = md.addNewMesh("", "intersected", true);
+    writeMesh(r.merged, attributes, *out);
+    out->cm.Tr.SetIdentity();
+  } else {
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      writeMesh(r.meshes[i], {attributes[i]}, *layers[i]);  // in place
+      layers[i]->cm.Tr.SetIdentity();  // the geometry is now in the common frame
+    }
+  }
+  if (parameters.getBool("curves_layer")) {
+    MeshModel* curves = md.addNewMesh("", "intersection curves", false);
+    const Mesh& merged = r.merged;
+    auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(curves->cm, merged.vert.size());
+    for (std::size_t v = 0; v < merged.vert.size(); ++v, ++vi)
+      vi->P() = vcg::Point3f::Construct(merged.vert[v].cP());
+    for (const auto& e : r.merged_curve_edges)
+      vcg::tri::Allocator<CMeshO>::AddEdge(curves->cm, e[0], e[1]);
+    vcg::tri::Clean<CMeshO>::RemoveUnreferencedVertex(curves->cm);
+    vcg::tri::Allocator<CMeshO>::CompactEveryVector(curves->cm);
+    vcg::tri::UpdateBounding<CMeshO>::Box(curves->cm);
+  }
+  Log("MeshMend: %zu intersecting pairs split: %zu curve edges in %zu closed loops and %zu open "
+      "curves; %zu faces re-triangulated into %zu more faces, %zu new vertices (%.0f ms)",
+      r.intersecting_pairs, r.merged_curve_edges.size(), r.curve_loops, r.open_curves,
+      r.faces_split, r.faces_added, r.new_vertices, r.time_ms);
+  if (r.degenerate_faces_kept)
+    Log("  warning: %zu zero-area faces touched by a curve were kept unsplit", r.degenerate_faces_kept);
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(IntersectPlugin)
