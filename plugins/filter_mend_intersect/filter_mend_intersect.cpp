@@ -57,7 +57,8 @@ QString IntersectPlugin::filterInfo(FilterIDType id) const {
          "exact instead of tolerance-based decisions.";
 }
 
-void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& parameters) {
+void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
+                                       RichParameterList& parameters) {
   MeshModel* current = md.mm();
   MeshModel* other = current;
   for (MeshModel* m : md.meshList)
@@ -84,7 +85,9 @@ void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParamet
         "Also inserts each layer's own self-intersection curves in the same pass, so that the "
         "result is free of every intersection (real scans often fold through themselves)."));
     parameters.addParam(RichEnum(
-        "output", 0, QStringList() << "Keep the layers separate" << "Merge into one welded layer",
+        "output", 0,
+        QStringList() << "Keep the layers separate"
+                      << "Merge into one welded layer",
         "Output",
         "Keep the layers separate: the curves are inserted into each layer in place, with "
         "identical vertices along them. Merge: a new layer holds all faces, welded along the "
@@ -167,60 +170,60 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
   const int mode = parameters.getEnum("mode");
   const std::vector<MeshModel*> layers = chosenLayers(md, parameters);
   const std::vector<Mesh> cores = coresOf(layers);
-    std::vector<const Mesh*> inputs;
-    for (const Mesh& m : cores) inputs.push_back(&m);
-    FindIntersectionsOptions options;
-    options.self = mode != kBetweenTwo;
-    options.cross = mode != kWithinCurrent;
-    options.contacts = parameters.getBool("segments_layer");
-    options.progress = progressFrom(cb);
-    const FindIntersectionsResult r = findIntersections(inputs, options);
+  std::vector<const Mesh*> inputs;
+  for (const Mesh& m : cores) inputs.push_back(&m);
+  FindIntersectionsOptions options;
+  options.self = mode != kBetweenTwo;
+  options.cross = mode != kWithinCurrent;
+  options.contacts = parameters.getBool("segments_layer");
+  options.progress = progressFrom(cb);
+  const FindIntersectionsResult r = findIntersections(inputs, options);
 
-    JsonObject report = toJson(r);
-    std::vector<std::string> names;
-    for (MeshModel* m : layers) names.push_back(toStd(m->label()));
-    report.set("layers", names);
-    writeReport(parameters.getString("report_file"), report);
+  JsonObject report = toJson(r);
+  std::vector<std::string> names;
+  for (MeshModel* m : layers) names.push_back(toStd(m->label()));
+  report.set("layers", names);
+  writeReport(parameters.getString("report_file"), report);
 
-    // The document changes only from here on.
-    std::size_t selected = 0;
-    for (std::size_t i = 0; i < layers.size(); ++i) {
-      CMeshO& cm = layers[i]->cm;
-      for (CFaceO& f : cm.face) f.ClearS();
-      FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(cores[i]));
-      for (std::size_t f = 0; f < r.face_involved[i].size(); ++f)
-        if (r.face_involved[i][f]) {
-          cm.face[fo[f].face].SetS();
-          ++selected;
-        }
-    }
-    if (options.contacts) {
-      const SegmentSoup soup = contactSegments(r);
-      MeshModel* seg = md.addNewMesh("", "intersection segments", false);
-      auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(seg->cm, soup.points.size());
-      for (std::size_t i = 0; i < soup.points.size(); ++i, ++vi)
-        vi->P() = vcg::Point3f::Construct(soup.points[i]);
-      for (const auto& e : soup.edges) vcg::tri::Allocator<CMeshO>::AddEdge(seg->cm, e[0], e[1]);
-      vcg::tri::UpdateBounding<CMeshO>::Box(seg->cm);
-      Log("  created layer 'intersection segments': %zu segments", soup.edges.size());
-    }
+  // The document changes only from here on.
+  std::size_t selected = 0;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    CMeshO& cm = layers[i]->cm;
+    for (CFaceO& f : cm.face) f.ClearS();
+    FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(cores[i]));
+    for (std::size_t f = 0; f < r.face_involved[i].size(); ++f)
+      if (r.face_involved[i][f]) {
+        cm.face[fo[f].face].SetS();
+        ++selected;
+      }
+  }
+  if (options.contacts) {
+    const SegmentSoup soup = contactSegments(r);
+    MeshModel* seg = md.addNewMesh("", "intersection segments", false);
+    auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(seg->cm, soup.points.size());
+    for (std::size_t i = 0; i < soup.points.size(); ++i, ++vi)
+      vi->P() = vcg::Point3f::Construct(soup.points[i]);
+    for (const auto& e : soup.edges) vcg::tri::Allocator<CMeshO>::AddEdge(seg->cm, e[0], e[1]);
+    vcg::tri::UpdateBounding<CMeshO>::Box(seg->cm);
+    Log("  created layer 'intersection segments': %zu segments", soup.edges.size());
+  }
 
-    for (std::size_t i = 0; i < layers.size(); ++i)
-      if (options.self)
-        Log("MeshMend: %s has %zu self-intersecting pairs (%zu faces)",
-            layerName(*layers[i]).c_str(), r.self_pairs[i], r.self_faces[i]);
-    if (options.cross)
-      Log("MeshMend: %zu intersecting pairs between layers (faces per layer: %s)", r.cross_pairs,
-          [&] {
-            std::string s;
-            for (std::size_t i = 0; i < layers.size(); ++i)
-              s += (i ? ", " : "") + toStd(layers[i]->label()) + " " +
-                   std::to_string(r.cross_faces[i]);
-            return s;
-          }()
-              .c_str());
-    Log("  selected %zu faces; %zu candidate pairs tested exactly in %.1f ms", selected,
-        r.candidate_pairs, r.time_ms);
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    if (options.self)
+      Log("MeshMend: %s has %zu self-intersecting pairs (%zu faces)", layerName(*layers[i]).c_str(),
+          r.self_pairs[i], r.self_faces[i]);
+  if (options.cross)
+    Log("MeshMend: %zu intersecting pairs between layers (faces per layer: %s)", r.cross_pairs,
+        [&] {
+          std::string s;
+          for (std::size_t i = 0; i < layers.size(); ++i)
+            s += (i ? ", " : "") + toStd(layers[i]->label()) + " " +
+                 std::to_string(r.cross_faces[i]);
+          return s;
+        }()
+            .c_str());
+  Log("  selected %zu faces; %zu candidate pairs tested exactly in %.1f ms", selected,
+      r.candidate_pairs, r.time_ms);
 }
 
 void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
@@ -237,7 +240,8 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   const SplitResult r = splitAlongIntersections(inputs, options);
   if (r.intersecting_pairs == 0)
     throw InvalidInputError(mode == kWithinCurrent
-                                ? layerName(*layers[0]) + " does not intersect itself: nothing to split"
+                                ? layerName(*layers[0]) +
+                                      " does not intersect itself: nothing to split"
                                 : "the chosen layers do not intersect: nothing to split");
   const bool merge = parameters.getEnum("output") == 1;
   JsonObject report = toJson(r);
@@ -281,7 +285,8 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
       r.intersecting_pairs, r.merged_curve_edges.size(), r.curve_loops, r.open_curves,
       r.faces_split, r.faces_added, r.new_vertices, r.time_ms);
   if (r.degenerate_faces_kept)
-    Log("  warning: %zu zero-area faces touched by a curve were kept unsplit", r.degenerate_faces_kept);
+    Log("  warning: %zu zero-area faces touched by a curve were kept unsplit",
+        r.degenerate_faces_kept);
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(IntersectPlugin)

@@ -23,7 +23,8 @@ class IntersectPlugin : public QObject, public MeshFilterInterface {
   FILTER_ARITY filterArity(QAction*) const override { return VARIABLE; }
   int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
   int postCondition(QAction* a) const override {
-    return ID(a) == SELECT_INTERSECTING ? int(MeshModel::MM_FACEFLAGSELECT) : int(MeshModel::MM_ALL);
+    return ID(a) == SELECT_INTERSECTING ? int(MeshModel::MM_FACEFLAGSELECT)
+                                        : int(MeshModel::MM_ALL);
   }
   void initParameterSet(QAction*, MeshDocument& md, RichParameterList& parameters) override;
   bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,

@@ -104,3 +104,28 @@ def test_cross_intersections_match_the_manifest(tmp_path, a, b, pairs, faces_a, 
     r = run.report
     assert r["cross_intersecting_pairs"] == pairs
     assert r["cross_intersecting_faces_per_layer"] == [faces_a, faces_b]
+
+
+# ---- intersect and split: clean closed pairs ---------------------------------
+
+SPLIT = "MeshMend: Intersect and Split Layers"
+
+
+@pytest.mark.parametrize("a,b", [("pairs/blobby.off", "pairs/eight.off"),
+                                 ("pairs/cheburashka.off", "pairs/decimated-knight.off"),
+                                 ("pairs/cube.obj", "pairs/sphere.obj"),
+                                 ("pairs/xcylinder.obj", "pairs/ycylinder.obj"),
+                                 ("pairs/ballA.off", "pairs/ballB.off")])
+def test_split_of_closed_pairs_leaves_no_intersection(tmp_path, a, b):
+    require_shared_data()
+    out = tmp_path / "merged.ply"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [DATA / a, DATA / b], script, outputs=[out])
+    assert run.returncode == 0, run.log[-2000:]
+    r, check = run.report, meshcheck(out)
+    assert r["remaining_intersecting_pairs"] == 0
+    assert r["open_curves"] == 0 and r["curve_loops"] >= 1
+    assert check["self_intersecting_pairs"] == 0
+    assert check["is_closed"] and check["border_edges"] == 0
+    assert check["non_manifold_edges"] == r["curve_edges"]

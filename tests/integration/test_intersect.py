@@ -1,9 +1,14 @@
 """MeshMend: Select Intersecting Faces, through the real meshlabserver."""
 import pytest
 
-from conftest import ROOT, cube, mlx, run_server, write_off, write_ply
+from conftest import MESHCHECK, ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
 
 SELECT = "MeshMend: Select Intersecting Faces"
+
+
+def meshcheck_if_available(path):
+    """The independent check when ../shared/tools was built (scripts/test builds it)."""
+    return meshcheck(path) if MESHCHECK.is_file() else None
 
 
 def shifted(V, d):
@@ -83,3 +88,62 @@ def test_nan_coordinates_are_refused(tmp_path):
     run = run_server(tmp_path, [path], mlx((SELECT, {"mode": 0, "report_file": ""})))
     assert run.returncode != 0
     assert "non-finite coordinate" in run.log
+
+
+# ---- MeshMend: Intersect and Split Layers ---------------------------------
+
+SPLIT = "MeshMend: Intersect and Split Layers"
+
+
+def test_split_two_cubes_merged_is_free_of_intersections(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out = tmp_path / "merged.off"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["remaining_intersecting_pairs"] == 0
+    assert r["curve_loops"] >= 1 and r["open_curves"] == 0
+    assert r["faces_split"] == 12 and r["curve_edges"] > 0
+    check = meshcheck_if_available(out)
+    if check:
+        assert check["self_intersecting_pairs"] == 0
+        assert check["non_manifold_edges"] == r["curve_edges"]
+        assert check["border_edges"] == 0
+
+
+def test_split_keeps_layers_separate_and_closed(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out_a, out_b = tmp_path / "a_split.off", tmp_path / "b_split.off"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 0,
+                          "report_file": "{report0}"}),
+                 ("MeshMend: Inspect Mesh Defects", {"report_file": "{report1}"}))
+    run = run_server(tmp_path, [a, b], script)
+    assert run.returncode == 0, run.log
+    inspect = run.reports[1]  # the current layer after the split: b, in place
+    assert inspect["is_closed"] and inspect["non_manifold_edges"] == 0
+    assert inspect["faces"] > 12
+
+
+def test_split_refuses_layers_that_do_not_intersect(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 5.0), F)
+    run = run_server(tmp_path, [a, b], mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
+                                                    "report_file": "{report0}"})))
+    assert run.returncode != 0
+    assert "do not intersect" in run.log and not run.reports
+
+
+def test_split_sample_runs(tmp_path):
+    V, F = cube()
+    a = write_ply(tmp_path / "a.ply", V, F)
+    b = write_ply(tmp_path / "b.ply", shifted(V, 0.5), F)
+    run = run_server(tmp_path, [a, b], (ROOT / "samples" / "intersect_split.mlx").read_text())
+    assert run.returncode == 0, run.log
+    assert "0 intersecting pairs remain" in run.log
