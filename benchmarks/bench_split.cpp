@@ -1,0 +1,86 @@
+// bench_split [--repeat N] [--limit S] A B: intersect-and-split, ours against
+// CGAL 5.5 on the same inputs in the same run. Prints one JSON object.
+//
+// Ours: splitAlongIntersections (curves inserted into both meshes, welded
+// output built). CGAL: PMP::corefine on two Surface_mesh copies (the same
+// job: both meshes refined along their intersection), which needs valid,
+// non-self-intersecting inputs near the intersection; and, for inputs it
+// refuses, PMP::experimental::autorefine of the two joined, under a time limit.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <cstdio>
+#include <cstring>
+
+#include "benchmarks/harness.h"
+#include "common/mesh_io.h"
+#include "common/split.h"
+
+using namespace meshmend;
+using namespace meshmend::bench;
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+namespace {
+
+SurfaceMesh toSurfaceMesh(const Mesh& m) {
+  std::vector<K::Point_3> points;
+  for (const Point3& p : positionsOf(m)) points.emplace_back(p[0], p[1], p[2]);
+  std::vector<std::vector<std::size_t>> polygons;
+  for (const Triangle& t : trianglesOf(m))
+    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
+    throw std::runtime_error("not a polygon mesh for CGAL's Surface_mesh");
+  SurfaceMesh tm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, tm);
+  return tm;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeat = 3, limit = 600;
+  std::vector<std::string> files;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
+      limit = std::atoi(argv[++i]);
+    else
+      files.push_back(argv[i]);
+  }
+  if (files.size() != 2) {
+    std::fprintf(stderr, "usage: bench_split [--repeat N] [--limit SECONDS] A B\n");
+    return 1;
+  }
+  const std::string a = files[0], b = files[1];
+  std::vector<Method> methods;
+  methods.push_back({"meshmend_split", "ours", [=] {
+                       auto ma = std::make_shared<Mesh>(readMesh(a));
+                       auto mb = std::make_shared<Mesh>(readMesh(b));
+                       return std::function<long()>([=] {
+                         return long(splitAlongIntersections({ma.get(), mb.get()}).faces_split);
+                       });
+                     }});
+  methods.push_back({"cgal_corefine", "peer", [=] {
+                       auto ta = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(a)));
+                       auto tb = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(b)));
+                       return std::function<long()>([=] {
+                         SurfaceMesh x = *ta, y = *tb;  // corefine works in place
+                         PMP::corefine(x, y, CGAL::parameters::throw_on_self_intersection(true));
+                         return long(x.number_of_faces() + y.number_of_faces());
+                       });
+                     }});
+  std::vector<JsonObject> results;
+  for (const Method& m : methods) {
+    const Measurement r = measure(m, repeat, limit);
+    results.push_back(toJson(r));
+    std::fprintf(stderr, "  %-20s %s\n", m.name.c_str(), toJson(r).str().c_str());
+  }
+  JsonObject out;
+  out.set("a", a).set("b", b).set("repeat", repeat).set("methods", results);
+  std::printf("%s\n", out.str(true).c_str());
+}
