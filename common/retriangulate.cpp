@@ -47,6 +47,13 @@ class Retriangulator {
     for (mpq_class& c : p.x) c.canonicalize();  // GMP compares canonical fractions only
     V_.push_back(p);
     approx_.emplace_back(p.x[0].get_d(), p.x[1].get_d(), p.x[2].get_d());
+    // How far each rounded coordinate may be from the exact one: nothing for
+    // doubles, otherwise one unit in the last place (get_d truncates).
+    double error = 0;
+    for (int k = 0; k < 3; ++k)
+      if (mpq_class(approx_.back()[k]) != p.x[k])
+        error = std::max(error, std::fabs(approx_.back()[k]) * 0x1p-52 + 0x1p-1074);
+    error_.push_back(error);
     return int(V_.size()) - 1;
   }
 
@@ -74,7 +81,28 @@ class Retriangulator {
                         (V_[b].x[v] - V_[a].x[v]) * (V_[c].x[u] - V_[a].x[u]);
     return sign_ > 0 ? r : mpq_class(-r);
   }
-  int orient(int a, int b, int c) const { return sgn(orientValue(a, b, c)); }
+  // The sign of orientValue, first from the rounded coordinates with a
+  // rigorous bound on the error (input rounding and arithmetic), exactly
+  // only when the bound cannot decide.
+  int orient(int a, int b, int c) const {
+    constexpr double eps = 0x1p-53;
+    const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
+    const Point3 &pa = approx_[a], &pb = approx_[b], &pc = approx_[c];
+    const double ea = error_[a], eb = error_[b], ec = error_[c];
+    const double x1 = pb[u] - pa[u], y1 = pc[v] - pa[v];
+    const double x2 = pb[v] - pa[v], y2 = pc[u] - pa[u];
+    const double ex1 = ea + eb + std::fabs(x1) * eps, ey1 = ea + ec + std::fabs(y1) * eps;
+    const double ex2 = ea + eb + std::fabs(x2) * eps, ey2 = ea + ec + std::fabs(y2) * eps;
+    const double l = x1 * y1, r = x2 * y2, det = l - r;
+    const double el = std::fabs(x1) * ey1 + std::fabs(y1) * ex1 + ex1 * ey1 + std::fabs(l) * eps;
+    const double er = std::fabs(x2) * ey2 + std::fabs(y2) * ex2 + ex2 * ey2 + std::fabs(r) * eps;
+    const double bound = (el + er + std::fabs(det) * eps) * (1 + 8 * eps);
+    if (std::isfinite(det) && std::isfinite(bound)) {
+      if (det > bound) return sign_;
+      if (-det > bound) return -sign_;
+    }
+    return sgn(orientValue(a, b, c));
+  }
 
   bool samePoint(const RationalPoint& p, int v) const {
     return p.x[0] == V_[v].x[0] && p.x[1] == V_[v].x[1] && p.x[2] == V_[v].x[2];
@@ -257,6 +285,7 @@ class Retriangulator {
 
   std::vector<RationalPoint> V_;
   std::vector<Point3> approx_;
+  std::vector<double> error_;  // per vertex: bound on |rounded - exact| of each coordinate
   std::vector<std::array<int, 3>> T_;
   std::set<Edge> constrained_;
   int axis_ = 2, sign_ = 1;

@@ -270,10 +270,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     splitters.emplace_back(*meshes[m], std::uint32_t(m));
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
     const IntersectingPair& p = found.pairs[i];
-    const TriangleContact& c = found.contacts[i];
-    const TrianglePoints a = splitters[p.a.mesh].at(p.a.face), b = splitters[p.b.mesh].at(p.b.face);
-    std::vector<RationalPoint> contact;
-    for (const ContactPoint& q : c.points) contact.push_back(exactPosition(q, a, b));
+    const std::vector<RationalPoint>& contact = found.contacts[i].exact;
     splitters[p.a.mesh].addContact(p.a.face, contact);
     splitters[p.b.mesh].addContact(p.b.face, contact);
   }

@@ -206,14 +206,39 @@ class Classifier {
       P_[0][i] = exactOf(a[i]);
       P_[1][i] = exactOf(b[i]);
     }
+    // All twelve doubles as integers times one power of two, 2^scale_: the
+    // plane-side determinants are then integer arithmetic (no fractions to
+    // reduce), which is where the exact classification spends its time.
+    int lowest = 0;
+    bool any = false;
+    for (const TrianglePoints* t : {&a, &b})
+      for (const Point3& p : *t)
+        for (int k = 0; k < 3; ++k)
+          if (p[k] != 0) {
+            int e;
+            std::frexp(p[k], &e);
+            lowest = any ? std::min(lowest, e - 53) : e - 53;
+            any = true;
+          }
+    scale_ = lowest;
+    for (int t = 0; t < 2; ++t)
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) {
+          const double v = (t == 0 ? a : b)[i][k];
+          mpz_class& z = I_[t][i][k];
+          z = mpz_class(std::ldexp(std::frexp(v, &frexpExponent_), 53));  // exact 53-bit integer
+          const int shift = frexpExponent_ - 53 - scale_;
+          if (v == 0)
+            z = 0;
+          else
+            z <<= shift;
+        }
   }
 
   TriangleContact run() {
     // side[t][i]: corner i of triangle t against the other triangle's plane.
-    for (int t = 0; t < 2; ++t) {
-      const auto& o = P_[1 - t];
-      for (int i = 0; i < 3; ++i) side_[t][i] = orient3dValue(o[0], o[1], o[2], P_[t][i]);
-    }
+    for (int t = 0; t < 2; ++t)
+      for (int i = 0; i < 3; ++i) side_[t][i] = integerSide(t, i);
     for (int t = 0; t < 2; ++t) {
       const int s[3] = {sgn(side_[t][0]), sgn(side_[t][1]), sgn(side_[t][2])};
       if (strictlyOneSide(s)) return {};
@@ -254,8 +279,16 @@ class Classifier {
           p.tag.kind = ContactPoint::Kind::kEdgeFace;
           p.tag.triangle = std::uint8_t(t);
           p.tag.index = std::uint8_t(i);
-          const mpq_class tt = side_[t][i] / (side_[t][i] - side_[t][j]);
-          p.exact = along(P_[t][i], P_[t][j], tt);
+          // p + t (q - p) with t = s_p / (s_p - s_q): (s_p q - s_q p) / (s_p - s_q)
+          const mpz_class &sp = side_[t][i], &sq = side_[t][j];
+          const mpz_class den = sp - sq;
+          for (int k = 0; k < 3; ++k) {
+            mpq_class& c = p.exact.x[k];
+            c = mpq_class(sp * I_[t][j][k] - sq * I_[t][i][k], den);
+            c.canonicalize();
+            if (scale_ > 0) mpq_mul_2exp(c.get_mpq_t(), c.get_mpq_t(), mp_bitcnt_t(scale_));
+            if (scale_ < 0) mpq_div_2exp(c.get_mpq_t(), c.get_mpq_t(), mp_bitcnt_t(-scale_));
+          }
           part[t].push_back(p);
         }
       }
@@ -306,13 +339,13 @@ class Classifier {
     if (startKey > endKey) return c;
     if (startKey == endKey) {
       c.kind = ContactKind::kTouchAtPoint;
-      c.points.push_back(finish(*start));
+      finish(c, *start);
       return c;
     }
     c.kind =
         (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
-    c.points.push_back(finish(*start));
-    c.points.push_back(finish(*end));
+    finish(c, *start);
+    finish(c, *end);
     return c;
   }
 
@@ -366,12 +399,12 @@ class Classifier {
       area2 += orient2Value(points[0].exact, points[k + 1].exact, points[k + 2].exact, axis_);
     if (sgn(area2) != 0) {
       c.kind = ContactKind::kCoplanarOverlap;
-      for (const Point& p : points) c.points.push_back(finish(p));
+      for (const Point& p : points) finish(c, p);
       return c;
     }
     c.kind = ContactKind::kCoplanarTouch;
     if (points.size() == 1) {
-      c.points.push_back(finish(points[0]));
+      finish(c, points[0]);
       return c;
     }
     // Collinear points: keep the two extremes.
@@ -381,8 +414,8 @@ class Classifier {
              (x.exact.x[u] == y.exact.x[u] && x.exact.x[v] < y.exact.x[v]);
     };
     const auto [mn, mx] = std::minmax_element(points.begin(), points.end(), less);
-    c.points.push_back(finish(*mn));
-    c.points.push_back(finish(*mx));
+    finish(c, *mn);
+    finish(c, *mx);
     return c;
   }
 
@@ -406,14 +439,34 @@ class Classifier {
     return p;
   }
 
-  ContactPoint finish(const Point& p) const {
+  // Appends p to the contact: its defining elements, rounded and exact positions.
+  void finish(TriangleContact& contact, const Point& p) const {
     ContactPoint c = p.tag;
     c.position = rounded(p.exact);
-    return c;
+    contact.points.push_back(c);
+    contact.exact.push_back({{p.exact.x[0], p.exact.x[1], p.exact.x[2]}});
   }
 
   Exact3 P_[2][3];
-  mpq_class side_[2][3];
+  // Corner i of triangle t against the other triangle's plane, as an
+  // integer determinant (scaled by 2^(3 scale_)).
+  mpz_class integerSide(int t, int i) const {
+    const auto& o = I_[1 - t];
+    const auto& p = I_[t][i];
+    mpz_class b[3], c[3], d[3];
+    for (int k = 0; k < 3; ++k) {
+      b[k] = o[1][k] - o[0][k];
+      c[k] = o[2][k] - o[0][k];
+      d[k] = p[k] - o[0][k];
+    }
+    return b[0] * (c[1] * d[2] - c[2] * d[1]) - b[1] * (c[0] * d[2] - c[2] * d[0]) +
+           b[2] * (c[0] * d[1] - c[1] * d[0]);
+  }
+
+  mpz_class I_[2][3][3];  // the coordinates as integers times 2^scale_
+  int scale_ = 0;
+  int frexpExponent_ = 0;
+  mpz_class side_[2][3];
   int axis_ = 2;
 };
 

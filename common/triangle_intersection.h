@@ -71,17 +71,18 @@ struct ContactPoint {
   Point3 position{0, 0, 0};  // the exact point, rounded to the nearest doubles
 };
 
+// A point with exact rational coordinates.
+struct RationalPoint {
+  std::array<mpq_class, 3> x;
+};
+
 struct TriangleContact {
   ContactKind kind = ContactKind::kNone;
   // kCrossing / kTouchAlongEdge: the segment's two end points; kTouchAtPoint:
   // one point; coplanar: the common polygon's corners in order (or the touching
   // point or segment).
   std::vector<ContactPoint> points;
-};
-
-// A point with exact rational coordinates.
-struct RationalPoint {
-  std::array<mpq_class, 3> x;
+  std::vector<RationalPoint> exact;  // the same points' exact positions
 };
 
 // The exact position of a contact point of classifyContact(a, b), from its
