@@ -1,5 +1,6 @@
 #include "common/mesh.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/errors.h"
@@ -60,6 +61,59 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
   FaceOriginHandle fo = faceOrigins(mesh);
   for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
   return mesh;
+}
+
+std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces) {
+  const std::vector<Point3> points = positionsOf(mesh);
+  const std::vector<Triangle> triangles = trianglesOf(mesh);
+  std::vector<int> order(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    const Point3 &p = points[a], &q = points[b];
+    if (p[0] != q[0]) return p[0] < q[0];
+    if (p[1] != q[1]) return p[1] < q[1];
+    if (p[2] != q[2]) return p[2] < q[2];
+    return a < b;
+  });
+  std::vector<int> target(points.size());
+  std::size_t merged = 0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const bool same = i > 0 && points[order[i]] == points[order[i - 1]];
+    target[order[i]] = same ? target[order[i - 1]] : order[i];
+    merged += same;
+  }
+  if (merged == 0) {
+    if (removedFaces) *removedFaces = 0;
+    return 0;
+  }
+  // Keep every vertex that is not a merged duplicate; renumber.
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  FaceOriginHandle fo = faceOrigins(mesh);
+  std::vector<int> index(points.size(), -1);
+  std::vector<Point3> keptPoints;
+  std::vector<VertexOrigin> keptOrigins;
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (target[v] == int(v)) {
+      index[v] = int(keptPoints.size());
+      keptPoints.push_back(points[v]);
+      keptOrigins.push_back(vo[v]);
+    }
+  std::vector<Triangle> keptTriangles;
+  std::vector<FaceOrigin> keptFaces;
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    Triangle t;
+    for (int k = 0; k < 3; ++k) t[k] = index[target[triangles[f][k]]];
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;
+    keptTriangles.push_back(t);
+    keptFaces.push_back(fo[f]);
+  }
+  if (removedFaces) *removedFaces = triangles.size() - keptTriangles.size();
+  mesh = makeMesh(keptPoints, keptTriangles);
+  VertexOriginHandle nvo = vertexOrigins(mesh);
+  FaceOriginHandle nfo = faceOrigins(mesh);
+  for (std::size_t v = 0; v < keptOrigins.size(); ++v) nvo[v] = keptOrigins[v];
+  for (std::size_t f = 0; f < keptFaces.size(); ++f) nfo[f] = keptFaces[f];
+  return merged;
 }
 
 Mesh appended(const Mesh& a, const Mesh& b) {

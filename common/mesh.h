@@ -80,6 +80,13 @@ FaceOriginHandle faceOrigins(Mesh& mesh);
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer = 0);
 
+// Merges vertices with exactly equal coordinates (scan seams, STL facets):
+// faces are re-pointed to the first such vertex, faces left with a repeated
+// corner are removed, unused duplicates are dropped. Provenance is kept.
+// Returns the number of vertices merged away; `removedFaces` (optional)
+// receives the number of faces removed.
+std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces = nullptr);
+
 // The two meshes in one (b's vertices and faces after a's), provenance kept.
 Mesh appended(const Mesh& a, const Mesh& b);
 

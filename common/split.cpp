@@ -254,6 +254,16 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options) {
   const auto start = Clock::now();
   SplitResult r;
+  std::vector<Mesh> welded;  // the inputs with their seams closed, when asked
+  std::vector<const Mesh*> inputs = meshes;
+  if (options.weld_duplicates) {
+    welded.reserve(meshes.size());
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      welded.push_back(*meshes[m]);
+      r.vertices_welded += weldCoincidentVertices(welded.back());
+      inputs[m] = &welded.back();
+    }
+  }
   FindIntersectionsOptions find;
   find.self = options.self;
   find.cross = options.between_meshes;
@@ -261,13 +271,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   find.progress = [&](int percent, const char* stage) {
     return !options.progress || options.progress(percent * 4 / 10, stage);
   };
-  const FindIntersectionsResult found = findIntersections(meshes, find);
+  const FindIntersectionsResult found = findIntersections(inputs, find);
   r.intersecting_pairs = found.pairs.size();
 
   reportProgress(options.progress, 40, "Collecting curve points");
   std::vector<MeshSplitter> splitters;
   for (std::size_t m = 0; m < meshes.size(); ++m)
-    splitters.emplace_back(*meshes[m], std::uint32_t(m));
+    splitters.emplace_back(*inputs[m], std::uint32_t(m));
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
     const IntersectingPair& p = found.pairs[i];
     const std::vector<RationalPoint>& contact = found.contacts[i].exact;
@@ -367,6 +377,7 @@ JsonObject toJson(const SplitResult& r) {
       .set("faces_added", r.faces_added)
       .set("new_vertices", r.new_vertices)
       .set("degenerate_faces_kept", r.degenerate_faces_kept)
+      .set("vertices_welded", r.vertices_welded)
       .set("time_ms", r.time_ms);
   return j;
 }

@@ -16,8 +16,9 @@
 namespace meshmend {
 
 struct SplitOptions {
-  bool between_meshes = true;  // insert the curves where different meshes meet
-  bool self = false;           // also split each mesh along its own self-intersections
+  bool between_meshes = true;    // insert the curves where different meshes meet
+  bool self = false;             // also split each mesh along its own self-intersections
+  bool weld_duplicates = false;  // first merge exact-duplicate vertices (scan seams) in each mesh
   bool weld = true;   // merged output: one vertex per curve point (meshes welded along curves)
   Progress progress;  // called between stages
 };
@@ -37,6 +38,7 @@ struct SplitResult {
   std::size_t faces_added = 0;            // output faces minus input faces
   std::size_t new_vertices = 0;           // curve points that are not input vertices
   std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
+  std::size_t vertices_welded = 0;        // duplicates merged first (weld_duplicates)
   std::size_t curve_loops = 0;            // closed curve components (merged output)
   std::size_t open_curves = 0;            // curve components with end points
   double time_ms = 0;

@@ -71,6 +71,35 @@ TEST(Mesh, RequireFacesNamesTheLayer) {
   EXPECT_NO_THROW(requireFacesAndFiniteCoordinates(testing::tetrahedron(), "x"));
 }
 
+TEST(Mesh, WeldCoincidentVerticesClosesASeam) {
+  // A box whose top four faces use their own copies of the top corners.
+  Mesh b = testing::box();
+  std::vector<Point3> p = positionsOf(b);
+  std::vector<Triangle> t = trianglesOf(b);
+  for (int v = 4; v < 8; ++v) p.push_back(p[v]);
+  t[2] = {8, 9, 10};
+  t[3] = {9, 11, 10};
+  p.push_back(p[0]);  // an unused duplicate goes too
+  Mesh m = makeMesh(p, t);
+  faceOrigins(m)[3].face = 77;  // provenance travels with the face
+  std::size_t removed = 99;
+  EXPECT_EQ(weldCoincidentVertices(m, &removed), 5u);
+  EXPECT_EQ(removed, 0u);
+  EXPECT_EQ(m.vn, 8);
+  EXPECT_EQ(m.fn, 12);
+  EXPECT_EQ(faceOrigins(m)[3].face, 77);
+  std::size_t again = 0;
+  EXPECT_EQ(weldCoincidentVertices(m, &again), 0u);
+}
+
+TEST(Mesh, WeldRemovesFacesThatCollapse) {
+  Mesh m = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}}, {{0, 1, 2}, {0, 1, 3}});
+  std::size_t removed = 0;
+  EXPECT_EQ(weldCoincidentVertices(m, &removed), 1u);
+  EXPECT_EQ(removed, 1u);
+  EXPECT_EQ(m.fn, 1);
+}
+
 // Rounding coordinates to float and back must really round (GCC 12's SLP
 // vectorizer dropped such round trips; the build disables it).
 TEST(Mesh, RoundingToFloatRoundsEveryCoordinate) {

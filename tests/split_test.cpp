@@ -99,6 +99,28 @@ TEST(Split, VeryDifferentResolutions) {
   for (const Mesh& m : r.meshes) EXPECT_EQ(check(m).non_manifold_edges, 0u);
 }
 
+TEST(Split, WeldingDuplicatesFirstClosesSeams) {
+  // A box whose top uses its own copies of the top corners, crossed by a
+  // sphere: without welding the seam's faces touch each other as well.
+  std::vector<Point3> p = positionsOf(box());
+  std::vector<Triangle> t = trianglesOf(box());
+  for (int v = 4; v < 8; ++v) p.push_back(p[v]);
+  t[2] = {8, 9, 10};
+  t[3] = {9, 11, 10};
+  const Mesh seamed = makeMesh(p, t), ball = uvSphere(12, 16, 0.5, {0.5, 0.5, 1.0});
+  SplitOptions o;
+  o.self = true;
+  const SplitResult plain = splitAlongIntersections({&seamed, &ball}, o);
+  o.weld_duplicates = true;
+  const SplitResult welded = splitAlongIntersections({&seamed, &ball}, o);
+  EXPECT_EQ(welded.vertices_welded, 4u);
+  EXPECT_LT(welded.intersecting_pairs, plain.intersecting_pairs);
+  const InspectResult i = check(welded.meshes[0]);
+  EXPECT_TRUE(i.is_closed);
+  EXPECT_EQ(i.duplicate_points, 0u);
+  EXPECT_EQ(*check(welded.merged).self_intersecting_pairs, 0u);
+}
+
 TEST(Split, NoIntersectionLeavesTheMeshes) {
   const Mesh a = box(), b = moved(box(), {5, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});

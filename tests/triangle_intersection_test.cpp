@@ -262,8 +262,11 @@ TEST(TriangleIntersection, ExactPositionsLieOnBothTriangles) {
   for (int i = 0; i < 20000; ++i) {
     const TrianglePoints a = gen.next(1), b = gen.next(1);
     const TriangleContact c = classifyContact(a, b);
-    for (const ContactPoint& p : c.points) {
+    ASSERT_EQ(c.exact.size(), c.points.size());
+    for (std::size_t i = 0; i < c.points.size(); ++i) {
+      const ContactPoint& p = c.points[i];
       const RationalPoint x = exactPosition(p, a, b);
+      EXPECT_EQ(x.x, c.exact[i].x);  // the classification's own exact positions agree
       for (const TrianglePoints* t : {&a, &b})
         ASSERT_EQ(orient3d(exactOf((*t)[0]), exactOf((*t)[1]), exactOf((*t)[2]), x), 0)
             << toString(c.kind);

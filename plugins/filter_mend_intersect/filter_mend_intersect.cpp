@@ -84,6 +84,11 @@ void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
         "split_self_intersections", false, "Also split self-intersections",
         "Also inserts each layer's own self-intersection curves in the same pass, so that the "
         "result is free of every intersection (real scans often fold through themselves)."));
+    parameters.addParam(RichBool(
+        "weld_duplicate_vertices", false, "Weld duplicate vertices first",
+        "First merges vertices with exactly equal coordinates in each layer (scan seams: the "
+        "Stanford dragon has 2,100); otherwise faces touching across such a seam are, "
+        "geometrically, intersecting faces and get split along it."));
     parameters.addParam(RichEnum(
         "output", 0,
         QStringList() << "Keep the layers separate"
@@ -236,6 +241,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   SplitOptions options;
   options.between_meshes = mode != kWithinCurrent;
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
+  options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.progress = progressFrom(cb);
   const SplitResult r = splitAlongIntersections(inputs, options);
   if (r.intersecting_pairs == 0)
