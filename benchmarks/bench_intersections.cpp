@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
 #include "common/intersections.h"
 #include "common/mesh_io.h"
@@ -26,8 +27,7 @@
 
 using namespace meshmend;
 using namespace meshmend::bench;
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
+using K = Kernel;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
 namespace {
@@ -87,19 +87,6 @@ long cgalSoupSelfIntersections(const Mesh& m) {
         pairs += hit;
       });
   return pairs;
-}
-
-SurfaceMesh toSurfaceMesh(const Mesh& m) {
-  std::vector<K::Point_3> points;
-  for (const Point3& p : positionsOf(m)) points.emplace_back(p[0], p[1], p[2]);
-  std::vector<std::vector<std::size_t>> polygons;
-  for (const Triangle& t : trianglesOf(m))
-    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
-    throw std::runtime_error("not a polygon mesh for CGAL's Surface_mesh");
-  SurfaceMesh tm;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, tm);
-  return tm;
 }
 
 long cgalCross(const Mesh& a, const Mesh& b) {

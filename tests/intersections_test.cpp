@@ -13,13 +13,8 @@ namespace meshmend {
 namespace {
 
 using testing::box;
+using testing::moved;
 using testing::uvSphere;
-
-Mesh moved(const Mesh& m, Point3 by) {
-  std::vector<Point3> p = positionsOf(m);
-  for (Point3& q : p) q += by;
-  return makeMesh(p, trianglesOf(m));
-}
 
 // Brute force over all face pairs with the same exact rules.
 std::size_t bruteForceSelfPairs(const Mesh& m) {

@@ -58,4 +58,11 @@ inline Mesh uvSphere(int rings, int segments, double r = 1, Point3 c = {0, 0, 0}
   return makeMesh(p, t);
 }
 
+// A copy of `m` moved by `by`.
+inline Mesh moved(const Mesh& m, Point3 by) {
+  std::vector<Point3> p = positionsOf(m);
+  for (Point3& q : p) q += by;
+  return makeMesh(p, trianglesOf(m));
+}
+
 }  // namespace meshmend::testing
