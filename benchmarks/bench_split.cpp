@@ -4,8 +4,8 @@
 // Ours: splitAlongIntersections (curves inserted into both meshes, welded
 // output built). CGAL: PMP::corefine on two Surface_mesh copies (the same
 // job: both meshes refined along their intersection), which needs valid,
-// non-self-intersecting inputs near the intersection; and, for inputs it
-// refuses, PMP::experimental::autorefine of the two joined, under a time limit.
+// non-self-intersecting inputs near the intersection; each method runs
+// under a time limit (--limit).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
