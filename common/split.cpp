@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <set>
 #include <unordered_map>
 
+#include "common/box_tree.h"
 #include "common/errors.h"
 #include "common/parallel.h"
 #include "common/predicates.h"
@@ -313,7 +315,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       std::vector<char> onCurve(mesh.vert.size(), 0);
       for (const auto& e : r.curve_edges[m]) onCurve[e[0]] = onCurve[e[1]] = 1;
       const std::size_t inputVertices = splitters[m].points().size();
-      std::vector<int> global(mesh.vert.size());
+      std::vector<int>& global = r.merged_vertex.emplace_back(mesh.vert.size());
       for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
         if (onCurve[v]) {
           const RationalPoint exact =
@@ -362,6 +364,94 @@ std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
   FindIntersectionsOptions o;
   o.cross = false;
   return findIntersections({&check}, o).self_pairs[0];
+}
+
+namespace {
+
+float below(double x) {
+  float f = float(x);
+  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+float above(double x) {
+  float f = float(x);
+  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+
+}  // namespace
+
+std::size_t roundToFloat(SplitResult& r, int passes) {
+  Mesh& merged = r.merged;
+  if (merged.fn == 0) return 0;
+  const std::vector<Point3> exact = positionsOf(merged);
+  std::vector<Point3> P = exact;
+  for (Point3& p : P) p = Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
+  const std::vector<Triangle> T = trianglesOf(merged);
+  VertexOriginHandle vo = vertexOrigins(merged);
+  // Faces around each vertex.
+  std::vector<std::vector<std::uint32_t>> around(P.size());
+  for (std::size_t f = 0; f < T.size(); ++f)
+    for (int v : T[f]) around[v].push_back(std::uint32_t(f));
+  auto at = [&](std::uint32_t f) -> TrianglePoints { return {P[T[f][0]], P[T[f][1]], P[T[f][2]]}; };
+  auto crosses = [&](std::uint32_t f, std::uint32_t g) {
+    const TrianglePoints a = at(f), b = at(g);
+    if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
+    const SharedCorners c = sharedCorners(T[f], T[g]);
+    return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+  };
+  std::size_t remaining = 0;
+  for (int pass = 0; pass <= passes; ++pass) {
+    const Mesh current = makeMesh(P, T);
+    FindIntersectionsOptions o;
+    o.cross = false;
+    const FindIntersectionsResult found = findIntersections({&current}, o);
+    remaining = found.pairs.size();
+    if (remaining == 0 || pass == passes) break;
+    std::vector<Box> boxes;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      boxes.push_back(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]));
+    const BoxTree tree(boxes);
+    std::set<int> candidates;
+    for (const IntersectingPair& p : found.pairs)
+      for (std::uint32_t f : {p.a.face, p.b.face})
+        for (int v : T[f])
+          if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
+    // How many faces the faces around v cross, with v where it is now.
+    auto localCrossings = [&](int v) {
+      std::size_t n = 0;
+      for (std::uint32_t f : around[v]) {
+        Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+        for (int k = 0; k < 3; ++k) {  // neighbours may have moved by an ulp this pass
+          for (int i = 0; i < 4; ++i) {
+            b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
+            b.hi[k] = std::nextafter(b.hi[k], INFINITY);
+          }
+        }
+        tree.query(b, 0, [&](std::uint32_t g, unsigned) {
+          if (g != f && crosses(f, g)) ++n;
+        });
+      }
+      return n;
+    };
+    for (int v : candidates) {
+      const Point3 e = exact[v];
+      Point3 best = P[v];
+      std::size_t bestCount = localCrossings(v);
+      for (int choice = 0; choice < 8 && bestCount > 0; ++choice) {
+        P[v] =
+            Point3(choice & 1 ? above(e[0]) : below(e[0]), choice & 2 ? above(e[1]) : below(e[1]),
+                   choice & 4 ? above(e[2]) : below(e[2]));
+        const std::size_t n = localCrossings(v);
+        if (n < bestCount) best = P[v], bestCount = n;
+      }
+      P[v] = best;
+    }
+  }
+  // Write the float positions back, to the merged output and to each mesh.
+  for (std::size_t v = 0; v < P.size(); ++v) merged.vert[v].P() = P[v];
+  for (std::size_t m = 0; m < r.meshes.size(); ++m)
+    for (std::size_t v = 0; v < r.merged_vertex[m].size(); ++v)
+      r.meshes[m].vert[v].P() = P[r.merged_vertex[m][v]];
+  return remaining;
 }
 
 JsonObject toJson(const SplitResult& r) {

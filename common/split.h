@@ -33,20 +33,29 @@ struct SplitResult {
   // non-manifold edges; provenance keeps the input mesh.
   Mesh merged;
   std::vector<std::array<int, 2>> merged_curve_edges;
-  std::size_t intersecting_pairs = 0;     // pairs found (and split)
-  std::size_t faces_split = 0;            // input faces re-triangulated
-  std::size_t faces_added = 0;            // output faces minus input faces
-  std::size_t new_vertices = 0;           // curve points that are not input vertices
-  std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
-  std::size_t vertices_welded = 0;        // duplicates merged first (weld_duplicates)
-  std::size_t curve_loops = 0;            // closed curve components (merged output)
-  std::size_t open_curves = 0;            // curve components with end points
+  std::vector<std::vector<int>> merged_vertex;  // per mesh, per vertex: its vertex in `merged`
+  std::size_t intersecting_pairs = 0;           // pairs found (and split)
+  std::size_t faces_split = 0;                  // input faces re-triangulated
+  std::size_t faces_added = 0;                  // output faces minus input faces
+  std::size_t new_vertices = 0;                 // curve points that are not input vertices
+  std::size_t degenerate_faces_kept = 0;        // zero-area faces a curve touches, left unsplit
+  std::size_t vertices_welded = 0;              // duplicates merged first (weld_duplicates)
+  std::size_t curve_loops = 0;                  // closed curve components (merged output)
+  std::size_t open_curves = 0;                  // curve components with end points
   double time_ms = 0;
 };
 
 // Throws InvalidInputError for empty meshes or non-finite coordinates.
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options = {});
+
+// Prepares the output for float storage (MeshLab's): every coordinate is
+// rounded to float, and where that makes faces that met only along a curve
+// cross, the new vertices of those faces are rounded the other way (each
+// coordinate to the float just below or above its exact value), choosing the
+// rounding under which the faces around the vertex cross nothing. Applied to
+// `merged` and to `meshes` alike. Returns the pairs still crossing.
+std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
 // Intersecting pairs left in the merged output, by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not

@@ -102,9 +102,9 @@ void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
                                  "curve edges, to see them and save them."));
     parameters.addParam(RichBool(
         "verify", true, "Check the written result",
-        "After writing (in float, as MeshLab stores meshes), finds the intersecting pairs that "
-        "remain (faces meeting only along a shared curve do not count) and logs and reports "
-        "them."));
+        "After writing the merged layer (in float, as MeshLab stores meshes), finds again, "
+        "independently, the intersecting pairs that remain (faces meeting only along a shared "
+        "curve do not count) and logs them."));
   } else {
     parameters.addParam(RichBool(
         "segments_layer", false, "Create a layer with the segments",
@@ -243,19 +243,20 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
   options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.progress = progressFrom(cb);
-  const SplitResult r = splitAlongIntersections(inputs, options);
+  SplitResult r = splitAlongIntersections(inputs, options);
   if (r.intersecting_pairs == 0)
     throw InvalidInputError(mode == kWithinCurrent
                                 ? layerName(*layers[0]) +
                                       " does not intersect itself: nothing to split"
                                 : "the chosen layers do not intersect: nothing to split");
   const bool merge = parameters.getEnum("output") == 1;
+  // MeshLab stores float: round, re-rounding curve points where that keeps
+  // faces that meet along a curve from crossing.
+  reportProgress(progressFrom(cb), 95, "Rounding to float");
+  const std::size_t remaining = roundToFloat(r);
+  Log("  rounded to float: %zu intersecting pairs remain", remaining);
   JsonObject report = toJson(r);
-  if (parameters.getBool("verify")) {
-    const std::size_t remaining = remainingIntersections(r, true);
-    report.set("remaining_intersecting_pairs", remaining);
-    Log("  check of the written (float) result: %zu intersecting pairs remain", remaining);
-  }
+  report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names).set("output", merge ? "merged" : "separate");
@@ -268,6 +269,13 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     MeshModel* out = md.addNewMesh("", "intersected", true);
     writeMesh(r.merged, attributes, *out);
     out->cm.Tr.SetIdentity();
+    if (parameters.getBool("verify")) {  // independently, on what was written
+      FindIntersectionsOptions o;
+      o.cross = false;
+      const Mesh written = toCore(out->cm);
+      Log("  check of the written layer: %zu intersecting pairs remain",
+          findIntersections({&written}, o).self_pairs[0]);
+    }
   } else {
     for (std::size_t i = 0; i < layers.size(); ++i) {
       writeMesh(r.meshes[i], {attributes[i]}, *layers[i]);  // in place
