@@ -116,6 +116,18 @@ TEST(Split, WeldingDuplicatesFirstClosesSeams) {
   EXPECT_EQ(*check(welded.merged).self_intersecting_pairs, 0u);
 }
 
+TEST(Split, RoundToFloatKeepsTheResultFreeOfCrossings) {
+  const Mesh a = uvSphere(30, 40), b = uvSphere(30, 40, 0.9, {0.7, 0.31, 0.17});
+  SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(roundToFloat(r), 0u);
+  for (const Vertex& v : r.merged.vert)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(v.cP()[k], double(float(v.cP()[k])));
+  for (std::size_t m = 0; m < 2; ++m)  // the per-mesh outputs got the same positions
+    for (std::size_t v = 0; v < r.meshes[m].vert.size(); ++v)
+      EXPECT_EQ(r.meshes[m].vert[v].cP(), r.merged.vert[r.merged_vertex[m][v]].cP());
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+}
+
 TEST(Split, NoIntersectionLeavesTheMeshes) {
   const Mesh a = box(), b = moved(box(), {5, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});
