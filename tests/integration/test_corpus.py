@@ -115,6 +115,8 @@ SPLIT = "MeshMend: Intersect and Split Layers"
                                  ("pairs/cheburashka.off", "pairs/decimated-knight.off"),
                                  ("pairs/cube.obj", "pairs/sphere.obj"),
                                  ("pairs/xcylinder.obj", "pairs/ycylinder.obj"),
+                                 ("pairs/ycylinder.obj", "pairs/zcylinder.obj"),
+                                 ("pairs/sphere.obj", "pairs/xcylinder.obj"),
                                  ("pairs/ballA.off", "pairs/ballB.off")])
 def test_split_of_closed_pairs_leaves_no_intersection(tmp_path, a, b):
     require_shared_data()
@@ -151,3 +153,18 @@ def test_split_bunny_and_dragon_full_is_free_of_intersections(tmp_path):
     assert check["non_manifold_edges"] == r["curve_edges"]
     # Borders only where the bunny had them (its five holes; curve points split a few edges).
     assert check["border_loops"] == 5
+
+
+@pytest.mark.parametrize("name", ["self_intersecting/cow.off", "self_intersecting/pig.off",
+                                  "self_intersecting/self_intersectA.obj"])
+def test_split_along_own_self_intersections(tmp_path, name):
+    require_shared_data()
+    out = tmp_path / "split.ply"
+    script = (ROOT / "samples" / "split_self_intersections.mlx").read_text().replace(
+        'name="report_file" value=""', 'name="report_file" value="{report0}"')
+    run = run_server(tmp_path, [DATA / name], script, outputs=[out])
+    assert run.returncode == 0, run.log[-2000:]
+    r, check = run.report, meshcheck(out)
+    assert r["remaining_intersecting_pairs"] == 0
+    assert check["self_intersecting_pairs"] == 0
+    assert check["non_manifold_edges"] == r["curve_edges"]
