@@ -3,6 +3,7 @@
 and rewrites the matching section of docs/BENCHMARKS.md.
 
     benchmarks/run.py intersections [--repeat N]
+    benchmarks/run.py split [--repeat N]
 
 Needs scripts/setup to have run (the private MeshLab prefix) and ../shared
 beside the project (the real meshes). Builds the C++ runners if needed."""
@@ -30,8 +31,8 @@ def build_runners():
     subprocess.run(["cmake", "-S", str(ROOT), "-B", str(BUILD), "-DMESHMEND_BUILD_BENCHMARKS=ON"],
                    check=True, stdout=subprocess.DEVNULL)
     subprocess.run(["cmake", "--build", str(BUILD), "-j", str(os.cpu_count() or 2),
-                    "--target", "bench_intersections", "filter_mend_intersect"], check=True,
-                   stdout=subprocess.DEVNULL)
+                    "--target", "bench_intersections", "bench_split", "filter_mend_intersect"],
+                   check=True, stdout=subprocess.DEVNULL)
 
 
 def data_file(name, tmp):
@@ -196,6 +197,31 @@ def intersections(repeat):
     return "\n".join(out)
 
 
+def split(repeat):
+    pairs = [("pairs/blobby.off", "pairs/eight.off"), ("pairs/ballA.off", "pairs/ballB.off"),
+             ("pairs/cheburashka.off", "pairs/decimated-knight.off")]
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; medians of {repeat} runs in one "
+           "`bench_split` run per pair (`benchmarks/run.py split`). Ours: `splitAlongIntersections` "
+           "(curves inserted into both meshes, welded output built; float rounding not included). "
+           "CGAL: `PMP::corefine` on two `Surface_mesh` copies.",
+           "",
+           "| pair | faces split (ours) | ours ms | CGAL corefine ms | ours / CGAL |",
+           "|---|---:|---:|---:|---:|"]
+    for a, b in pairs:
+        text = subprocess.run([str(BUILD / "benchmarks" / "bench_split"), "--repeat", str(repeat),
+                               str(DATA / a), str(DATA / b)], capture_output=True, text=True,
+                              check=True).stdout
+        by = {m["method"]: m for m in json.loads(text)["methods"]}
+        o, c = by["meshmend_split"], by["cgal_corefine"]
+        ratio = f"{o['median_ms'] / c['median_ms']:.1f}×" if o.get("ok") and c.get("ok") else "–"
+        out.append(f"| {Path(a).stem} + {Path(b).stem} | {o.get('result', '–')} | "
+                   f"{fmt(o['median_ms']) if o.get('ok') else o.get('error')} | "
+                   f"{fmt(c['median_ms']) if c.get('ok') else c.get('error')} | {ratio} |")
+    out += ["", "The split is not yet competitive with CGAL's corefinement: its exact arithmetic "
+            "uses GMP rationals throughout, which dominate its time."]
+    return "\n".join(out)
+
+
 def write_section(name, title, body):
     text = DOC.read_text() if DOC.exists() else (
         "# Benchmarks\n\nSide-by-side measurements of MeshMend against its peers, written by "
@@ -211,12 +237,14 @@ def write_section(name, title, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("benchmark", choices=["intersections"])
+    parser.add_argument("benchmark", choices=["intersections", "split"])
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
     build_runners()
     if args.benchmark == "intersections":
         write_section("intersections", "Intersection detection", intersections(args.repeat))
+    if args.benchmark == "split":
+        write_section("split", "Intersect and split", split(args.repeat))
     print(f"updated {DOC}")
 
 
