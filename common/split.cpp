@@ -194,6 +194,10 @@ class MeshSplitter {
         }
         global[v] = it->second;
       }
+      // Every contact point is a place where meshes meet, curve or not (a
+      // touching corner): the merged output welds them.
+      for (std::size_t i = 3; i < patch.vertex_of_input.size(); ++i)
+        contactVertices_.push_back(global[patch.vertex_of_input[i]]);
       for (const auto& t : patch.triangles) {
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
         birthFaces.push_back({int(index_), int(f)});
@@ -214,6 +218,7 @@ class MeshSplitter {
   }
 
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
+  const std::vector<int>& contactVertices() const { return contactVertices_; }
   std::size_t degenerateKept() const { return degenerateKept_; }
   const std::vector<Point3>& points() const { return points_; }
 
@@ -226,6 +231,7 @@ class MeshSplitter {
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
+  std::vector<int> contactVertices_;  // output vertices at contact points
 };
 
 // Closed and open components of a curve graph.
@@ -312,8 +318,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       Mesh& mesh = r.meshes[m];
       VertexOriginHandle vo = vertexOrigins(mesh);
       FaceOriginHandle fo = faceOrigins(mesh);
-      std::vector<char> onCurve(mesh.vert.size(), 0);
+      std::vector<char> onCurve(mesh.vert.size(), 0);  // on a curve or at a contact point
       for (const auto& e : r.curve_edges[m]) onCurve[e[0]] = onCurve[e[1]] = 1;
+      for (int v : splitters[m].contactVertices()) onCurve[v] = 1;
       const std::size_t inputVertices = splitters[m].points().size();
       std::vector<int>& global = r.merged_vertex.emplace_back(mesh.vert.size());
       for (std::size_t v = 0; v < mesh.vert.size(); ++v) {

@@ -128,6 +128,49 @@ TEST(Split, RoundToFloatKeepsTheResultFreeOfCrossings) {
   EXPECT_EQ(remainingIntersections(r, false), 0u);
 }
 
+TEST(Split, CurveThroughAnExistingVertex) {
+  // A square sheet (two triangles, diagonal 0-2) standing across a flat one
+  // so that the curve passes exactly through the flat sheet's corner 1 and
+  // centre vertex.
+  const Mesh flat = makeMesh({{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}, {0, 0, 0}},
+                             {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
+  const Mesh wall =
+      makeMesh({{-3, -3, -1}, {3, 3, -1}, {3, 3, 1}, {-3, -3, 1}}, {{0, 1, 2}, {0, 2, 3}});
+  const SplitResult r = splitAlongIntersections({&flat, &wall});
+  EXPECT_GT(r.intersecting_pairs, 0u);
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  // The flat sheet needs no new vertex on the diagonal's interior points that
+  // already are its vertices: its centre vertex stays a curve vertex.
+  bool centreOnCurve = false;
+  for (const auto& e : r.curve_edges[0]) centreOnCurve |= e[0] == 4 || e[1] == 4;
+  EXPECT_TRUE(centreOnCurve);
+  EXPECT_EQ(r.open_curves, 1u);  // one open curve across the flat sheet
+}
+
+TEST(Split, TrianglesTouchingAtOnePoint) {
+  const Mesh a = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}});
+  const Mesh b = makeMesh({{1, 1, 0}, {1, 2, 3}, {2, 1, 3}}, {{0, 1, 2}});  // corner on a
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(r.intersecting_pairs, 1u);
+  EXPECT_EQ(r.meshes[0].fn, 3);  // the point splits a into three
+  EXPECT_EQ(r.meshes[1].fn, 1);  // b's own corner: nothing to split
+  EXPECT_EQ(r.merged_curve_edges.size(), 0u);
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+}
+
+TEST(Split, PointOnASharedEdgeSplitsBothFaces) {
+  // A needle through the shared edge of two faces: both faces are split at
+  // the same point, so the sheet stays conforming (no T-junction).
+  const Mesh sheet = makeMesh({{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {2, 2, 0}}, {{0, 1, 2}, {1, 3, 2}});
+  const Mesh needle = makeMesh({{1, 1, -1}, {1.2, 0.8, 1}, {0.8, 1.2, 1}}, {{0, 1, 2}});
+  const SplitResult r = splitAlongIntersections({&sheet, &needle});
+  const InspectResult i = check(r.meshes[0]);
+  EXPECT_EQ(i.border_edges, 4u + 0u);  // still the square's outline, split nowhere on it
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(i.connected_components, 1u);
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+}
+
 TEST(Split, NoIntersectionLeavesTheMeshes) {
   const Mesh a = box(), b = moved(box(), {5, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});
