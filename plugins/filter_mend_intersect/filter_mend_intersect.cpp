@@ -149,13 +149,22 @@ std::vector<MeshModel*> chosenLayers(MeshDocument& md, const RichParameterList& 
 }
 
 // The chosen layers as core meshes in one frame (layer matrices applied).
-std::vector<Mesh> coresOf(const std::vector<MeshModel*>& layers) {
+struct Inputs {
+  std::vector<MeshModel*> layers;
   std::vector<Mesh> cores;
-  for (std::size_t i = 0; i < layers.size(); ++i) {
-    cores.push_back(toCore(layers[i]->cm, {int(i), true}));
-    requireFacesAndFiniteCoordinates(cores.back(), layerName(*layers[i]));
+  std::vector<const Mesh*> meshes;  // pointers to cores, as the core functions take them
+};
+
+Inputs inputsOf(MeshDocument& md, const RichParameterList& parameters) {
+  Inputs in;
+  in.layers = chosenLayers(md, parameters);
+  in.cores.reserve(in.layers.size());
+  for (std::size_t i = 0; i < in.layers.size(); ++i) {
+    in.cores.push_back(toCore(in.layers[i]->cm, {int(i), true}));
+    requireFacesAndFiniteCoordinates(in.cores.back(), layerName(*in.layers[i]));
   }
-  return cores;
+  for (const Mesh& m : in.cores) in.meshes.push_back(&m);
+  return in;
 }
 
 }  // namespace
@@ -173,16 +182,14 @@ bool IntersectPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParame
 void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterList& parameters,
                                          vcg::CallBackPos* cb) {
   const int mode = parameters.getEnum("mode");
-  const std::vector<MeshModel*> layers = chosenLayers(md, parameters);
-  const std::vector<Mesh> cores = coresOf(layers);
-  std::vector<const Mesh*> inputs;
-  for (const Mesh& m : cores) inputs.push_back(&m);
+  const Inputs in = inputsOf(md, parameters);
+  const std::vector<MeshModel*>& layers = in.layers;
   FindIntersectionsOptions options;
   options.self = mode != kBetweenTwo;
   options.cross = mode != kWithinCurrent;
   options.contacts = parameters.getBool("segments_layer");
   options.progress = progressFrom(cb);
-  const FindIntersectionsResult r = findIntersections(inputs, options);
+  const FindIntersectionsResult r = findIntersections(in.meshes, options);
 
   JsonObject report = toJson(r);
   std::vector<std::string> names;
@@ -195,7 +202,7 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
   for (std::size_t i = 0; i < layers.size(); ++i) {
     CMeshO& cm = layers[i]->cm;
     for (CFaceO& f : cm.face) f.ClearS();
-    FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(cores[i]));
+    FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(in.cores[i]));
     for (std::size_t f = 0; f < r.face_involved[i].size(); ++f)
       if (r.face_involved[i][f]) {
         cm.face[fo[f].face].SetS();
@@ -234,16 +241,14 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
 void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
                                         vcg::CallBackPos* cb) {
   const int mode = parameters.getEnum("mode");
-  const std::vector<MeshModel*> layers = chosenLayers(md, parameters);
-  const std::vector<Mesh> cores = coresOf(layers);
-  std::vector<const Mesh*> inputs;
-  for (const Mesh& m : cores) inputs.push_back(&m);
+  const Inputs in = inputsOf(md, parameters);
+  const std::vector<MeshModel*>& layers = in.layers;
   SplitOptions options;
   options.between_meshes = mode != kWithinCurrent;
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
   options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.progress = progressFrom(cb);
-  SplitResult r = splitAlongIntersections(inputs, options);
+  SplitResult r = splitAlongIntersections(in.meshes, options);
   if (r.intersecting_pairs == 0)
     throw InvalidInputError(mode == kWithinCurrent
                                 ? layerName(*layers[0]) +
