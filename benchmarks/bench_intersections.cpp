@@ -14,7 +14,6 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/box_intersection_d.h>
 
-#include <atomic>
 #include <cstdio>
 #include <cstring>
 

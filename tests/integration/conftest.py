@@ -107,25 +107,26 @@ def meshcheck(path, *args):
 
 # ---- small meshes in every format ------------------------------------------
 
-def write_off(path, V, F):
+def _write_counted(path, header, V, F):
+    """OFF and ASCII PLY share their body: vertex lines, then counted face lines."""
     with open(path, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
+        f.write(header)
         for v in V:
             f.write(" ".join(repr(float(c)) for c in v) + "\n")
         for t in F:
             f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
     return path
+
+
+def write_off(path, V, F):
+    return _write_counted(path, f"OFF\n{len(V)} {len(F)} 0\n", V, F)
 
 
 def write_ply(path, V, F):
-    with open(path, "w") as f:
-        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"
-                f"property float z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
-        for v in V:
-            f.write(" ".join(repr(float(c)) for c in v) + "\n")
-        for t in F:
-            f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
-    return path
+    return _write_counted(
+        path, f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"
+              f"property float z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n",
+        V, F)
 
 
 def write_obj(path, V, F):
