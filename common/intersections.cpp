@@ -30,8 +30,7 @@ struct Soup {
 
   // `withPlanes`: also prepare the exact plane sides of every face (needed
   // for faces that are tested against many others).
-  Soup(const Mesh& mesh, bool withPlanes)
-      : points(positionsOf(mesh)), triangles(trianglesOf(mesh)) {
+  Soup(const MeshArrays& mesh, bool withPlanes) : points(mesh.points), triangles(mesh.triangles) {
     boxes.resize(triangles.size());
     degenerate.resize(triangles.size());
     if (withPlanes) planes.resize(triangles.size());
@@ -93,11 +92,27 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
 
 FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
                                           const FindIntersectionsOptions& options) {
+  for (std::size_t m = 0; m < meshes.size(); ++m)
+    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+  std::vector<MeshArrays> arrays;
+  for (const Mesh* mesh : meshes) arrays.push_back(arraysOf(*mesh));
+  std::vector<const MeshArrays*> pointers;
+  for (const MeshArrays& a : arrays) pointers.push_back(&a);
+  return findIntersectionsInArrays(pointers, options);
+}
+
+FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
+                                                  const FindIntersectionsOptions& options) {
   const auto start = Clock::now();
   FindIntersectionsResult r;
   const std::size_t n = meshes.size();
-  for (std::size_t m = 0; m < n; ++m)
-    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+  for (std::size_t m = 0; m < n; ++m) {
+    if (meshes[m]->triangles.empty())
+      throw InvalidInputError("mesh " + std::to_string(m) + " has no faces");
+    for (const Point3& p : meshes[m]->points)
+      if (!isFinite(p))
+        throw InvalidInputError("mesh " + std::to_string(m) + " has a non-finite coordinate");
+  }
   reportProgress(options.progress, 0, "Preparing boxes");
   // A mesh needs a tree (and exact plane sides) for its self-intersections,
   // or when it is the smaller of a pair: the larger one's faces query it.
@@ -105,7 +120,7 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   if (options.cross)
     for (std::size_t m = 0; m < n; ++m)
       for (std::size_t k = m + 1; k < n; ++k)
-        needsTree[meshes[m]->fn > meshes[k]->fn ? k : m] = true;
+        needsTree[meshes[m]->triangles.size() > meshes[k]->triangles.size() ? k : m] = true;
   std::vector<Soup> soups;
   soups.reserve(n);
   for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m], needsTree[m]);
@@ -142,7 +157,7 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
       for (std::size_t k = m + 1; k < n; ++k) {
         reportProgress(options.progress, 50, "Intersections between meshes");
         // Query the faces of the larger mesh against the tree of the smaller.
-        const bool swap = meshes[m]->fn > meshes[k]->fn;
+        const bool swap = meshes[m]->triangles.size() > meshes[k]->triangles.size();
         const std::size_t small = swap ? k : m, large = swap ? m : k;
         const Soup &s = soups[small], &l = soups[large];
         const Box& smallBounds = trees[small].bounds();

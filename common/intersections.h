@@ -55,6 +55,9 @@ struct FindIntersectionsResult {
 // Throws InvalidInputError for a non-finite coordinate.
 FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
                                           const FindIntersectionsOptions& options = {});
+// The same on plain arrays (every vertex index in range).
+FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
+                                                  const FindIntersectionsOptions& options = {});
 
 // The contact segments of every pair (a coplanar overlap contributes its
 // outline, a single touching point nothing), with coinciding end points

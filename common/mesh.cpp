@@ -31,13 +31,9 @@ FaceOriginHandle faceOrigins(Mesh& mesh) {
   return vcg::tri::Allocator<Mesh>::GetPerFaceAttribute<FaceOrigin>(mesh, kFaceOriginAttribute);
 }
 
-namespace {
-
 bool isFinite(const Point3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
-
-}  // namespace
 
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer) {
@@ -63,9 +59,12 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
   return mesh;
 }
 
-std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces) {
-  const std::vector<Point3> points = positionsOf(mesh);
-  const std::vector<Triangle> triangles = trianglesOf(mesh);
+MeshArrays arraysOf(const Mesh& mesh) {
+  return {positionsOf(mesh), trianglesOf(mesh)};
+}
+
+WeldedArrays weldCoincident(const MeshArrays& in) {
+  const std::vector<Point3>& points = in.points;
   std::vector<int> order(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
   std::sort(order.begin(), order.end(), [&](int a, int b) {
@@ -76,44 +75,47 @@ std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces) {
     return a < b;
   });
   std::vector<int> target(points.size());
-  std::size_t merged = 0;
+  WeldedArrays w;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const bool same = i > 0 && points[order[i]] == points[order[i - 1]];
     target[order[i]] = same ? target[order[i - 1]] : order[i];
-    merged += same;
-  }
-  if (merged == 0) {
-    if (removedFaces) *removedFaces = 0;
-    return 0;
+    w.vertices_merged += same;
   }
   // Keep every vertex that is not a merged duplicate; renumber.
-  VertexOriginHandle vo = vertexOrigins(mesh);
-  FaceOriginHandle fo = faceOrigins(mesh);
   std::vector<int> index(points.size(), -1);
-  std::vector<Point3> keptPoints;
-  std::vector<VertexOrigin> keptOrigins;
   for (std::size_t v = 0; v < points.size(); ++v)
     if (target[v] == int(v)) {
-      index[v] = int(keptPoints.size());
-      keptPoints.push_back(points[v]);
-      keptOrigins.push_back(vo[v]);
+      index[v] = int(w.mesh.points.size());
+      w.mesh.points.push_back(points[v]);
+      w.vertex_origin.push_back(int(v));
     }
-  std::vector<Triangle> keptTriangles;
-  std::vector<FaceOrigin> keptFaces;
-  for (std::size_t f = 0; f < triangles.size(); ++f) {
+  for (std::size_t f = 0; f < in.triangles.size(); ++f) {
     Triangle t;
-    for (int k = 0; k < 3; ++k) t[k] = index[target[triangles[f][k]]];
+    for (int k = 0; k < 3; ++k) t[k] = index[target[in.triangles[f][k]]];
     if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;
-    keptTriangles.push_back(t);
-    keptFaces.push_back(fo[f]);
+    w.mesh.triangles.push_back(t);
+    w.face_origin.push_back(int(f));
   }
-  if (removedFaces) *removedFaces = triangles.size() - keptTriangles.size();
-  mesh = makeMesh(keptPoints, keptTriangles);
+  w.faces_removed = in.triangles.size() - w.mesh.triangles.size();
+  return w;
+}
+
+std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces) {
+  const WeldedArrays w = weldCoincident(arraysOf(mesh));
+  if (removedFaces) *removedFaces = w.faces_removed;
+  if (w.vertices_merged == 0) return 0;
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  FaceOriginHandle fo = faceOrigins(mesh);
+  std::vector<VertexOrigin> keptOrigins;
+  for (int v : w.vertex_origin) keptOrigins.push_back(vo[v]);
+  std::vector<FaceOrigin> keptFaces;
+  for (int f : w.face_origin) keptFaces.push_back(fo[f]);
+  mesh = makeMesh(w.mesh.points, w.mesh.triangles);
   VertexOriginHandle nvo = vertexOrigins(mesh);
   FaceOriginHandle nfo = faceOrigins(mesh);
   for (std::size_t v = 0; v < keptOrigins.size(); ++v) nvo[v] = keptOrigins[v];
   for (std::size_t f = 0; f < keptFaces.size(); ++f) nfo[f] = keptFaces[f];
-  return merged;
+  return w.vertices_merged;
 }
 
 Mesh appended(const Mesh& a, const Mesh& b) {

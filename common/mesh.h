@@ -80,6 +80,22 @@ FaceOriginHandle faceOrigins(Mesh& mesh);
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer = 0);
 
+// A mesh as plain arrays, for the inner loops of the core.
+struct MeshArrays {
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+};
+MeshArrays arraysOf(const Mesh& mesh);
+
+// weldCoincident on arrays: the welded mesh, and for each of its vertices and
+// faces the input index it keeps.
+struct WeldedArrays {
+  MeshArrays mesh;
+  std::vector<int> vertex_origin, face_origin;
+  std::size_t vertices_merged = 0, faces_removed = 0;
+};
+WeldedArrays weldCoincident(const MeshArrays& mesh);
+
 // Merges vertices with exactly equal coordinates (scan seams, STL facets):
 // faces are re-pointed to the first such vertex, faces left with a repeated
 // corner are removed, unused duplicates are dropped. Provenance is kept.
@@ -93,6 +109,8 @@ Mesh appended(const Mesh& a, const Mesh& b);
 // Vertex positions and face corner indices of a compact mesh (no deleted elements).
 std::vector<Point3> positionsOf(const Mesh& mesh);
 std::vector<Triangle> trianglesOf(const Mesh& mesh);
+
+bool isFinite(const Point3& p);
 
 // Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh
 // has no faces or a non-finite coordinate.

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/errors.h"
+#include "common/predicates.h"
 
 namespace meshmend {
 
@@ -20,7 +21,7 @@ Edge key(int a, int b) {
 class Retriangulator {
  public:
   explicit Retriangulator(const PatchInput& in) {
-    for (const RationalPoint& c : in.corners) add(c);
+    for (int i = 0; i < 3; ++i) add(in.corners[i], std::uint8_t((1 << i) | (1 << ((i + 2) % 3))));
     chooseProjection();
     T_.push_back({0, 1, 2});
   }
@@ -28,7 +29,11 @@ class Retriangulator {
   Patch run(const PatchInput& in) {
     Patch out;
     out.vertex_of_input = {0, 1, 2};
-    for (const RationalPoint& p : in.points) out.vertex_of_input.push_back(insertPoint(p));
+    if (!in.on_edges.empty() && in.on_edges.size() != in.points.size())
+      throw InvalidInputError("retriangulate: on_edges must have one entry per point");
+    for (std::size_t i = 0; i < in.points.size(); ++i)
+      out.vertex_of_input.push_back(
+          insertPoint(in.points[i], in.on_edges.empty() ? 0 : in.on_edges[i]));
     const int inputs = int(out.vertex_of_input.size());
     for (const auto& s : in.segments) {
       if (s[0] < 0 || s[0] >= inputs || s[1] < 0 || s[1] >= inputs)
@@ -43,28 +48,27 @@ class Retriangulator {
   }
 
  private:
-  int add(RationalPoint p) {
-    for (mpq_class& c : p.x) c.canonicalize();  // GMP compares canonical fractions only
+  int add(const ExactPoint& p, std::uint8_t edges = 0) {
     V_.push_back(p);
-    approx_.emplace_back(p.x[0].get_d(), p.x[1].get_d(), p.x[2].get_d());
-    // How far each rounded coordinate may be from the exact one: nothing for
-    // doubles, otherwise one unit in the last place (get_d truncates).
-    double error = 0;
-    for (int k = 0; k < 3; ++k)
-      if (mpq_class(approx_.back()[k]) != p.x[k])
-        error = std::max(error, std::fabs(approx_.back()[k]) * 0x1p-52 + 0x1p-1074);
-    error_.push_back(error);
+    edges_.push_back(edges);
     return int(V_.size()) - 1;
   }
 
-  // Drop the axis along which the triangle's exact normal is largest (and
+  // Drop the axis along which the triangle's normal is largest (and
   // non-zero), so that the projection keeps every orientation.
   void chooseProjection() {
+    if (V_[0].isInputPoint() && V_[1].isInputPoint() && V_[2].isInputPoint()) {
+      const Point3 &a = V_[0].approx(), &b = V_[1].approx(), &c = V_[2].approx();
+      axis_ = projectionAxis(a, b, c);
+      if (axis_ < 0) throw InvalidInputError("retriangulate: the triangle is degenerate");
+      sign_ = orient2dDropping(a, b, c, axis_);
+      return;
+    }
     std::array<mpq_class, 3> n;
+    const RationalPoint &p = V_[0].exact(), &q = V_[1].exact(), &r = V_[2].exact();
     for (int k = 0; k < 3; ++k) {
       const int u = (k + 1) % 3, v = (k + 2) % 3;
-      n[k] = (V_[1].x[u] - V_[0].x[u]) * (V_[2].x[v] - V_[0].x[v]) -
-             (V_[1].x[v] - V_[0].x[v]) * (V_[2].x[u] - V_[0].x[u]);
+      n[k] = (q.x[u] - p.x[u]) * (r.x[v] - p.x[v]) - (q.x[v] - p.x[v]) * (r.x[u] - p.x[u]);
     }
     axis_ = -1;
     for (int k = 0; k < 3; ++k)
@@ -73,39 +77,34 @@ class Retriangulator {
     sign_ = sgn(n[axis_]);
   }
 
-  // Orientation of (a, b, c) in the projection, exactly (value and sign),
-  // relative to the input triangle: positive = same turn as the input.
+  // Orientation of (a, b, c) in the projection, exactly, relative to the
+  // input triangle: positive = same turn as the input.
   mpq_class orientValue(int a, int b, int c) const {
     const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
-    const mpq_class r = (V_[b].x[u] - V_[a].x[u]) * (V_[c].x[v] - V_[a].x[v]) -
-                        (V_[b].x[v] - V_[a].x[v]) * (V_[c].x[u] - V_[a].x[u]);
+    const RationalPoint &A = V_[a].exact(), &B = V_[b].exact(), &C = V_[c].exact();
+    const mpq_class r =
+        (B.x[u] - A.x[u]) * (C.x[v] - A.x[v]) - (B.x[v] - A.x[v]) * (C.x[u] - A.x[u]);
     return sign_ > 0 ? r : mpq_class(-r);
   }
-  // The sign of orientValue, first from the rounded coordinates with a
-  // rigorous bound on the error (input rounding and arithmetic), exactly
-  // only when the bound cannot decide.
   int orient(int a, int b, int c) const {
-    constexpr double eps = 0x1p-53;
-    const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
-    const Point3 &pa = approx_[a], &pb = approx_[b], &pc = approx_[c];
-    const double ea = error_[a], eb = error_[b], ec = error_[c];
-    const double x1 = pb[u] - pa[u], y1 = pc[v] - pa[v];
-    const double x2 = pb[v] - pa[v], y2 = pc[u] - pa[u];
-    const double ex1 = ea + eb + std::fabs(x1) * eps, ey1 = ea + ec + std::fabs(y1) * eps;
-    const double ex2 = ea + eb + std::fabs(x2) * eps, ey2 = ea + ec + std::fabs(y2) * eps;
-    const double l = x1 * y1, r = x2 * y2, det = l - r;
-    const double el = std::fabs(x1) * ey1 + std::fabs(y1) * ex1 + ex1 * ey1 + std::fabs(l) * eps;
-    const double er = std::fabs(x2) * ey2 + std::fabs(y2) * ex2 + ex2 * ey2 + std::fabs(r) * eps;
-    const double bound = (el + er + std::fabs(det) * eps) * (1 + 8 * eps);
-    if (std::isfinite(det) && std::isfinite(bound)) {
-      if (det > bound) return sign_;
-      if (-det > bound) return -sign_;
-    }
-    return sgn(orientValue(a, b, c));
+    if (edges_[a] & edges_[b] & edges_[c]) return 0;  // on one edge of the input triangle
+    return sign_ * orient2dDropping(V_[a], V_[b], V_[c], axis_);
   }
 
-  bool samePoint(const RationalPoint& p, int v) const {
-    return p.x[0] == V_[v].x[0] && p.x[1] == V_[v].x[1] && p.x[2] == V_[v].x[2];
+  // Is p visibly off the triangle's plane (from the rounded values)?
+  bool visiblyOffPlane(const ExactPoint& p) const {
+    const Interval3 a = intervalOf(V_[0]), b = intervalOf(V_[1]), c = intervalOf(V_[2]);
+    const Interval3 d = intervalOf(p);
+    Interval e1[3], e2[3], e3[3];
+    for (int k = 0; k < 3; ++k) {
+      e1[k] = b[k] - a[k];
+      e2[k] = c[k] - a[k];
+      e3[k] = d[k] - a[k];
+    }
+    const Interval det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
+                         e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
+                         e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+    return det.positive() || det.negative();
   }
 
   // Index of the triangle holding directed edge a->b, or -1.
@@ -116,12 +115,16 @@ class Retriangulator {
     return -1;
   }
 
-  int insertPoint(RationalPoint p) {
-    for (mpq_class& c : p.x) c.canonicalize();
+  int insertPoint(const ExactPoint& p, std::uint8_t edges) {
     for (std::size_t v = 0; v < V_.size(); ++v)
-      if (samePoint(p, int(v))) return int(v);
-    if (orient3d(V_[0], V_[1], V_[2], p) != 0)
+      if (samePoint(p, V_[v])) return int(v);
+    if (visiblyOffPlane(p))
       throw InvalidInputError("retriangulate: a point does not lie in the triangle's plane");
+    for (int k = 0; k < 3; ++k)
+      if (edges & (1 << k)) {
+        const int q = insertOnEdge(p, k);
+        if (q >= 0) return q;
+      }
     const int q = add(p);
     for (std::size_t t = 0; t < T_.size(); ++t) {
       const std::array<int, 3> tri = T_[t];
@@ -138,11 +141,37 @@ class Retriangulator {
         T_.push_back({tri[1], tri[2], q});
         T_.push_back({tri[2], tri[0], q});
       } else {
-        splitEdge(tri[zeroEdge], tri[(zeroEdge + 1) % 3], q);
+        const int a = tri[zeroEdge], b = tri[(zeroEdge + 1) % 3];
+        edges_[q] |= edges_[a] & edges_[b];  // on an edge of the input triangle too
+        splitEdge(a, b, q);
       }
       return q;
     }
     throw InvalidInputError("retriangulate: a point does not lie on the triangle");
+  }
+
+  // Inserts p, known to lie inside edge k of the input triangle, between its
+  // neighbours along that edge; -1 when they are not joined by an edge (a
+  // point on the edge arrived without saying so), for the general insertion.
+  int insertOnEdge(const ExactPoint& p, int k) {
+    const int c0 = k, c1 = (k + 1) % 3;
+    int axis = 0;  // a coordinate that changes monotonically along the edge
+    for (int a = 1; a < 3; ++a)
+      if (std::fabs(V_[c1].approx()[a] - V_[c0].approx()[a]) >
+          std::fabs(V_[c1].approx()[axis] - V_[c0].approx()[axis]))
+        axis = a;
+    const int direction = compareCoordinate(V_[c1], V_[c0], axis);
+    int before = c0, after = c1;
+    for (int v = 3; v < int(V_.size()); ++v) {
+      if (!(edges_[v] & (1 << k))) continue;
+      const int side = compareCoordinate(V_[v], p, axis) * direction;
+      if (side < 0 && compareCoordinate(V_[v], V_[before], axis) * direction > 0) before = v;
+      if (side > 0 && compareCoordinate(V_[v], V_[after], axis) * direction < 0) after = v;
+    }
+    if (triangleWith(before, after) < 0 && triangleWith(after, before) < 0) return -1;
+    const int q = add(p, std::uint8_t(1 << k));
+    splitEdge(before, after, q);
+    return q;
   }
 
   // Splits edge (a, b) at q (q lies on it), in both triangles that hold it.
@@ -165,11 +194,9 @@ class Retriangulator {
 
   // Is vertex v strictly inside segment (a, b)? (collinear checked by caller)
   bool between(int a, int b, int v) const {
-    for (int k = 0; k < 3; ++k) {
-      const int s1 = sgn(V_[v].x[k] - V_[a].x[k]), s2 = sgn(V_[b].x[k] - V_[v].x[k]);
-      if (s1 * s2 < 0) return false;
-    }
-    return !samePoint(V_[a], v) && !samePoint(V_[b], v);
+    for (int k = 0; k < 3; ++k)
+      if (compareCoordinate(V_[v], V_[a], k) * compareCoordinate(V_[b], V_[v], k) < 0) return false;
+    return !samePoint(V_[a], V_[v]) && !samePoint(V_[b], V_[v]);
   }
 
   void insertSegment(int a, int b) {
@@ -207,8 +234,9 @@ class Retriangulator {
         const mpq_class ob = orientValue(e.first, e.second, b);
         const mpq_class t = oa / (oa - ob);
         RationalPoint x;
-        for (int k = 0; k < 3; ++k) x.x[k] = V_[a].x[k] + t * (V_[b].x[k] - V_[a].x[k]);
-        const int q = add(x);
+        const RationalPoint &A = V_[a].exact(), &B = V_[b].exact();
+        for (int k = 0; k < 3; ++k) x.x[k] = A.x[k] + t * (B.x[k] - A.x[k]);
+        const int q = add(ExactPoint(x));
         splitEdge(e.first, e.second, q);
         insertSegment(a, q);
         insertSegment(q, b);
@@ -257,7 +285,7 @@ class Retriangulator {
   // Smallest angle of triangle (a, b, c), from the rounded positions.
   double minAngle(int a, int b, int c) const {
     auto angle = [&](int p, int q, int r) {
-      const Point3 u = approx_[q] - approx_[p], v = approx_[r] - approx_[p];
+      const Point3 u = V_[q].approx() - V_[p].approx(), v = V_[r].approx() - V_[p].approx();
       return std::atan2((u ^ v).Norm(), u * v);
     };
     return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
@@ -283,9 +311,8 @@ class Retriangulator {
     }
   }
 
-  std::vector<RationalPoint> V_;
-  std::vector<Point3> approx_;
-  std::vector<double> error_;  // per vertex: bound on |rounded - exact| of each coordinate
+  std::vector<ExactPoint> V_;
+  std::vector<std::uint8_t> edges_;  // per vertex: edges of the input triangle it lies on (bits)
   std::vector<std::array<int, 3>> T_;
   std::set<Edge> constrained_;
   int axis_ = 2, sign_ = 1;

@@ -3,8 +3,8 @@
 // the constraint segments between them become edges (recovered by flips;
 // two crossing constraints meet at their exact crossing point, which is
 // inserted), and the result is improved by flips that never remove a
-// constraint, maximising the smallest angle. Every decision is exact: the
-// points are rational and lie exactly in the triangle's plane.
+// constraint, maximising the smallest angle. Every decision is exact
+// (exact_point.h: from rounded values where their error bounds allow).
 #pragma once
 
 #include <array>
@@ -15,8 +15,14 @@
 namespace meshmend {
 
 struct PatchInput {
-  std::array<RationalPoint, 3> corners;      // the triangle, in its orientation
-  std::vector<RationalPoint> points;         // on the triangle (inside or on an edge)
+  std::array<ExactPoint, 3> corners;  // the triangle, in its orientation
+  // On the triangle (inside or on an edge), exactly in its plane: a
+  // precondition, checked only where the rounded values show a violation.
+  std::vector<ExactPoint> points;
+  // Optional, one per point: bit i set when the point is known to lie inside
+  // edge i (corner i to i+1) — exact knowledge from how the point was made,
+  // which spares the exact arithmetic that proving it would take.
+  std::vector<std::uint8_t> on_edges;
   std::vector<std::array<int, 2>> segments;  // constraints: 0..2 corners, 3 + i points[i]
   bool improve = true;                       // max-min angle flips after the constraints
 };
@@ -24,14 +30,14 @@ struct PatchInput {
 struct Patch {
   // Vertices: the corners, then the distinct input points, then crossings of
   // constraints (new points).
-  std::vector<RationalPoint> vertices;
+  std::vector<ExactPoint> vertices;
   std::vector<int> vertex_of_input;           // per input index (corners, points): its vertex
   std::vector<std::array<int, 3>> triangles;  // oriented like the input triangle
   std::vector<std::array<int, 2>> constrained_edges;  // the constraints, split at vertices on them
 };
 
-// Throws InvalidInputError when a point is not on the triangle or a segment
-// index is out of range.
+// Throws InvalidInputError when the triangle is degenerate, a point is not
+// on it, or a segment index is out of range.
 Patch retriangulate(const PatchInput& input);
 
 }  // namespace meshmend

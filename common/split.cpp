@@ -5,11 +5,14 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numeric>
 #include <set>
+#include <tuple>
 #include <unordered_map>
 
 #include "common/box_tree.h"
 #include "common/errors.h"
+#include "common/exact_point.h"
 #include "common/parallel.h"
 #include "common/predicates.h"
 #include "common/retriangulate.h"
@@ -20,19 +23,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool sameExact(const RationalPoint& p, const RationalPoint& q) {
-  return p.x[0] == q.x[0] && p.x[1] == q.x[1] && p.x[2] == q.x[2];
-}
-
-RationalPoint exactOf(const Point3& p) {
-  return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
-}
-
-Point3 roundedOf(const RationalPoint& p) {
-  return {p.x[0].get_d(), p.x[1].get_d(), p.x[2].get_d()};
-}
-
-// Lexicographic order on exact coordinates, to key points.
+// Lexicographic order on exact coordinates, to key the rare points made
+// inside one face (crossings of two curves).
 struct ExactLess {
   bool operator()(const RationalPoint& p, const RationalPoint& q) const {
     for (int k = 0; k < 3; ++k) {
@@ -43,33 +35,6 @@ struct ExactLess {
   }
 };
 
-// The points and curve segments one face receives.
-struct FaceWork {
-  std::vector<RationalPoint> points;
-  std::vector<std::array<int, 2>> segments;  // indices into points
-
-  int add(const RationalPoint& p) {
-    for (std::size_t i = 0; i < points.size(); ++i)
-      if (sameExact(points[i], p)) return int(i);
-    points.push_back(p);
-    return int(points.size()) - 1;
-  }
-};
-
-// Is the exact point p on the closed segment a-b (a, b input doubles)?
-bool onSegment(const RationalPoint& p, const Point3& a, const Point3& b) {
-  const RationalPoint A = exactOf(a), B = exactOf(b);
-  for (int k = 0; k < 3; ++k) {
-    const int u = (k + 1) % 3;
-    // (p - a) x (b - a) == 0, component by component
-    if ((p.x[k] - A.x[k]) * (B.x[u] - A.x[u]) != (p.x[u] - A.x[u]) * (B.x[k] - A.x[k]))
-      return false;
-  }
-  for (int k = 0; k < 3; ++k)
-    if (sgn(p.x[k] - A.x[k]) * sgn(B.x[k] - p.x[k]) < 0) return false;
-  return true;
-}
-
 // Barycentric coordinates of p in triangle (a, b, c), from the rounded values.
 Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Point3& c) {
   const Point3 n = (b - a) ^ (c - a);
@@ -79,11 +44,132 @@ Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Poin
   return {wa, wb, 1 - wa - wb};
 }
 
+// An input edge: mesh and its two vertices, smaller first.
+struct EdgeRef {
+  std::uint32_t mesh, u, v;
+  bool operator==(const EdgeRef& o) const { return mesh == o.mesh && u == o.u && v == o.v; }
+};
+EdgeRef edgeRef(std::uint32_t mesh, int a, int b) {
+  return {mesh, std::uint32_t(std::min(a, b)), std::uint32_t(std::max(a, b))};
+}
+
+// Every distinct curve point of all pairs, named by its defining input
+// elements (an input vertex; an input edge crossing an input face; two
+// coplanar input edges crossing), so that the pairs sharing a point find it
+// without comparing coordinates. Points of different names that coincide
+// exactly (degenerate inputs) are merged afterwards.
+class CurvePoints {
+ public:
+  // The id of the point `tag` of the pair's contact (its ExactPoint `point`).
+  int add(const ContactPoint& tag, const ExactPoint& point, const FaceRef faces[2],
+          const std::vector<const std::vector<Triangle>*>& triangles) {
+    const FaceRef& own = faces[tag.triangle];
+    const Triangle& t = (*triangles[own.mesh])[own.face];
+    Key key{};
+    std::vector<EdgeRef> edges;
+    std::int64_t vertex = -1;
+    switch (tag.kind) {
+      case ContactPoint::Kind::kVertex:
+        key = {0, own.mesh, std::uint32_t(t[tag.index]), 0, 0, 0, 0};
+        vertex = t[tag.index];
+        break;
+      case ContactPoint::Kind::kEdgeFace: {
+        const FaceRef& other = faces[1 - tag.triangle];
+        const EdgeRef e = edgeRef(own.mesh, t[tag.index], t[(tag.index + 1) % 3]);
+        key = {1, e.mesh, e.u, e.v, other.mesh, other.face, 0};
+        edges.push_back(e);
+        break;
+      }
+      case ContactPoint::Kind::kEdgeEdge: {
+        const Triangle& tb = (*triangles[faces[1].mesh])[faces[1].face];
+        EdgeRef e = edgeRef(faces[0].mesh, t[tag.index], t[(tag.index + 1) % 3]);
+        EdgeRef g = edgeRef(faces[1].mesh, tb[tag.other_index], tb[(tag.other_index + 1) % 3]);
+        if (std::tie(g.mesh, g.u, g.v) < std::tie(e.mesh, e.u, e.v)) std::swap(e, g);
+        key = {2, e.mesh, e.u, e.v, g.mesh, g.u, g.v};
+        edges = {e, g};
+        break;
+      }
+    }
+    const auto [it, added] = ids_.emplace(key, int(points_.size()));
+    if (added) {
+      points_.push_back(point);
+      edges_.push_back(edges);
+      vertexOf_.push_back(vertex >= 0 ? std::pair<std::uint32_t, std::int64_t>{own.mesh, vertex}
+                                      : std::pair<std::uint32_t, std::int64_t>{0, -1});
+    }
+    return it->second;
+  }
+
+  // Merges exactly coincident points; afterwards representative(id) names each.
+  void mergeCoincident() {
+    std::vector<const ExactPoint*> all;
+    for (const ExactPoint& p : points_) all.push_back(&p);
+    representative_ = coincidentGroups(all);
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const int r = representative_[i];
+      if (r == int(i)) continue;
+      edges_[r].insert(edges_[r].end(), edges_[i].begin(), edges_[i].end());
+    }
+    for (std::size_t i = 0; i < points_.size(); ++i)
+      if (vertexOf_[i].second >= 0)
+        inputVertex_[std::pair<std::uint32_t, int>(vertexOf_[i].first, representative_[i])] =
+            int(vertexOf_[i].second);
+  }
+
+  int representative(int id) const { return representative_[id]; }
+  const ExactPoint& point(int id) const { return points_[id]; }
+  std::size_t size() const { return points_.size(); }
+  // Input edges the point is known to lie on (from its names).
+  const std::vector<EdgeRef>& knownEdges(int id) const { return edges_[id]; }
+  // The input vertex of `mesh` at this point, or -1.
+  int inputVertex(std::uint32_t mesh, int id) const {
+    const auto it = inputVertex_.find({mesh, id});
+    return it == inputVertex_.end() ? -1 : it->second;
+  }
+
+ private:
+  using Key = std::array<std::uint32_t, 7>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::size_t h = 0;
+      for (std::uint32_t x : k) h = h * 0x9E3779B97F4A7C15ull + x;
+      return h ^ (h >> 29);
+    }
+  };
+  std::unordered_map<Key, int, KeyHash> ids_;
+  std::vector<ExactPoint> points_;
+  std::vector<std::vector<EdgeRef>> edges_;
+  std::vector<std::pair<std::uint32_t, std::int64_t>> vertexOf_;
+  std::vector<int> representative_;
+  std::map<std::pair<std::uint32_t, int>, int> inputVertex_;
+};
+
+// The curve points and segments one face receives (representative ids).
+struct FaceWork {
+  std::vector<int> points;
+  std::vector<std::uint8_t> edges;           // per point: the face's edges it lies inside (bits)
+  std::vector<std::array<int, 2>> segments;  // indices into points
+
+  int add(int id, std::uint8_t onEdges = 0) {
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (points[i] == id) {
+        edges[i] |= onEdges;
+        return int(i);
+      }
+    points.push_back(id);
+    edges.push_back(onEdges);
+    return int(points.size()) - 1;
+  }
+};
+
 class MeshSplitter {
  public:
-  MeshSplitter(const Mesh& mesh, std::uint32_t index) : index_(index) {
-    points_ = positionsOf(mesh);
-    triangles_ = trianglesOf(mesh);
+  MeshSplitter(WeldedArrays&& input, std::uint32_t index)
+      : index_(index),
+        points_(std::move(input.mesh.points)),
+        triangles_(std::move(input.mesh.triangles)),
+        vertexOrigin_(std::move(input.vertex_origin)),
+        faceOrigin_(std::move(input.face_origin)) {
     // Faces around each vertex (compressed rows), to find the faces on an edge.
     offsets_.assign(points_.size() + 1, 0);
     for (const Triangle& t : triangles_)
@@ -95,43 +181,54 @@ class MeshSplitter {
       for (int v : triangles_[f]) faces_[next[v]++] = std::uint32_t(f);
   }
 
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+
   TrianglePoints at(std::uint32_t f) const {
     return {points_[triangles_[f][0]], points_[triangles_[f][1]], points_[triangles_[f][2]]};
   }
 
-  // The contact of a pair, seen from this mesh's face f.
-  void addContact(std::uint32_t f, const std::vector<RationalPoint>& contact) {
+  // The contact of a pair (curve point ids), seen from this mesh's face f.
+  void addContact(std::uint32_t f, const std::vector<int>& contact) {
     FaceWork& w = work_[f];
     std::vector<int> ids;
-    for (const RationalPoint& p : contact) ids.push_back(w.add(p));
-    if (ids.size() == 2) w.segments.push_back({ids[0], ids[1]});
+    for (int p : contact) ids.push_back(w.add(p));
+    if (ids.size() == 2 && ids[0] != ids[1]) w.segments.push_back({ids[0], ids[1]});
     if (ids.size() > 2)
       for (std::size_t i = 0; i < ids.size(); ++i)
-        w.segments.push_back({ids[i], ids[(i + 1) % ids.size()]});
+        if (ids[i] != ids[(i + 1) % ids.size()])
+          w.segments.push_back({ids[i], ids[(i + 1) % ids.size()]});
   }
 
   // Points on an edge of a face also split that edge in the faces across it.
-  void shareEdgePoints() {
-    std::vector<std::pair<std::uint32_t, RationalPoint>> shared;
-    for (const auto& [f, w] : work_) {
+  void shareEdgePoints(const CurvePoints& table) {
+    struct Shared {
+      std::uint32_t face;
+      int id;
+      std::uint8_t edges;
+    };
+    std::vector<Shared> shared;
+    for (auto& [f, w] : work_) {
       const Triangle& t = triangles_[f];
-      for (const RationalPoint& p : w.points)
+      for (std::size_t p = 0; p < w.points.size(); ++p)
         for (int i = 0; i < 3; ++i) {
           const int a = t[i], b = t[(i + 1) % 3];
-          if (!onSegment(p, points_[a], points_[b])) continue;
+          if (!onEdge(table, w.points[p], a, b)) continue;
+          w.edges[p] |= std::uint8_t(1 << i);
           for (std::uint32_t k = offsets_[a]; k < offsets_[a + 1]; ++k) {
             const std::uint32_t g = faces_[k];
             if (g == f) continue;
             const Triangle& u = triangles_[g];
-            if (u[0] == b || u[1] == b || u[2] == b) shared.emplace_back(g, p);
+            for (int j = 0; j < 3; ++j)
+              if ((u[j] == b && u[(j + 1) % 3] == a) || (u[j] == a && u[(j + 1) % 3] == b))
+                shared.push_back({g, w.points[p], std::uint8_t(1 << j)});
           }
         }
     }
-    for (const auto& [g, p] : shared) work_[g].add(p);
+    for (const Shared& x : shared) work_[x.face].add(x.id, x.edges);
   }
 
   // Re-triangulates every face that received points, in parallel.
-  void retriangulateFaces() {
+  void retriangulateFaces(const CurvePoints& table) {
     order_.clear();
     for (const auto& [f, w] : work_) order_.push_back(f);
     std::sort(order_.begin(), order_.end());
@@ -145,8 +242,9 @@ class MeshSplitter {
             const TrianglePoints t = at(f);
             if (collinear(t[0], t[1], t[2])) continue;  // degenerate: kept as it is (empty patch)
             PatchInput in;
-            for (int k = 0; k < 3; ++k) in.corners[k] = exactOf(points_[triangles_[f][k]]);
-            in.points = w.points;
+            for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(t[k]);
+            for (int id : w.points) in.points.push_back(table.point(id));
+            in.on_edges = w.edges;
             for (const auto& s : w.segments) in.segments.push_back({3 + s[0], 3 + s[1]});
             patches_[i] = retriangulate(in);
           }
@@ -154,22 +252,33 @@ class MeshSplitter {
         16);
   }
 
-  // Builds the output mesh and its curve edges.
-  void build(Mesh& out, std::vector<std::array<int, 2>>& curves,
-             std::vector<RationalPoint>& exactNew, std::size_t& facesAdded) {
+  // Builds the output mesh and its curve edges; `exactNew` receives the
+  // exact positions of the new vertices.
+  void build(const CurvePoints& table, Mesh& out, std::vector<std::array<int, 2>>& curves,
+             std::vector<ExactPoint>& exactNew, std::size_t& facesAdded) {
     std::vector<Point3> positions = points_;
     std::vector<Triangle> triangles;
     std::vector<FaceOrigin> birthFaces;
     std::vector<VertexOrigin> newOrigins;
-    std::map<RationalPoint, int, ExactLess> registry;
+    std::unordered_map<int, int> vertexOfPoint;              // curve point id -> output vertex
+    std::map<RationalPoint, int, ExactLess> crossingPoints;  // made inside one face
+    auto newVertex = [&](const ExactPoint& p, std::uint32_t f) {
+      positions.push_back(p.approx());
+      exactNew.push_back(p);
+      const TrianglePoints t = at(f);
+      newOrigins.push_back(
+          {int(index_), -1, faceOrigin_[f], barycentric(p.approx(), t[0], t[1], t[2])});
+      return int(positions.size()) - 1;
+    };
     std::vector<char> split(triangles_.size(), 0);
     for (std::size_t i = 0; i < order_.size(); ++i)
       split[order_[i]] = !patches_[i].triangles.empty();
     for (std::size_t f = 0; f < triangles_.size(); ++f)
       if (!split[f]) {
         triangles.push_back(triangles_[f]);
-        birthFaces.push_back({int(index_), int(f)});
+        birthFaces.push_back({int(index_), faceOrigin_[f]});
       }
+    keptFaces_ = triangles.size();
     std::set<std::array<int, 2>> curveSet;
     for (std::size_t i = 0; i < order_.size(); ++i) {
       const std::uint32_t f = order_[i];
@@ -178,29 +287,35 @@ class MeshSplitter {
         ++degenerateKept_;
         continue;
       }
-      std::vector<int> global(patch.vertices.size());
-      for (std::size_t v = 0; v < patch.vertices.size(); ++v) {
-        if (v < 3) {
-          global[v] = triangles_[f][v];
-          continue;
+      const std::vector<int>& ids = work_.at(f).points;
+      std::vector<int> global(patch.vertices.size(), -1);
+      for (int k = 0; k < 3; ++k) global[k] = triangles_[f][k];
+      for (std::size_t j = 0; j < ids.size(); ++j) {
+        const int v = patch.vertex_of_input[3 + j];
+        const int id = ids[j];
+        if (global[v] < 0) {
+          const auto [it, added] = vertexOfPoint.emplace(id, -1);
+          if (added) {
+            const int input = table.inputVertex(index_, id);
+            it->second = input >= 0 ? input : newVertex(table.point(id), f);
+          }
+          global[v] = it->second;
         }
-        const auto [it, added] = registry.emplace(patch.vertices[v], int(positions.size()));
-        if (added) {
-          const Point3 p = roundedOf(patch.vertices[v]);
-          positions.push_back(p);
-          exactNew.push_back(patch.vertices[v]);
-          const TrianglePoints t = at(f);
-          newOrigins.push_back({int(index_), -1, int(f), barycentric(p, t[0], t[1], t[2])});
-        }
+        pointOfVertex_[global[v]] = id;
+      }
+      for (std::size_t v = 3; v < patch.vertices.size(); ++v) {
+        if (global[v] >= 0) continue;
+        const auto [it, added] = crossingPoints.emplace(patch.vertices[v].exact(), -1);
+        if (added) it->second = newVertex(patch.vertices[v], f);
         global[v] = it->second;
       }
       // Every contact point is a place where meshes meet, curve or not (a
       // touching corner): the merged output welds them.
-      for (std::size_t i = 3; i < patch.vertex_of_input.size(); ++i)
-        contactVertices_.push_back(global[patch.vertex_of_input[i]]);
+      for (std::size_t j = 3; j < patch.vertex_of_input.size(); ++j)
+        contactVertices_.push_back(global[patch.vertex_of_input[j]]);
       for (const auto& t : patch.triangles) {
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
-        birthFaces.push_back({int(index_), int(f)});
+        birthFaces.push_back({int(index_), faceOrigin_[f]});
       }
       for (const auto& e : patch.constrained_edges) {
         std::array<int, 2> g{global[e[0]], global[e[1]]};
@@ -210,6 +325,8 @@ class MeshSplitter {
     }
     out = makeMesh(positions, triangles, int(index_));
     VertexOriginHandle vo = vertexOrigins(out);
+    for (std::size_t v = 0; v < points_.size(); ++v)
+      vo[v] = {int(index_), vertexOrigin_[v], -1, {}};
     for (std::size_t i = 0; i < newOrigins.size(); ++i) vo[points_.size() + i] = newOrigins[i];
     FaceOriginHandle fo = faceOrigins(out);
     for (std::size_t f = 0; f < birthFaces.size(); ++f) fo[f] = birthFaces[f];
@@ -218,20 +335,37 @@ class MeshSplitter {
   }
 
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
+  std::size_t keptFaces() const { return keptFaces_; }  // output faces before the new ones
   const std::vector<int>& contactVertices() const { return contactVertices_; }
+  // Output vertices at curve points: the point's id.
+  const std::unordered_map<int, int>& pointOfVertex() const { return pointOfVertex_; }
   std::size_t degenerateKept() const { return degenerateKept_; }
   const std::vector<Point3>& points() const { return points_; }
 
  private:
+  // Is curve point `id` on the input edge (a, b) of this mesh?
+  bool onEdge(const CurvePoints& table, int id, int a, int b) const {
+    const EdgeRef e = edgeRef(index_, a, b);
+    for (const EdgeRef& known : table.knownEdges(id))
+      if (known == e) return true;
+    const ExactPoint& p = table.point(id);
+    if (p.isInputPoint() && (p.approx() == points_[a] || p.approx() == points_[b]))
+      return false;  // a corner: not inside the edge
+    return onSegment(p, ExactPoint(points_[a]), ExactPoint(points_[b]));
+  }
+
   std::uint32_t index_;
   std::vector<Point3> points_;
   std::vector<Triangle> triangles_;
+  std::vector<int> vertexOrigin_, faceOrigin_;  // input index of each vertex and face
   std::vector<std::uint32_t> offsets_, faces_;
   std::unordered_map<std::uint32_t, FaceWork> work_;
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
+  std::size_t keptFaces_ = 0;
   std::vector<int> contactVertices_;  // output vertices at contact points
+  std::unordered_map<int, int> pointOfVertex_;
 };
 
 // Closed and open components of a curve graph.
@@ -262,16 +396,25 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options) {
   const auto start = Clock::now();
   SplitResult r;
-  std::vector<Mesh> welded;  // the inputs with their seams closed, when asked
-  std::vector<const Mesh*> inputs = meshes;
-  if (options.weld_duplicates) {
-    welded.reserve(meshes.size());
-    for (std::size_t m = 0; m < meshes.size(); ++m) {
-      welded.push_back(*meshes[m]);
-      r.vertices_welded += weldCoincidentVertices(welded.back());
-      inputs[m] = &welded.back();
+  // The inputs as arrays, with their seams closed when asked; each keeps
+  // the input index of its vertices and faces.
+  std::vector<WeldedArrays> inputs(meshes.size());
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+    WeldedArrays& in = inputs[m];
+    if (options.weld_duplicates) {
+      in = weldCoincident(arraysOf(*meshes[m]));
+      r.vertices_welded += in.vertices_merged;
+    } else {
+      in.mesh = arraysOf(*meshes[m]);
+      in.vertex_origin.resize(in.mesh.points.size());
+      std::iota(in.vertex_origin.begin(), in.vertex_origin.end(), 0);
+      in.face_origin.resize(in.mesh.triangles.size());
+      std::iota(in.face_origin.begin(), in.face_origin.end(), 0);
     }
   }
+  std::vector<const MeshArrays*> arrays;
+  for (const WeldedArrays& in : inputs) arrays.push_back(&in.mesh);
   FindIntersectionsOptions find;
   find.self = options.self;
   find.cross = options.between_meshes;
@@ -279,27 +422,39 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   find.progress = [&](int percent, const char* stage) {
     return !options.progress || options.progress(percent * 4 / 10, stage);
   };
-  const FindIntersectionsResult found = findIntersections(inputs, find);
+  const FindIntersectionsResult found = findIntersectionsInArrays(arrays, find);
   r.intersecting_pairs = found.pairs.size();
+  r.complete = options.self && (options.between_meshes || meshes.size() == 1);
 
   reportProgress(options.progress, 40, "Collecting curve points");
   std::vector<MeshSplitter> splitters;
   for (std::size_t m = 0; m < meshes.size(); ++m)
-    splitters.emplace_back(*inputs[m], std::uint32_t(m));
+    splitters.emplace_back(std::move(inputs[m]), std::uint32_t(m));
+  std::vector<const std::vector<Triangle>*> triangles;
+  for (const MeshSplitter& s : splitters) triangles.push_back(&s.triangles());
+  CurvePoints table;
+  std::vector<std::vector<int>> contactIds(found.pairs.size());
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
-    const IntersectingPair& p = found.pairs[i];
-    const std::vector<RationalPoint>& contact = found.contacts[i].exact;
-    splitters[p.a.mesh].addContact(p.a.face, contact);
-    splitters[p.b.mesh].addContact(p.b.face, contact);
+    const FaceRef faces[2] = {found.pairs[i].a, found.pairs[i].b};
+    const TriangleContact& c = found.contacts[i];
+    for (std::size_t k = 0; k < c.points.size(); ++k)
+      contactIds[i].push_back(table.add(c.points[k], c.exact[k], faces, triangles));
+  }
+  table.mergeCoincident();
+  for (std::size_t i = 0; i < found.pairs.size(); ++i) {
+    std::vector<int>& ids = contactIds[i];
+    for (int& id : ids) id = table.representative(id);
+    splitters[found.pairs[i].a.mesh].addContact(found.pairs[i].a.face, ids);
+    splitters[found.pairs[i].b.mesh].addContact(found.pairs[i].b.face, ids);
   }
   reportProgress(options.progress, 55, "Re-triangulating crossed faces");
-  std::vector<std::vector<RationalPoint>> exactNew(meshes.size());
+  std::vector<std::vector<ExactPoint>> exactNew(meshes.size());
   r.meshes.resize(meshes.size());
   r.curve_edges.resize(meshes.size());
   for (std::size_t m = 0; m < meshes.size(); ++m) {
-    splitters[m].shareEdgePoints();
-    splitters[m].retriangulateFaces();
-    splitters[m].build(r.meshes[m], r.curve_edges[m], exactNew[m], r.faces_added);
+    splitters[m].shareEdgePoints(table);
+    splitters[m].retriangulateFaces(table);
+    splitters[m].build(table, r.meshes[m], r.curve_edges[m], exactNew[m], r.faces_added);
     r.faces_split += splitters[m].facesSplit();
     r.degenerate_faces_kept += splitters[m].degenerateKept();
     r.new_vertices += exactNew[m].size();
@@ -307,32 +462,59 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 
   reportProgress(options.progress, 90, "Welding along the curves");
   {
-    // All meshes in one; curve vertices with the same exact position merge.
+    // All meshes in one; curve vertices with the same exact position merge:
+    // those at one curve point by its id, the others (crossings of two
+    // curves inside a face) by comparing exactly.
+    std::vector<ExactPoint> curvePoints;  // one per curve point id used, then the others
+    std::unordered_map<int, int> curvePointOfId;
+    std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const Mesh& mesh = r.meshes[m];
+      std::vector<int>& index = curveIndex[m];
+      index.assign(mesh.vert.size(), -1);
+      const auto& pointOfVertex = splitters[m].pointOfVertex();
+      auto mark = [&](int v) {
+        if (index[v] >= 0) return;
+        const auto known = pointOfVertex.find(v);
+        if (known != pointOfVertex.end()) {
+          const auto [it, added] = curvePointOfId.emplace(known->second, int(curvePoints.size()));
+          if (added) curvePoints.push_back(table.point(known->second));
+          index[v] = it->second;
+          return;
+        }
+        index[v] = int(curvePoints.size());
+        const std::size_t inputVertices = splitters[m].points().size();
+        curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.vert[v].cP())
+                                                             : exactNew[m][v - inputVertices]);
+      };
+      for (const auto& e : r.curve_edges[m]) mark(e[0]), mark(e[1]);
+      for (int v : splitters[m].contactVertices()) mark(v);
+    }
+    std::vector<const ExactPoint*> curvePointers;
+    for (const ExactPoint& p : curvePoints) curvePointers.push_back(&p);
+    const std::vector<int> weldedTo = coincidentGroups(curvePointers);
+    std::vector<int> mergedOfCurvePoint(curvePoints.size(), -1);
     std::vector<Point3> positions;
     std::vector<Triangle> triangles;
     std::vector<VertexOrigin> vertexOrigin;
     std::vector<FaceOrigin> faceOrigin;
-    std::map<RationalPoint, int, ExactLess> weld;
     std::set<std::array<int, 2>> curves;
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       Mesh& mesh = r.meshes[m];
       VertexOriginHandle vo = vertexOrigins(mesh);
       FaceOriginHandle fo = faceOrigins(mesh);
-      std::vector<char> onCurve(mesh.vert.size(), 0);  // on a curve or at a contact point
-      for (const auto& e : r.curve_edges[m]) onCurve[e[0]] = onCurve[e[1]] = 1;
-      for (int v : splitters[m].contactVertices()) onCurve[v] = 1;
-      const std::size_t inputVertices = splitters[m].points().size();
       std::vector<int>& global = r.merged_vertex.emplace_back(mesh.vert.size());
       for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
-        if (onCurve[v]) {
-          const RationalPoint exact =
-              v < inputVertices ? exactOf(mesh.vert[v].cP()) : exactNew[m][v - inputVertices];
-          const auto [it, added] = weld.emplace(exact, int(positions.size()));
-          global[v] = it->second;
-          if (!added) continue;
-        } else {
-          global[v] = int(positions.size());
+        const int c = curveIndex[m][v];
+        if (c >= 0) {
+          int& target = mergedOfCurvePoint[weldedTo[c]];
+          if (target >= 0) {
+            global[v] = target;
+            continue;
+          }
+          target = int(positions.size());
         }
+        global[v] = int(positions.size());
         positions.push_back(mesh.vert[v].cP());
         vertexOrigin.push_back(vo[v]);
       }
@@ -342,6 +524,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                              global[vcg::tri::Index(mesh, face.cV(1))],
                              global[vcg::tri::Index(mesh, face.cV(2))]});
         faceOrigin.push_back(fo[f]);
+        r.merged_new_face.push_back(f >= splitters[m].keptFaces());
       }
       for (const auto& e : r.curve_edges[m]) {
         std::array<int, 2> g{global[e[0]], global[e[1]]};
@@ -394,10 +577,77 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   for (Point3& p : P) p = Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
   const std::vector<Triangle> T = trianglesOf(merged);
   VertexOriginHandle vo = vertexOrigins(merged);
-  // Faces around each vertex.
-  std::vector<std::vector<std::uint32_t>> around(P.size());
-  for (std::size_t f = 0; f < T.size(); ++f)
-    for (int v : T[f]) around[v].push_back(std::uint32_t(f));
+
+  // Only faces that are new or that rounding moves can cross anything they
+  // did not cross before: every other face is an input face, exactly as it was.
+  std::vector<int> changedIndex(T.size(), -1);
+  std::vector<std::uint32_t> changed;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    bool isChanged = f < r.merged_new_face.size() && r.merged_new_face[f];
+    for (int v : T[f]) isChanged |= P[v] != exact[v];
+    if (isChanged) {
+      changedIndex[f] = int(changed.size());
+      changed.push_back(std::uint32_t(f));
+    }
+  }
+  if (changed.empty()) return 0;
+
+  // Candidate pairs: a changed face and any face whose box overlaps its box
+  // widened by a few float steps (re-rounding moves a vertex by one step).
+  auto widened = [](Box b) {
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) {
+        b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
+        b.hi[k] = std::nextafter(b.hi[k], INFINITY);
+      }
+    return b;
+  };
+  std::vector<Box> changedBoxes;
+  for (std::uint32_t f : changed)
+    changedBoxes.push_back(widened(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]])));
+  const BoxTree tree(changedBoxes);
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t g = begin; g < end; ++g) {
+      Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
+      if (changedIndex[g] >= 0) b = widened(b);
+      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
+        const std::uint32_t f = changed[i];
+        // A pair of two changed faces is found from both sides: keep one.
+        if (f != g && (changedIndex[g] < 0 || f < g))
+          found[worker].push_back({f, std::uint32_t(g)});
+      });
+    }
+  });
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (const auto& w : found) pairs.insert(pairs.end(), w.begin(), w.end());
+  // Candidates of each changed face, both ways (compressed rows).
+  std::vector<std::uint32_t> offsets(changed.size() + 1, 0), others;
+  for (const auto& [f, g] : pairs) {
+    ++offsets[changedIndex[f] + 1];
+    if (changedIndex[g] >= 0) ++offsets[changedIndex[g] + 1];
+  }
+  for (std::size_t i = 0; i < changed.size(); ++i) offsets[i + 1] += offsets[i];
+  others.resize(offsets.back());
+  {
+    std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+    for (const auto& [f, g] : pairs) {
+      others[next[changedIndex[f]]++] = g;
+      if (changedIndex[g] >= 0) others[next[changedIndex[g]]++] = f;
+    }
+  }
+  // Changed faces around each vertex.
+  std::vector<std::uint32_t> aroundOffsets(P.size() + 1, 0), around;
+  for (std::uint32_t f : changed)
+    for (int v : T[f]) ++aroundOffsets[v + 1];
+  for (std::size_t v = 0; v < P.size(); ++v) aroundOffsets[v + 1] += aroundOffsets[v];
+  around.resize(aroundOffsets.back());
+  {
+    std::vector<std::uint32_t> next(aroundOffsets.begin(), aroundOffsets.end() - 1);
+    for (std::uint32_t f : changed)
+      for (int v : T[f]) around[next[v]++] = f;
+  }
+
   auto at = [&](std::uint32_t f) -> TrianglePoints { return {P[T[f][0]], P[T[f][1]], P[T[f][2]]}; };
   auto crosses = [&](std::uint32_t f, std::uint32_t g) {
     const TrianglePoints a = at(f), b = at(g);
@@ -405,40 +655,40 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
     const SharedCorners c = sharedCorners(T[f], T[g]);
     return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
   };
+  auto crossingPairs = [&] {
+    std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+    parallelChunks(
+        pairs.size(),
+        [&](std::size_t begin, std::size_t end, unsigned worker) {
+          for (std::size_t i = begin; i < end; ++i)
+            if (crosses(pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
+        },
+        1024);
+    std::vector<std::array<std::uint32_t, 2>> all;
+    for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+    return all;
+  };
+  // How many crossings the changed faces around v take part in.
+  auto localCrossings = [&](int v) {
+    std::size_t n = 0;
+    for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k) {
+      const std::uint32_t f = around[k];
+      const int i = changedIndex[f];
+      for (std::uint32_t j = offsets[i]; j < offsets[i + 1]; ++j) n += crosses(f, others[j]);
+    }
+    return n;
+  };
+
   std::size_t remaining = 0;
   for (int pass = 0; pass <= passes; ++pass) {
-    const Mesh current = makeMesh(P, T);
-    FindIntersectionsOptions o;
-    o.cross = false;
-    const FindIntersectionsResult found = findIntersections({&current}, o);
-    remaining = found.pairs.size();
+    const std::vector<std::array<std::uint32_t, 2>> crossing = crossingPairs();
+    remaining = crossing.size();
     if (remaining == 0 || pass == passes) break;
-    std::vector<Box> boxes;
-    for (std::size_t f = 0; f < T.size(); ++f)
-      boxes.push_back(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]));
-    const BoxTree tree(boxes);
     std::set<int> candidates;
-    for (const IntersectingPair& p : found.pairs)
-      for (std::uint32_t f : {p.a.face, p.b.face})
+    for (const auto& p : crossing)
+      for (std::uint32_t f : p)
         for (int v : T[f])
           if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
-    // How many faces the faces around v cross, with v where it is now.
-    auto localCrossings = [&](int v) {
-      std::size_t n = 0;
-      for (std::uint32_t f : around[v]) {
-        Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
-        for (int k = 0; k < 3; ++k) {  // neighbours may have moved by an ulp this pass
-          for (int i = 0; i < 4; ++i) {
-            b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
-            b.hi[k] = std::nextafter(b.hi[k], INFINITY);
-          }
-        }
-        tree.query(b, 0, [&](std::uint32_t g, unsigned) {
-          if (g != f && crosses(f, g)) ++n;
-        });
-      }
-      return n;
-    };
     for (int v : candidates) {
       const Point3 e = exact[v];
       Point3 best = P[v];

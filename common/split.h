@@ -34,14 +34,19 @@ struct SplitResult {
   Mesh merged;
   std::vector<std::array<int, 2>> merged_curve_edges;
   std::vector<std::vector<int>> merged_vertex;  // per mesh, per vertex: its vertex in `merged`
-  std::size_t intersecting_pairs = 0;           // pairs found (and split)
-  std::size_t faces_split = 0;                  // input faces re-triangulated
-  std::size_t faces_added = 0;                  // output faces minus input faces
-  std::size_t new_vertices = 0;                 // curve points that are not input vertices
-  std::size_t degenerate_faces_kept = 0;        // zero-area faces a curve touches, left unsplit
-  std::size_t vertices_welded = 0;              // duplicates merged first (weld_duplicates)
-  std::size_t curve_loops = 0;                  // closed curve components (merged output)
-  std::size_t open_curves = 0;                  // curve components with end points
+  std::vector<char> merged_new_face;            // per face of `merged`: 1 when a split made it
+  // Every intersecting pair of the inputs was searched for (and split): each
+  // mesh's own and those between meshes. Faces left as they were then cross
+  // nothing, so the intersections left are among pairs with a new face.
+  bool complete = false;
+  std::size_t intersecting_pairs = 0;     // pairs found (and split)
+  std::size_t faces_split = 0;            // input faces re-triangulated
+  std::size_t faces_added = 0;            // output faces minus input faces
+  std::size_t new_vertices = 0;           // curve points that are not input vertices
+  std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
+  std::size_t vertices_welded = 0;        // duplicates merged first (weld_duplicates)
+  std::size_t curve_loops = 0;            // closed curve components (merged output)
+  std::size_t open_curves = 0;            // curve components with end points
   double time_ms = 0;
 };
 
@@ -54,7 +59,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 // cross, the new vertices of those faces are rounded the other way (each
 // coordinate to the float just below or above its exact value), choosing the
 // rounding under which the faces around the vertex cross nothing. Applied to
-// `merged` and to `meshes` alike. Returns the pairs still crossing.
+// `merged` and to `meshes` alike. Returns the pairs still crossing among
+// those with a new face or a face that rounding moved (faces kept exactly
+// as they were cannot cross anything new); with `complete`, that is every
+// intersecting pair of the rounded output.
 std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
 // Intersecting pairs left in the merged output, by the self-intersection

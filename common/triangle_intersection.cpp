@@ -199,9 +199,116 @@ Exact3 along(const Exact3& p, const Exact3& q, const mpq_class& t) {
   return r;
 }
 
+// The ExactPoint a contact point's defining elements describe.
+ExactPoint exactPointOf(const ContactPoint& c, const TrianglePoints& a, const TrianglePoints& b) {
+  const TrianglePoints& own = c.triangle == 0 ? a : b;
+  const TrianglePoints& other = c.triangle == 0 ? b : a;
+  switch (c.kind) {
+    case ContactPoint::Kind::kVertex:
+      return ExactPoint(own[c.index]);
+    case ContactPoint::Kind::kEdgeFace:
+      return ExactPoint::edgePlane(own[c.index], own[(c.index + 1) % 3], other[0], other[1],
+                                   other[2]);
+    case ContactPoint::Kind::kEdgeEdge:
+      break;
+  }
+  return ExactPoint::edgeLine(a[c.index], a[(c.index + 1) % 3], b[c.other_index],
+                              b[(c.other_index + 1) % 3], projectionAxis(a[0], a[1], a[2]));
+}
+
+// Not coplanar, from rounded values: each triangle meets the other's plane
+// in a segment (its points on an edge crossing the plane, or its corners in
+// the plane), and the contact is the overlap of the two segments along the
+// planes' common line, found by comparing positions along that line in
+// interval arithmetic. Returns false when a comparison is too close to call
+// (touching configurations, ties), leaving it to the exact classification.
+bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const int side[2][3],
+                      TriangleContact& contact) {
+  const TrianglePoints* T[2] = {&a, &b};
+  Interval3 n[2];
+  for (int t = 0; t < 2; ++t) {
+    const TrianglePoints& p = *T[t];
+    Interval e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      e1[k] = Interval(p[1][k]) - p[0][k];
+      e2[k] = Interval(p[2][k]) - p[0][k];
+    }
+    for (int k = 0; k < 3; ++k)
+      n[t][k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
+  }
+  Interval3 d;  // direction of the common line
+  for (int k = 0; k < 3; ++k)
+    d[k] = n[0][(k + 1) % 3] * n[1][(k + 2) % 3] - n[0][(k + 2) % 3] * n[1][(k + 1) % 3];
+  struct Candidate {
+    ContactPoint tag;
+    ExactPoint point;
+    Interval key;  // position along d
+  };
+  Candidate part[2][2];
+  int count[2] = {0, 0}, zeros[2] = {0, 0};
+  for (int t = 0; t < 2; ++t)
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3;
+      const int si = side[t][i], sj = side[t][j];
+      if (si != 0 && si * sj >= 0) continue;
+      if (count[t] == 2) return false;  // cannot happen for crossing triangles
+      Candidate& c = part[t][count[t]++];
+      c.tag.triangle = std::uint8_t(t);
+      c.tag.index = std::uint8_t(i);
+      if (si == 0) {
+        c.tag.kind = ContactPoint::Kind::kVertex;
+        ++zeros[t];
+      } else {
+        c.tag.kind = ContactPoint::Kind::kEdgeFace;
+      }
+      c.point = exactPointOf(c.tag, a, b);
+      const Interval3 x = intervalOf(c.point);
+      c.key = d[0] * x[0] + d[1] * x[1] + d[2] * x[2];
+    }
+  const Candidate *lo[2], *hi[2];
+  for (int t = 0; t < 2; ++t) {
+    if (count[t] != 2) return false;  // touching at a corner: exactly
+    const Candidate &x = part[t][0], &y = part[t][1];
+    if (x.key.hi < y.key.lo) {
+      lo[t] = &x, hi[t] = &y;
+    } else if (y.key.hi < x.key.lo) {
+      lo[t] = &y, hi[t] = &x;
+    } else {
+      return false;
+    }
+  }
+  // The overlap [max of starts, min of ends].
+  const Candidate* start;
+  if (lo[0]->key.lo > lo[1]->key.hi)
+    start = lo[0];
+  else if (lo[1]->key.lo > lo[0]->key.hi)
+    start = lo[1];
+  else
+    return false;
+  const Candidate* end;
+  if (hi[0]->key.hi < hi[1]->key.lo)
+    end = hi[0];
+  else if (hi[1]->key.hi < hi[0]->key.lo)
+    end = hi[1];
+  else
+    return false;
+  contact = {};
+  if (start->key.lo > end->key.hi) return true;  // the segments do not overlap
+  if (!(start->key.hi < end->key.lo)) return false;
+  contact.kind =
+      (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
+  for (const Candidate* c : {start, end}) {
+    ContactPoint p = c->tag;
+    p.position = c->point.approx();
+    contact.points.push_back(p);
+    contact.exact.push_back(c->point);
+  }
+  return true;
+}
+
 class Classifier {
  public:
-  Classifier(const TrianglePoints& a, const TrianglePoints& b) {
+  Classifier(const TrianglePoints& a, const TrianglePoints& b) : a_(a), b_(b) {
     for (int i = 0; i < 3; ++i) {
       P_[0][i] = exactOf(a[i]);
       P_[1][i] = exactOf(b[i]);
@@ -444,9 +551,10 @@ class Classifier {
     ContactPoint c = p.tag;
     c.position = rounded(p.exact);
     contact.points.push_back(c);
-    contact.exact.push_back({{p.exact.x[0], p.exact.x[1], p.exact.x[2]}});
+    contact.exact.push_back(exactPointOf(c, a_, b_));
   }
 
+  TrianglePoints a_, b_;
   Exact3 P_[2][3];
   // Corner i of triangle t against the other triangle's plane, as an
   // integer determinant (scaled by 2^(3 scale_)).
@@ -473,6 +581,15 @@ class Classifier {
 }  // namespace
 
 TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b) {
+  int side[2][3];  // corner i of triangle t against the other triangle's plane
+  for (int i = 0; i < 3; ++i) {
+    side[0][i] = orient3d(b[0], b[1], b[2], a[i]);
+    side[1][i] = orient3d(a[0], a[1], a[2], b[i]);
+  }
+  if (strictlyOneSide(side[0]) || strictlyOneSide(side[1])) return {};
+  const bool coplanar = side[0][0] == 0 && side[0][1] == 0 && side[0][2] == 0;
+  TriangleContact contact;
+  if (!coplanar && classifyCrossing(a, b, side, contact)) return contact;
   return Classifier(a, b).run();
 }
 
@@ -503,13 +620,6 @@ RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
     }
   }
   return {{r.x[0], r.x[1], r.x[2]}};
-}
-
-int orient3d(const RationalPoint& p, const RationalPoint& q, const RationalPoint& r,
-             const RationalPoint& s) {
-  const Exact3 a{{p.x[0], p.x[1], p.x[2]}}, b{{q.x[0], q.x[1], q.x[2]}};
-  const Exact3 c{{r.x[0], r.x[1], r.x[2]}}, d{{s.x[0], s.x[1], s.x[2]}};
-  return sgn(orient3dValue(a, b, c, d));
 }
 
 }  // namespace meshmend

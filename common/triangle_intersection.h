@@ -10,8 +10,7 @@
 #include <array>
 #include <vector>
 
-#include <gmpxx.h>
-
+#include "common/exact_point.h"
 #include "common/mesh.h"
 
 namespace meshmend {
@@ -71,18 +70,13 @@ struct ContactPoint {
   Point3 position{0, 0, 0};  // the exact point, rounded to the nearest doubles
 };
 
-// A point with exact rational coordinates.
-struct RationalPoint {
-  std::array<mpq_class, 3> x;
-};
-
 struct TriangleContact {
   ContactKind kind = ContactKind::kNone;
   // kCrossing / kTouchAlongEdge: the segment's two end points; kTouchAtPoint:
   // one point; coplanar: the common polygon's corners in order (or the touching
   // point or segment).
   std::vector<ContactPoint> points;
-  std::vector<RationalPoint> exact;  // the same points' exact positions
+  std::vector<ExactPoint> exact;  // the same points, exactly
 };
 
 // The exact position of a contact point of classifyContact(a, b), from its
@@ -92,12 +86,10 @@ struct TriangleContact {
 RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
                             const TrianglePoints& b);
 
-// Exact sign of det[q-p, r-p, s-p] for rational points.
-int orient3d(const RationalPoint& p, const RationalPoint& q, const RationalPoint& r,
-             const RationalPoint& s);
-
-// Full classification with exact end points. Slower than trianglesIntersect
-// (it builds exact rational points): meant for pairs known to intersect.
+// Full classification with exact end points. Slower than trianglesIntersect:
+// meant for pairs known to intersect. Crossing triangles (the common case)
+// are classified from rounded values with error bounds; touching and
+// coplanar ones fall back to rational arithmetic.
 TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b);
 
 }  // namespace meshmend

@@ -28,9 +28,9 @@ RationalPoint on(mpq_class s,
 
 // Twice the area, projected along z (the triangle's normal has a non-zero z).
 mpq_class area2(const Patch& p, const std::array<int, 3>& t) {
-  const auto& a = p.vertices[t[0]].x;
-  const auto& b = p.vertices[t[1]].x;
-  const auto& c = p.vertices[t[2]].x;
+  const auto& a = p.vertices[t[0]].exact().x;
+  const auto& b = p.vertices[t[1]].exact().x;
+  const auto& c = p.vertices[t[2]].exact().x;
   return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
@@ -55,10 +55,11 @@ bool hasEdge(const Patch& p, int a, int b) {
   return false;
 }
 
-PatchInput input(std::vector<RationalPoint> points, std::vector<std::array<int, 2>> segments) {
+PatchInput input(const std::vector<RationalPoint>& points,
+                 std::vector<std::array<int, 2>> segments) {
   PatchInput in;
-  in.corners = kTri;
-  in.points = std::move(points);
+  for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(kTri[k]);
+  for (const RationalPoint& p : points) in.points.push_back(ExactPoint(p));
   in.segments = std::move(segments);
   return in;
 }
@@ -99,7 +100,8 @@ TEST(Retriangulate, CrossingConstraintsMeetAtTheirExactCrossing) {
   expectValidTiling(p);
   EXPECT_EQ(p.vertices.size(), 3u + 3u + 1u);  // corner 0 repeated as a point; one crossing
   EXPECT_EQ(p.constrained_edges.size(), 4u);
-  const RationalPoint& x = p.vertices.back();  // the crossing: (1/4, 1/4) in barycentric terms
+  const RationalPoint& x =
+      p.vertices.back().exact();  // the crossing: (1/4, 1/4) in barycentric terms
   const RationalPoint want = on(mpq_class(1, 4), mpq_class(1, 4));
   EXPECT_EQ(x.x, want.x);
 }

@@ -211,7 +211,7 @@ TEST(TriangleIntersection, AgreesWithCgalOnDegenerateRandomInput) {
   EXPECT_LT(intersecting, checked);
 }
 
-// The classification's end points equal CGAL's exact intersection, rounded.
+// The classification's end points equal CGAL's exact intersection.
 TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
   Generator gen(7);
   int compared = 0;
@@ -233,9 +233,9 @@ TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
       // Epeck's to_double is only an approximation: round the exact value.
       const Point3 want(CGAL::to_double(CGAL::exact(e.x())), CGAL::to_double(CGAL::exact(e.y())),
                         CGAL::to_double(CGAL::exact(e.z())));
-      bool found = false;
-      for (const ContactPoint& p : c.points)
-        found |= (p.position - want).Norm() <= 1e-15 * (1 + want.Norm());
+      bool found = false;  // our exact point, rounded the same way
+      for (const ExactPoint& p : c.exact)
+        found |= (nearestDoubles(p.exact()) - want).Norm() <= 1e-15 * (1 + want.Norm());
       EXPECT_TRUE(found) << toString(c.kind) << " want " << want[0] << " " << want[1] << " "
                          << want[2] << " got " << c.points[0].position[0] << " "
                          << c.points[0].position[1] << " " << c.points[0].position[2] << " / "
@@ -252,7 +252,7 @@ TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
 }
 
 // Every contact point, rebuilt exactly from its defining elements, lies
-// exactly on both triangles and rounds to the reported position.
+// exactly on both triangles and is within the error bound of the reported position.
 TEST(TriangleIntersection, ExactPositionsLieOnBothTriangles) {
   Generator gen(31);
   auto exactOf = [](const Point3& p) {
@@ -266,11 +266,14 @@ TEST(TriangleIntersection, ExactPositionsLieOnBothTriangles) {
     for (std::size_t i = 0; i < c.points.size(); ++i) {
       const ContactPoint& p = c.points[i];
       const RationalPoint x = exactPosition(p, a, b);
-      EXPECT_EQ(x.x, c.exact[i].x);  // the classification's own exact positions agree
+      EXPECT_EQ(x.x, c.exact[i].exact().x);  // the classification's own exact positions agree
+      for (int k = 0; k < 3; ++k)  // and their approximations are within their error bounds
+        EXPECT_LE(abs(x.x[k] - mpq_class(c.exact[i].approx()[k])), mpq_class(c.exact[i].error()));
       for (const TrianglePoints* t : {&a, &b})
         ASSERT_EQ(orient3d(exactOf((*t)[0]), exactOf((*t)[1]), exactOf((*t)[2]), x), 0)
             << toString(c.kind);
-      EXPECT_NEAR(x.x[0].get_d(), p.position[0], 1e-15 * (1 + std::fabs(p.position[0])));
+      EXPECT_NEAR(x.x[0].get_d(), p.position[0],
+                  c.exact[i].error() + 1e-15 * std::fabs(p.position[0]));
       ++checked;
     }
   }

@@ -1,0 +1,255 @@
+#include "common/exact_point.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "common/box_tree.h"
+#include "common/interval.h"
+#include "common/predicates.h"
+
+namespace meshmend {
+
+namespace {
+
+// det[s-r, t-r, p-r]
+Interval orient3dInterval(const Point3& r, const Point3& s, const Point3& t, const Point3& p) {
+  Interval b[3], c[3], d[3];
+  for (int k = 0; k < 3; ++k) {
+    b[k] = Interval(s[k]) - r[k];
+    c[k] = Interval(t[k]) - r[k];
+    d[k] = Interval(p[k]) - r[k];
+  }
+  return b[0] * (c[1] * d[2] - c[2] * d[1]) - b[1] * (c[0] * d[2] - c[2] * d[0]) +
+         b[2] * (c[0] * d[1] - c[1] * d[0]);
+}
+
+Interval orient2dInterval(const Point3& a, const Point3& b, const Point3& c, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return (Interval(b[u]) - a[u]) * (Interval(c[v]) - a[v]) -
+         (Interval(b[v]) - a[v]) * (Interval(c[u]) - a[u]);
+}
+
+// ---- exact rational helpers --------------------------------------------------------
+
+RationalPoint rationalOf(const Point3& p) {
+  return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
+}
+
+mpq_class orient3dValue(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+                        const RationalPoint& d) {
+  mpq_class m[3][3];
+  for (int k = 0; k < 3; ++k) {
+    m[0][k] = b.x[k] - a.x[k];
+    m[1][k] = c.x[k] - a.x[k];
+    m[2][k] = d.x[k] - a.x[k];
+  }
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+mpq_class orient2dValue(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+                        int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return (b.x[u] - a.x[u]) * (c.x[v] - a.x[v]) - (b.x[v] - a.x[v]) * (c.x[u] - a.x[u]);
+}
+
+// p + t (q - p)
+RationalPoint along(const RationalPoint& p, const RationalPoint& q, const mpq_class& t) {
+  RationalPoint r;
+  for (int k = 0; k < 3; ++k) {
+    r.x[k] = p.x[k] + t * (q.x[k] - p.x[k]);
+    r.x[k].canonicalize();
+  }
+  return r;
+}
+
+double nearestDouble(const mpq_class& q) {
+  const double d = q.get_d();  // truncated toward zero
+  if (mpq_class(d) == q) return d;
+  const double away = std::nextafter(d, q > 0 ? INFINITY : -INFINITY);
+  return abs(q - mpq_class(away)) < abs(q - mpq_class(d)) ? away : d;
+}
+
+// The approximation and error of a point whose coordinates lie in `x`.
+void enclose(const Interval3& x, Point3& approx, double& error) {
+  error = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double mid = 0.5 * x[k].lo + 0.5 * x[k].hi;
+    approx[k] = mid;
+    error = std::max({error, up(x[k].hi - mid), up(mid - x[k].lo)});
+  }
+  if (!std::isfinite(error)) error = INFINITY;
+}
+
+}  // namespace
+
+Point3 nearestDoubles(const RationalPoint& p) {
+  return {nearestDouble(p.x[0]), nearestDouble(p.x[1]), nearestDouble(p.x[2])};
+}
+
+ExactPoint::ExactPoint(const Point3& p) : kind_(Kind::kDouble), approx_(p), error_(0) {
+  definition_[0] = p;
+}
+
+ExactPoint::ExactPoint(const RationalPoint& p) : kind_(Kind::kRational) {
+  auto exact = std::make_shared<RationalPoint>(p);
+  for (mpq_class& c : exact->x) c.canonicalize();
+  approx_ = nearestDoubles(*exact);
+  error_ = 0;
+  for (int k = 0; k < 3; ++k)
+    if (mpq_class(approx_[k]) != exact->x[k])
+      error_ = std::max(error_, up(std::fabs(approx_[k]) * 0x1p-52 + kTiny));
+  exact_ = std::move(exact);
+}
+
+ExactPoint ExactPoint::edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                                 const Point3& t) {
+  ExactPoint e;
+  e.kind_ = Kind::kEdgePlane;
+  e.definition_ = {p, q, r, s, t};
+  const Interval sp = orient3dInterval(r, s, t, p), sq = orient3dInterval(r, s, t, q);
+  const Interval lambda = intersect(sp / (sp - sq), 0, 1);
+  Interval3 x;
+  for (int k = 0; k < 3; ++k)
+    x[k] = intersect(Interval(p[k]) + lambda * (Interval(q[k]) - p[k]), std::min(p[k], q[k]),
+                     std::max(p[k], q[k]));
+  enclose(x, e.approx_, e.error_);
+  if (!std::isfinite(e.error_)) e = ExactPoint(e.exact());  // out of double range on the way
+  return e;
+}
+
+ExactPoint ExactPoint::edgeLine(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                                int axis) {
+  ExactPoint e;
+  e.kind_ = Kind::kEdgeLine;
+  e.axis_ = std::uint8_t(axis);
+  e.definition_ = {p, q, r, s, Point3(0, 0, 0)};
+  const Interval op = orient2dInterval(r, s, p, axis), oq = orient2dInterval(r, s, q, axis);
+  const Interval lambda = intersect(op / (op - oq), 0, 1);
+  Interval3 x;
+  for (int k = 0; k < 3; ++k)
+    x[k] = intersect(Interval(p[k]) + lambda * (Interval(q[k]) - p[k]), std::min(p[k], q[k]),
+                     std::max(p[k], q[k]));
+  enclose(x, e.approx_, e.error_);
+  if (!std::isfinite(e.error_)) e = ExactPoint(e.exact());
+  return e;
+}
+
+const RationalPoint& ExactPoint::exact() const {
+  if (!exact_) computeExact();
+  return *exact_;
+}
+
+void ExactPoint::computeExact() const {
+  const auto& d = definition_;
+  switch (kind_) {
+    case Kind::kDouble:
+    case Kind::kRational:  // always present
+      exact_ = std::make_shared<RationalPoint>(rationalOf(d[0]));
+      return;
+    case Kind::kEdgePlane: {
+      const RationalPoint p = rationalOf(d[0]), q = rationalOf(d[1]);
+      const RationalPoint r = rationalOf(d[2]), s = rationalOf(d[3]), t = rationalOf(d[4]);
+      const mpq_class sp = orient3dValue(r, s, t, p), sq = orient3dValue(r, s, t, q);
+      exact_ = std::make_shared<RationalPoint>(along(p, q, sp / (sp - sq)));
+      return;
+    }
+    case Kind::kEdgeLine: {
+      const RationalPoint p = rationalOf(d[0]), q = rationalOf(d[1]);
+      const RationalPoint r = rationalOf(d[2]), s = rationalOf(d[3]);
+      const mpq_class op = orient2dValue(r, s, p, axis_), oq = orient2dValue(r, s, q, axis_);
+      exact_ = std::make_shared<RationalPoint>(along(p, q, op / (op - oq)));
+      return;
+    }
+  }
+}
+
+bool samePoint(const ExactPoint& a, const ExactPoint& b) {
+  if (a.isInputPoint() && b.isInputPoint()) return a.approx() == b.approx();
+  const double e = up(a.error() + b.error());
+  for (int k = 0; k < 3; ++k)
+    if (std::fabs(a.approx()[k] - b.approx()[k]) > up(e)) return false;
+  const RationalPoint &x = a.exact(), &y = b.exact();
+  return x.x[0] == y.x[0] && x.x[1] == y.x[1] && x.x[2] == y.x[2];
+}
+
+int compareCoordinate(const ExactPoint& a, const ExactPoint& b, int k) {
+  const double d = a.approx()[k] - b.approx()[k];
+  if (a.error() == 0 && b.error() == 0) return (d > 0) - (d < 0);  // exact sign of a difference
+  const double bound = up(up(a.error() + b.error()) + std::fabs(d) * kRelative);
+  if (d > bound) return 1;
+  if (-d > bound) return -1;
+  return sgn(a.exact().x[k] - b.exact().x[k]);
+}
+
+int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c, int axis) {
+  if (a.isInputPoint() && b.isInputPoint() && c.isInputPoint())
+    return orient2dDropping(a.approx(), b.approx(), c.approx(), axis);
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const Interval3 pa = intervalOf(a), pb = intervalOf(b), pc = intervalOf(c);
+  const Interval det = (pb[u] - pa[u]) * (pc[v] - pa[v]) - (pb[v] - pa[v]) * (pc[u] - pa[u]);
+  if (det.positive()) return 1;
+  if (det.negative()) return -1;
+  return sgn(orient2dValue(a.exact(), b.exact(), c.exact(), axis));
+}
+
+bool onSegment(const ExactPoint& p, const ExactPoint& a, const ExactPoint& b) {
+  for (int k = 0; k < 3; ++k)  // between a and b, coordinate by coordinate
+    if (compareCoordinate(p, a, k) * compareCoordinate(b, p, k) < 0) return false;
+  if (p.isInputPoint() && a.isInputPoint() && b.isInputPoint())
+    return collinear(p.approx(), a.approx(), b.approx());
+  // (p - a) x (b - a) == 0
+  const Interval3 x = intervalOf(p), y = intervalOf(a), z = intervalOf(b);
+  for (int k = 0; k < 3; ++k) {
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    const Interval c = (x[u] - y[u]) * (z[v] - y[v]) - (x[v] - y[v]) * (z[u] - y[u]);
+    if (c.positive() || c.negative()) return false;
+  }
+  const RationalPoint &P = p.exact(), &A = a.exact(), &B = b.exact();
+  for (int k = 0; k < 3; ++k) {
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    if ((P.x[u] - A.x[u]) * (B.x[v] - A.x[v]) != (P.x[v] - A.x[v]) * (B.x[u] - A.x[u]))
+      return false;
+  }
+  return true;
+}
+
+int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+             const RationalPoint& d) {
+  return sgn(orient3dValue(a, b, c, d));
+}
+
+std::vector<int> coincidentGroups(const std::vector<const ExactPoint*>& points) {
+  std::vector<int> parent(points.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  if (points.size() < 2) return parent;
+  std::vector<Box> boxes(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point3& a = points[i]->approx();
+    const double e = points[i]->error();
+    const Point3 lo(down(a[0] - e), down(a[1] - e), down(a[2] - e));
+    const Point3 hi(up(a[0] + e), up(a[1] + e), up(a[2] + e));
+    boxes[i] = boxOf(lo, hi, hi);
+  }
+  const BoxTree tree(boxes);
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> candidates(workerCount());
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
+    candidates[worker].push_back({i, j});
+  });
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& list : candidates)  // sequential: exact values are computed on demand
+    for (const auto& [i, j] : list) {
+      const int ri = find(int(i)), rj = find(int(j));
+      if (ri != rj && samePoint(*points[i], *points[j]))
+        parent[std::max(ri, rj)] = std::min(ri, rj);
+    }
+  for (std::size_t i = 0; i < points.size(); ++i) parent[i] = find(int(i));
+  return parent;
+}
+
+}  // namespace meshmend

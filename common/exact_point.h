@@ -1,0 +1,99 @@
+// Points known exactly by their construction from input doubles (DESIGN §4).
+//
+// An intersection point (an edge crossing a plane, two coplanar edges
+// crossing) has rational coordinates whose exact value is costly to compute
+// and to compare. An ExactPoint carries its construction, a rounded
+// approximation and a rigorous bound on that approximation's error; the
+// predicates below decide from the approximation whenever the bound allows
+// and compute the exact rational value (once per point, on first use) only
+// when it does not, so that the common case never touches GMP.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include <gmpxx.h>
+
+#include "common/interval.h"
+#include "common/mesh.h"
+
+namespace meshmend {
+
+// A point with exact rational coordinates.
+struct RationalPoint {
+  std::array<mpq_class, 3> x;
+};
+
+class ExactPoint {
+ public:
+  ExactPoint() = default;
+  explicit ExactPoint(const Point3& p);         // an input point (exactly its doubles)
+  explicit ExactPoint(const RationalPoint& p);  // a given rational point
+
+  // Where segment pq crosses the plane through r, s, t; p and q must lie
+  // strictly on opposite sides of that plane.
+  static ExactPoint edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                              const Point3& t);
+  // Coplanar: where segment pq crosses the line through r and s, in the
+  // projection that drops `axis`; p and q strictly on opposite sides of it.
+  static ExactPoint edgeLine(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                             int axis);
+
+  // |approx()[k] - exact k-th coordinate| <= error() for k = 0, 1, 2.
+  const Point3& approx() const { return approx_; }
+  double error() const { return error_; }
+  bool isInputPoint() const { return kind_ == Kind::kDouble; }
+
+  // The exact coordinates, computed on first use. Not safe to call from two
+  // threads on one object (copies are independent).
+  const RationalPoint& exact() const;
+
+ private:
+  enum class Kind : std::uint8_t { kDouble, kRational, kEdgePlane, kEdgeLine };
+  void computeExact() const;
+
+  Kind kind_ = Kind::kDouble;
+  std::uint8_t axis_ = 0;
+  std::array<Point3, 5> definition_{};  // the input points of the construction
+  Point3 approx_{0, 0, 0};
+  double error_ = 0;
+  mutable std::shared_ptr<const RationalPoint> exact_;
+};
+
+// The box of coordinates the exact point may have, as intervals.
+inline Interval3 intervalOf(const ExactPoint& p) {
+  const double e = p.error();
+  const Point3& a = p.approx();
+  if (e == 0) return intervalOf(a);
+  return {Interval(down(a[0] - e), up(a[0] + e)), Interval(down(a[1] - e), up(a[1] + e)),
+          Interval(down(a[2] - e), up(a[2] + e))};
+}
+
+// Exact predicates on ExactPoints (filtered).
+
+// Do a and b have the same exact coordinates?
+bool samePoint(const ExactPoint& a, const ExactPoint& b);
+
+// Sign of a[k] - b[k].
+int compareCoordinate(const ExactPoint& a, const ExactPoint& b, int k);
+
+// Sign of the orientation of (a, b, c) projected onto the plane that drops
+// `axis` (coordinates (axis+1)%3, (axis+2)%3): +1 counter-clockwise.
+int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c, int axis);
+
+// Is p on the closed segment ab (collinear in 3-D and between them)?
+bool onSegment(const ExactPoint& p, const ExactPoint& a, const ExactPoint& b);
+
+// Sign of det[b-a, c-a, d-a] on exact rational points.
+int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+             const RationalPoint& d);
+
+// The double nearest to each coordinate.
+Point3 nearestDoubles(const RationalPoint& p);
+
+// Representatives of exactly coincident points: result[i] is the smallest
+// index j with samePoint(points[j], points[i]). Sorts by the approximations
+// and compares exactly only where their error boxes overlap.
+std::vector<int> coincidentGroups(const std::vector<const ExactPoint*>& points);
+
+}  // namespace meshmend
