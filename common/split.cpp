@@ -368,6 +368,35 @@ class MeshSplitter {
   std::unordered_map<int, int> pointOfVertex_;
 };
 
+// Removes faces with the same three vertices as an earlier face (in any
+// order): the same surface twice, which would intersect itself everywhere.
+std::size_t removeDuplicateFaces(WeldedArrays& in) {
+  std::vector<std::array<int, 3>> keys(in.mesh.triangles.size());
+  std::vector<std::uint32_t> order(keys.size());
+  for (std::size_t f = 0; f < keys.size(); ++f) {
+    keys[f] = in.mesh.triangles[f];
+    std::sort(keys[f].begin(), keys[f].end());
+    order[f] = std::uint32_t(f);
+  }
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
+  });
+  std::vector<char> drop(keys.size(), 0);
+  for (std::size_t i = 1; i < order.size(); ++i)
+    drop[order[i]] = keys[order[i]] == keys[order[i - 1]];
+  std::size_t kept = 0;
+  for (std::size_t f = 0; f < keys.size(); ++f)
+    if (!drop[f]) {
+      in.mesh.triangles[kept] = in.mesh.triangles[f];
+      in.face_origin[kept] = in.face_origin[f];
+      ++kept;
+    }
+  const std::size_t removed = keys.size() - kept;
+  in.mesh.triangles.resize(kept);
+  in.face_origin.resize(kept);
+  return removed;
+}
+
 // Closed and open components of a curve graph.
 void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& edges,
                  std::size_t& loops, std::size_t& open) {
@@ -412,6 +441,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       in.face_origin.resize(in.mesh.triangles.size());
       std::iota(in.face_origin.begin(), in.face_origin.end(), 0);
     }
+    if (options.remove_duplicate_faces) r.duplicate_faces_removed += removeDuplicateFaces(in);
   }
   std::vector<const MeshArrays*> arrays;
   for (const WeldedArrays& in : inputs) arrays.push_back(&in.mesh);
@@ -725,6 +755,7 @@ JsonObject toJson(const SplitResult& r) {
       .set("new_vertices", r.new_vertices)
       .set("degenerate_faces_kept", r.degenerate_faces_kept)
       .set("vertices_welded", r.vertices_welded)
+      .set("duplicate_faces_removed", r.duplicate_faces_removed)
       .set("time_ms", r.time_ms);
   return j;
 }

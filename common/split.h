@@ -19,6 +19,10 @@ struct SplitOptions {
   bool between_meshes = true;    // insert the curves where different meshes meet
   bool self = false;             // also split each mesh along its own self-intersections
   bool weld_duplicates = false;  // first merge exact-duplicate vertices (scan seams) in each mesh
+  // First remove faces with the same three vertices as another face of their
+  // mesh (after welding): the same surface twice, intersecting itself
+  // everywhere (decimated scans have them). The first of each group stays.
+  bool remove_duplicate_faces = false;
   bool weld = true;   // merged output: one vertex per curve point (meshes welded along curves)
   Progress progress;  // called between stages
 };
@@ -45,6 +49,7 @@ struct SplitResult {
   std::size_t new_vertices = 0;           // curve points that are not input vertices
   std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
   std::size_t vertices_welded = 0;        // duplicates merged first (weld_duplicates)
+  std::size_t duplicate_faces_removed = 0;  // remove_duplicate_faces
   std::size_t curve_loops = 0;            // closed curve components (merged output)
   std::size_t open_curves = 0;            // curve components with end points
   double time_ms = 0;

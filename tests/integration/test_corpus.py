@@ -155,6 +155,26 @@ def test_split_bunny_and_dragon_full_is_free_of_intersections(tmp_path):
     assert check["border_loops"] == 5
 
 
+@pytest.mark.parametrize("res", [2, 3, 4])
+def test_split_decimated_bunny_and_dragon_is_free_of_intersections(tmp_path, res):
+    """The decimated pairs have duplicate faces (the same surface twice) and
+    non-manifold edges: the sample removes the duplicates and splits the rest."""
+    require_shared_data()
+    inputs = [DATA / "stanford" / f"bun_zipper_res{res}.ply",
+              DATA / "stanford" / f"dragon_vrip_res{res}.ply"]
+    duplicates = sum(meshcheck(p)["duplicate_faces"] for p in inputs)
+    out = tmp_path / "merged.ply"
+    script = (ROOT / "samples" / "intersect_split.mlx").read_text().replace(
+        'name="report_file" value=""', 'name="report_file" value="{report0}"')
+    run = run_server(tmp_path, inputs, script, outputs=[out])
+    assert run.returncode == 0, run.log[-2000:]
+    r, check = run.report, meshcheck(out)
+    assert duplicates > 0 and r["duplicate_faces_removed"] == duplicates
+    assert r["remaining_intersecting_pairs"] == 0
+    assert check["self_intersecting_pairs"] == 0
+    assert check["duplicate_faces"] == 0
+
+
 @pytest.mark.parametrize("name", ["self_intersecting/cow.off", "self_intersecting/pig.off",
                                   "self_intersecting/self_intersectA.obj"])
 def test_split_along_own_self_intersections(tmp_path, name):
