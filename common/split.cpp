@@ -144,6 +144,23 @@ class CurvePoints {
   std::map<std::pair<std::uint32_t, int>, int> inputVertex_;
 };
 
+// An output mesh as arrays, with the provenance of every element.
+struct OutputArrays {
+  std::vector<Point3> positions;
+  std::vector<Triangle> triangles;
+  std::vector<VertexOrigin> vertex_origin;
+  std::vector<FaceOrigin> face_origin;
+
+  Mesh toMesh() const {
+    Mesh mesh = makeMesh(positions, triangles);
+    VertexOriginHandle vo = vertexOrigins(mesh);
+    FaceOriginHandle fo = faceOrigins(mesh);
+    for (std::size_t v = 0; v < vertex_origin.size(); ++v) vo[v] = vertex_origin[v];
+    for (std::size_t f = 0; f < face_origin.size(); ++f) fo[f] = face_origin[f];
+    return mesh;
+  }
+};
+
 // The curve points and segments one face receives (representative ids).
 struct FaceWork {
   std::vector<int> points;
@@ -254,19 +271,22 @@ class MeshSplitter {
 
   // Builds the output mesh and its curve edges; `exactNew` receives the
   // exact positions of the new vertices.
-  void build(const CurvePoints& table, Mesh& out, std::vector<std::array<int, 2>>& curves,
+  void build(const CurvePoints& table, OutputArrays& out, std::vector<std::array<int, 2>>& curves,
              std::vector<ExactPoint>& exactNew, std::size_t& facesAdded) {
-    std::vector<Point3> positions = points_;
-    std::vector<Triangle> triangles;
-    std::vector<FaceOrigin> birthFaces;
-    std::vector<VertexOrigin> newOrigins;
+    std::vector<Point3>& positions = out.positions;
+    std::vector<Triangle>& triangles = out.triangles;
+    std::vector<FaceOrigin>& birthFaces = out.face_origin;
+    std::vector<VertexOrigin>& origins = out.vertex_origin;
+    positions = points_;
+    for (std::size_t v = 0; v < points_.size(); ++v)
+      origins.push_back({int(index_), vertexOrigin_[v], -1, {}});
     std::unordered_map<int, int> vertexOfPoint;              // curve point id -> output vertex
     std::map<RationalPoint, int, ExactLess> crossingPoints;  // made inside one face
     auto newVertex = [&](const ExactPoint& p, std::uint32_t f) {
       positions.push_back(p.approx());
       exactNew.push_back(p);
       const TrianglePoints t = at(f);
-      newOrigins.push_back(
+      origins.push_back(
           {int(index_), -1, faceOrigin_[f], barycentric(p.approx(), t[0], t[1], t[2])});
       return int(positions.size()) - 1;
     };
@@ -323,13 +343,6 @@ class MeshSplitter {
         curveSet.insert(g);
       }
     }
-    out = makeMesh(positions, triangles, int(index_));
-    VertexOriginHandle vo = vertexOrigins(out);
-    for (std::size_t v = 0; v < points_.size(); ++v)
-      vo[v] = {int(index_), vertexOrigin_[v], -1, {}};
-    for (std::size_t i = 0; i < newOrigins.size(); ++i) vo[points_.size() + i] = newOrigins[i];
-    FaceOriginHandle fo = faceOrigins(out);
-    for (std::size_t f = 0; f < birthFaces.size(); ++f) fo[f] = birthFaces[f];
     curves.assign(curveSet.begin(), curveSet.end());
     facesAdded += triangles.size() - triangles_.size();
   }
@@ -479,12 +492,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
   reportProgress(options.progress, 55, "Re-triangulating crossed faces");
   std::vector<std::vector<ExactPoint>> exactNew(meshes.size());
-  r.meshes.resize(meshes.size());
+  std::vector<OutputArrays> outputs(meshes.size());
   r.curve_edges.resize(meshes.size());
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     splitters[m].shareEdgePoints(table);
     splitters[m].retriangulateFaces(table);
-    splitters[m].build(table, r.meshes[m], r.curve_edges[m], exactNew[m], r.faces_added);
+    splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], r.faces_added);
     r.faces_split += splitters[m].facesSplit();
     r.degenerate_faces_kept += splitters[m].degenerateKept();
     r.new_vertices += exactNew[m].size();
@@ -499,9 +512,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     std::unordered_map<int, int> curvePointOfId;
     std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
     for (std::size_t m = 0; m < meshes.size(); ++m) {
-      const Mesh& mesh = r.meshes[m];
+      const OutputArrays& mesh = outputs[m];
       std::vector<int>& index = curveIndex[m];
-      index.assign(mesh.vert.size(), -1);
+      index.assign(mesh.positions.size(), -1);
       const auto& pointOfVertex = splitters[m].pointOfVertex();
       auto mark = [&](int v) {
         if (index[v] >= 0) return;
@@ -514,7 +527,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         }
         index[v] = int(curvePoints.size());
         const std::size_t inputVertices = splitters[m].points().size();
-        curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.vert[v].cP())
+        curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.positions[v])
                                                              : exactNew[m][v - inputVertices]);
       };
       for (const auto& e : r.curve_edges[m]) mark(e[0]), mark(e[1]);
@@ -524,17 +537,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     for (const ExactPoint& p : curvePoints) curvePointers.push_back(&p);
     const std::vector<int> weldedTo = coincidentGroups(curvePointers);
     std::vector<int> mergedOfCurvePoint(curvePoints.size(), -1);
-    std::vector<Point3> positions;
-    std::vector<Triangle> triangles;
-    std::vector<VertexOrigin> vertexOrigin;
-    std::vector<FaceOrigin> faceOrigin;
+    OutputArrays merged;
+    std::vector<Point3>& positions = merged.positions;
     std::set<std::array<int, 2>> curves;
     for (std::size_t m = 0; m < meshes.size(); ++m) {
-      Mesh& mesh = r.meshes[m];
-      VertexOriginHandle vo = vertexOrigins(mesh);
-      FaceOriginHandle fo = faceOrigins(mesh);
-      std::vector<int>& global = r.merged_vertex.emplace_back(mesh.vert.size());
-      for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
+      const OutputArrays& mesh = outputs[m];
+      std::vector<int>& global = r.merged_vertex.emplace_back(mesh.positions.size());
+      for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
         const int c = curveIndex[m][v];
         if (c >= 0) {
           int& target = mergedOfCurvePoint[weldedTo[c]];
@@ -545,15 +554,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
           target = int(positions.size());
         }
         global[v] = int(positions.size());
-        positions.push_back(mesh.vert[v].cP());
-        vertexOrigin.push_back(vo[v]);
+        positions.push_back(mesh.positions[v]);
+        merged.vertex_origin.push_back(mesh.vertex_origin[v]);
       }
-      for (std::size_t f = 0; f < mesh.face.size(); ++f) {
-        const Face& face = mesh.face[f];
-        triangles.push_back({global[vcg::tri::Index(mesh, face.cV(0))],
-                             global[vcg::tri::Index(mesh, face.cV(1))],
-                             global[vcg::tri::Index(mesh, face.cV(2))]});
-        faceOrigin.push_back(fo[f]);
+      for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+        const Triangle& t = mesh.triangles[f];
+        merged.triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
+        merged.face_origin.push_back(mesh.face_origin[f]);
         r.merged_new_face.push_back(f >= splitters[m].keptFaces());
       }
       for (const auto& e : r.curve_edges[m]) {
@@ -562,11 +569,11 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         curves.insert(g);
       }
     }
-    r.merged = makeMesh(positions, triangles);
-    VertexOriginHandle vo = vertexOrigins(r.merged);
-    FaceOriginHandle fo = faceOrigins(r.merged);
-    for (std::size_t v = 0; v < vertexOrigin.size(); ++v) vo[v] = vertexOrigin[v];
-    for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
+    r.merged = merged.toMesh();
+    if (options.separate_meshes) {
+      r.meshes.resize(meshes.size());
+      for (std::size_t m = 0; m < meshes.size(); ++m) r.meshes[m] = outputs[m].toMesh();
+    }
     r.merged_curve_edges.assign(curves.begin(), curves.end());
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
   }
@@ -636,16 +643,45 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   for (std::uint32_t f : changed)
     changedBoxes.push_back(widened(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]])));
   const BoxTree tree(changedBoxes);
+  // A coarse grid of the cells that changed boxes touch turns away, cheaply,
+  // the faces far from every changed face (most of a large mesh).
+  const Box& bounds = tree.bounds();
+  constexpr int kCells = 64;
+  float cellSize[3];
+  for (int k = 0; k < 3; ++k)
+    cellSize[k] = std::max((bounds.hi[k] - bounds.lo[k]) / kCells, 1e-30f);
+  auto cellRange = [&](const Box& b, int k, int& lo, int& hi) {
+    lo = std::clamp(int((b.lo[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
+    hi = std::clamp(int((b.hi[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
+  };
+  std::vector<char> occupied(kCells * kCells * kCells, 0);
+  for (const Box& b : changedBoxes) {
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z) occupied[(x * kCells + y) * kCells + z] = 1;
+  }
+  auto nearChanged = [&](const Box& b) {
+    if (!overlap(b, bounds)) return false;
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          if (occupied[(x * kCells + y) * kCells + z]) return true;
+    return false;
+  };
   std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
   parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
     for (std::size_t g = begin; g < end; ++g) {
       Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
       if (changedIndex[g] >= 0) b = widened(b);
+      if (!nearChanged(b)) continue;
       tree.query(b, worker, [&](std::uint32_t i, unsigned) {
         const std::uint32_t f = changed[i];
         // A pair of two changed faces is found from both sides: keep one.
-        if (f != g && (changedIndex[g] < 0 || f < g))
-          found[worker].push_back({f, std::uint32_t(g)});
+        if (f != g && (changedIndex[g] < 0 || f < g)) found[worker].push_back({f, std::uint32_t(g)});
       });
     }
   });
@@ -679,9 +715,15 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   }
 
   auto at = [&](std::uint32_t f) -> TrianglePoints { return {P[T[f][0]], P[T[f][1]], P[T[f][2]]}; };
+  // Degenerate faces never count; the flags of changed faces follow their vertices.
+  std::vector<char> degenerate(T.size(), 0);
+  auto updateDegenerate = [&](std::uint32_t f) {
+    degenerate[f] = collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+  };
+  for (const auto& [f, g] : pairs) updateDegenerate(f), updateDegenerate(g);
   auto crosses = [&](std::uint32_t f, std::uint32_t g) {
+    if (degenerate[f] || degenerate[g]) return false;
     const TrianglePoints a = at(f), b = at(g);
-    if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
     const SharedCorners c = sharedCorners(T[f], T[g]);
     return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
   };
@@ -722,15 +764,19 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
     for (int v : candidates) {
       const Point3 e = exact[v];
       Point3 best = P[v];
-      std::size_t bestCount = localCrossings(v);
+      std::size_t bestCount = localCrossings(v);  // (flags of its faces are current here)
       for (int choice = 0; choice < 8 && bestCount > 0; ++choice) {
         P[v] =
             Point3(choice & 1 ? above(e[0]) : below(e[0]), choice & 2 ? above(e[1]) : below(e[1]),
                    choice & 4 ? above(e[2]) : below(e[2]));
+        for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k)
+          updateDegenerate(around[k]);
         const std::size_t n = localCrossings(v);
         if (n < bestCount) best = P[v], bestCount = n;
       }
       P[v] = best;
+      for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k)
+        updateDegenerate(around[k]);
     }
   }
   // Write the float positions back, to the merged output and to each mesh.

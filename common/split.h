@@ -23,14 +23,15 @@ struct SplitOptions {
   // mesh (after welding): the same surface twice, intersecting itself
   // everywhere (decimated scans have them). The first of each group stays.
   bool remove_duplicate_faces = false;
-  bool weld = true;   // merged output: one vertex per curve point (meshes welded along curves)
+  bool separate_meshes = true;  // also build `meshes` (one output per input); else merged only
   Progress progress;  // called between stages
 };
 
 struct SplitResult {
   // Per input mesh: the mesh with the curves inserted (input vertices first,
   // in their order, then the new ones; provenance records every element's
-  // birth), and its curve edges (pairs of vertex indices).
+  // birth), and its curve edges (pairs of vertex indices). Empty unless
+  // options.separate_meshes.
   std::vector<Mesh> meshes;
   std::vector<std::vector<std::array<int, 2>>> curve_edges;
   // All meshes in one, welded along the curves: the curves become

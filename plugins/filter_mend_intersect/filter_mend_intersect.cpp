@@ -260,6 +260,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.remove_duplicate_faces = parameters.getBool("remove_duplicate_faces");
   options.progress = progressFrom(cb);
   const bool merge = parameters.getEnum("output") == 1;
+  options.separate_meshes = !merge;
   SplitResult r = splitAlongIntersections(in.meshes, options);
   if (r.intersecting_pairs == 0)
     throw InvalidInputError(mode == kWithinCurrent
