@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "common/errors.h"
 
@@ -65,21 +66,35 @@ MeshArrays arraysOf(const Mesh& mesh) {
 
 WeldedArrays weldCoincident(const MeshArrays& in) {
   const std::vector<Point3>& points = in.points;
-  std::vector<int> order(points.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = int(i);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    const Point3 &p = points[a], &q = points[b];
-    if (p[0] != q[0]) return p[0] < q[0];
-    if (p[1] != q[1]) return p[1] < q[1];
-    if (p[2] != q[2]) return p[2] < q[2];
-    return a < b;
-  });
+  // Each vertex goes to the first vertex with its exact coordinates, found
+  // in an open-addressing table keyed by the coordinates' bits.
+  std::size_t capacity = 16;
+  while (capacity < 2 * points.size()) capacity *= 2;
+  std::vector<int> table(capacity, -1);
+  auto hash = [](const Point3& p) {
+    std::uint64_t h = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = p[k] == 0 ? 0.0 : p[k];  // -0 and +0 are the same coordinate
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h = (h ^ bits) * 0x9E3779B97F4A7C15ull;
+      h ^= h >> 32;
+    }
+    return h;
+  };
   std::vector<int> target(points.size());
   WeldedArrays w;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const bool same = i > 0 && points[order[i]] == points[order[i - 1]];
-    target[order[i]] = same ? target[order[i - 1]] : order[i];
-    w.vertices_merged += same;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::size_t slot = hash(points[i]) & (capacity - 1);
+    while (table[slot] >= 0 && !(points[table[slot]] == points[i]))
+      slot = (slot + 1) & (capacity - 1);
+    if (table[slot] < 0) {
+      table[slot] = int(i);
+      target[i] = int(i);
+    } else {
+      target[i] = table[slot];
+      ++w.vertices_merged;
+    }
   }
   // Keep every vertex that is not a merged duplicate; renumber.
   std::vector<int> index(points.size(), -1);

@@ -384,27 +384,38 @@ class MeshSplitter {
 // Removes faces with the same three vertices as an earlier face (in any
 // order): the same surface twice, which would intersect itself everywhere.
 std::size_t removeDuplicateFaces(WeldedArrays& in) {
-  std::vector<std::array<int, 3>> keys(in.mesh.triangles.size());
-  std::vector<std::uint32_t> order(keys.size());
-  for (std::size_t f = 0; f < keys.size(); ++f) {
-    keys[f] = in.mesh.triangles[f];
-    std::sort(keys[f].begin(), keys[f].end());
-    order[f] = std::uint32_t(f);
+  const std::vector<Triangle>& triangles = in.mesh.triangles;
+  auto sorted = [&](std::size_t f) {
+    Triangle t = triangles[f];
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  // Open-addressing table of the first face with each vertex set.
+  std::size_t capacity = 16;
+  while (capacity < 2 * triangles.size()) capacity *= 2;
+  std::vector<int> table(capacity, -1);
+  std::vector<char> drop(triangles.size(), 0);
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    const Triangle key = sorted(f);
+    std::uint64_t h = 0;
+    for (int v : key)
+      h = (h ^ std::uint64_t(std::uint32_t(v))) * 0x9E3779B97F4A7C15ull, h ^= h >> 29;
+    std::size_t slot = h & (capacity - 1);
+    while (table[slot] >= 0 && sorted(std::size_t(table[slot])) != key)
+      slot = (slot + 1) & (capacity - 1);
+    if (table[slot] < 0)
+      table[slot] = int(f);
+    else
+      drop[f] = 1;
   }
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
-  });
-  std::vector<char> drop(keys.size(), 0);
-  for (std::size_t i = 1; i < order.size(); ++i)
-    drop[order[i]] = keys[order[i]] == keys[order[i - 1]];
   std::size_t kept = 0;
-  for (std::size_t f = 0; f < keys.size(); ++f)
+  for (std::size_t f = 0; f < drop.size(); ++f)
     if (!drop[f]) {
       in.mesh.triangles[kept] = in.mesh.triangles[f];
       in.face_origin[kept] = in.face_origin[f];
       ++kept;
     }
-  const std::size_t removed = keys.size() - kept;
+  const std::size_t removed = drop.size() - kept;
   in.mesh.triangles.resize(kept);
   in.face_origin.resize(kept);
   return removed;
@@ -681,7 +692,8 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
       tree.query(b, worker, [&](std::uint32_t i, unsigned) {
         const std::uint32_t f = changed[i];
         // A pair of two changed faces is found from both sides: keep one.
-        if (f != g && (changedIndex[g] < 0 || f < g)) found[worker].push_back({f, std::uint32_t(g)});
+        if (f != g && (changedIndex[g] < 0 || f < g))
+          found[worker].push_back({f, std::uint32_t(g)});
       });
     }
   });
