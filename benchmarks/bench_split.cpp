@@ -1,11 +1,17 @@
-// bench_split [--repeat N] [--limit S] A B: intersect-and-split, ours against
-// CGAL 5.5 on the same inputs in the same run. Prints one JSON object.
+// bench_split [--repeat N] [--limit S] [--sample] [--autorefine] A B:
+// intersect-and-split, ours against CGAL 5.5 on the same inputs in the same
+// run. Prints one JSON object.
 //
-// Ours: splitAlongIntersections (curves inserted into both meshes, welded
-// output built). CGAL: PMP::corefine on two Surface_mesh copies (the same
-// job: both meshes refined along their intersection), which needs valid,
-// non-self-intersecting inputs near the intersection; each method runs
-// under a time limit (--limit).
+// Ours: splitAlongIntersections (curves inserted into both meshes, both
+// refined meshes and the welded one built). With --sample, ours runs the
+// configuration of samples/intersect_split.mlx instead (seams welded,
+// duplicate faces removed, self-intersections split too, merged output,
+// rounded to float): the filter's own work. CGAL: PMP::corefine on two
+// Surface_mesh copies (the same job: both meshes refined along their
+// intersection), which needs valid, non-self-intersecting inputs near the
+// intersection; with --autorefine also PMP::experimental::autorefine of the
+// two joined into one mesh (CGAL 5.5's only way to refine a mesh along its
+// own self-intersections). Each method runs under a time limit (--limit).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -28,9 +34,14 @@ namespace {}  // namespace
 
 int main(int argc, char** argv) {
   int repeat = 3, limit = 600;
+  bool sample = false, autorefine = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+    if (!std::strcmp(argv[i], "--sample"))
+      sample = true;
+    else if (!std::strcmp(argv[i], "--autorefine"))
+      autorefine = true;
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
       repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
       limit = std::atoi(argv[++i]);
@@ -43,11 +54,18 @@ int main(int argc, char** argv) {
   }
   const std::string a = files[0], b = files[1];
   std::vector<Method> methods;
-  methods.push_back({"meshmend_split", "ours", [=] {
+  methods.push_back({sample ? "meshmend_split_sample" : "meshmend_split", "ours", [=] {
                        auto ma = std::make_shared<Mesh>(readMesh(a));
                        auto mb = std::make_shared<Mesh>(readMesh(b));
                        return std::function<long()>([=] {
-                         return long(splitAlongIntersections({ma.get(), mb.get()}).faces_split);
+                         SplitOptions o;
+                         if (sample) {
+                           o.self = o.weld_duplicates = o.remove_duplicate_faces = true;
+                           o.separate_meshes = false;
+                         }
+                         SplitResult r = splitAlongIntersections({ma.get(), mb.get()}, o);
+                         if (sample && roundToFloat(r) != 0) return -1L;
+                         return long(r.faces_split);
                        });
                      }});
   methods.push_back({"cgal_corefine", "peer", [=] {
@@ -59,6 +77,16 @@ int main(int argc, char** argv) {
                          return long(x.number_of_faces() + y.number_of_faces());
                        });
                      }});
+  if (autorefine)
+    methods.push_back({"cgal_autorefine", "peer", [=] {
+                         auto joined = std::make_shared<SurfaceMesh>(
+                             toSurfaceMesh(appended(readMesh(a), readMesh(b))));
+                         return std::function<long()>([=] {
+                           SurfaceMesh x = *joined;
+                           PMP::experimental::autorefine(x);
+                           return long(x.number_of_faces());
+                         });
+                       }});
   std::vector<JsonObject> results;
   for (const Method& m : methods) {
     const Measurement r = measure(m, repeat, limit);

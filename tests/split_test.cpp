@@ -171,6 +171,53 @@ TEST(Split, PointOnASharedEdgeSplitsBothFaces) {
   EXPECT_EQ(remainingIntersections(r, false), 0u);
 }
 
+TEST(Split, CoplanarOverlappingTriangles) {
+  // Two triangles of different meshes in one plane, overlapping in the
+  // triangle (1,1) (3,1) (1,3): both are cut along its outline, and both
+  // then hold it as one face (the merged output welds the two copies).
+  const Mesh a = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}});
+  const Mesh b = makeMesh({{1, 1, 0}, {5, 1, 0}, {1, 5, 0}}, {{0, 1, 2}});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(r.intersecting_pairs, 1u);
+  EXPECT_EQ(r.faces_split, 2u);
+  EXPECT_GT(r.meshes[0].fn, 1);
+  EXPECT_GT(r.meshes[1].fn, 1);
+  EXPECT_EQ(r.merged_curve_edges.size(), 3u);  // the overlap's outline, shared by both
+  EXPECT_EQ(r.curve_loops, 1u);
+  EXPECT_EQ(r.open_curves, 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(merged.duplicate_faces, 1u);  // the overlap, once from each mesh
+}
+
+TEST(Split, TJunctionOfTwoCurvesInOneFace) {
+  // Two thin plates cross a big triangle and each other: the curves meet at
+  // a point inside the triangle (a curve ending on another).
+  const Mesh big = makeMesh({{-4, -4, 0}, {4, -4, 0}, {0, 4, 0}}, {{0, 1, 2}});
+  const Mesh plateX = makeMesh({{-1, 0, -1}, {1, 0, -1}, {0, 0, 1}}, {{0, 1, 2}});
+  const Mesh plateY = makeMesh({{0, -1, -1}, {0, 1, -1}, {0, 0.5, 1}}, {{0, 1, 2}});
+  const SplitResult r = splitAlongIntersections({&big, &plateX, &plateY});
+  EXPECT_EQ(r.intersecting_pairs, 3u);
+  EXPECT_EQ(r.faces_split, 3u);
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+}
+
+TEST(Split, DuplicateFacesAreRemovedFirst) {
+  // The same face twice (opposite orientations) crossed by a plate.
+  const Mesh sheet = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}, {0, 2, 1}});
+  const Mesh plate = makeMesh({{1, 1, -1}, {1, 1, 1}, {3, 0.5, 0}}, {{0, 1, 2}});
+  SplitOptions keep;
+  const SplitResult kept = splitAlongIntersections({&sheet, &plate}, keep);
+  EXPECT_GT(remainingIntersections(kept, false), 0u);  // the duplicate intersects its twin
+  SplitOptions remove;
+  remove.remove_duplicate_faces = true;
+  SplitResult r = splitAlongIntersections({&sheet, &plate}, remove);
+  EXPECT_EQ(r.duplicate_faces_removed, 1u);
+  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  FaceOriginHandle birth = faceOrigins(r.meshes[0]);
+  for (std::size_t f = 0; f < r.meshes[0].face.size(); ++f)
+    EXPECT_EQ(birth[f].face, 0);  // the first of the two stays, and its pieces say so
+}
+
 TEST(Split, NoIntersectionLeavesTheMeshes) {
   const Mesh a = box(), b = moved(box(), {5, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});
