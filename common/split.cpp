@@ -799,6 +799,24 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   return remaining;
 }
 
+std::vector<std::uint8_t> curveEdgeFlags(const Mesh& mesh,
+                                         const std::vector<std::array<int, 2>>& curveEdges) {
+  std::set<std::array<int, 2>> curves;
+  for (auto e : curveEdges) {
+    if (e[0] > e[1]) std::swap(e[0], e[1]);
+    curves.insert(e);
+  }
+  const std::vector<Triangle> triangles = trianglesOf(mesh);
+  std::vector<std::uint8_t> flags(triangles.size(), 0);
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      std::array<int, 2> e{triangles[f][i], triangles[f][(i + 1) % 3]};
+      if (e[0] > e[1]) std::swap(e[0], e[1]);
+      if (curves.count(e)) flags[f] |= std::uint8_t(1 << i);
+    }
+  return flags;
+}
+
 JsonObject toJson(const SplitResult& r) {
   std::size_t curveEdges = r.merged_curve_edges.size();
   if (curveEdges == 0)

@@ -77,6 +77,14 @@ std::size_t roundToFloat(SplitResult& result, int passes = 4);
 // to float as MeshLab stores them.
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
 
+// Per face of `mesh`: bit i set when its edge from corner i to corner i+1 is
+// one of `curveEdges` (pairs of vertex indices, either order), so that later
+// operations (patch painting) find the curves. MeshLab layers carry it as
+// the per-face attribute named kCurveEdgesAttribute.
+std::vector<std::uint8_t> curveEdgeFlags(const Mesh& mesh,
+                                         const std::vector<std::array<int, 2>>& curveEdges);
+inline constexpr const char* kCurveEdgesAttribute = "meshmend_curve_edges";
+
 // The report_file keys: curve_edges, curve_loops, open_curves, faces_split, ...
 JsonObject toJson(const SplitResult& result);
 

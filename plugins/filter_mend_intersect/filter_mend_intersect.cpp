@@ -248,6 +248,19 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
       r.candidate_pairs, r.time_ms);
 }
 
+namespace {
+
+// Marks the curve edges of a written layer in its per-face attribute.
+void markCurveEdges(const Mesh& core, const std::vector<std::array<int, 2>>& curves,
+                    CMeshO& cm) {
+  const std::vector<std::uint8_t> flags = curveEdgeFlags(core, curves);
+  auto attribute = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(
+      cm, kCurveEdgesAttribute);
+  for (std::size_t f = 0; f < flags.size() && f < cm.face.size(); ++f) attribute[f] = flags[f];
+}
+
+}  // namespace
+
 void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
                                         vcg::CallBackPos* cb) {
   const int mode = parameters.getEnum("mode");
@@ -297,10 +310,12 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   if (merge) {
     MeshModel* out = md.addNewMesh("", "intersected", true);
     writeMesh(r.merged, attributes, *out);
+    markCurveEdges(r.merged, r.merged_curve_edges, out->cm);
     out->cm.Tr.SetIdentity();
   } else {
     for (std::size_t i = 0; i < layers.size(); ++i) {
       writeMesh(r.meshes[i], {attributes[i]}, *layers[i]);  // in place
+      markCurveEdges(r.meshes[i], r.curve_edges[i], layers[i]->cm);
       layers[i]->cm.Tr.SetIdentity();  // the geometry is now in the common frame
     }
   }
