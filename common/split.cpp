@@ -44,6 +44,15 @@ Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Poin
   return {wa, wb, 1 - wa - wb};
 }
 
+// The smallest angle of triangle (a, b, c), in radians.
+double smallestAngleOf(const Point3& a, const Point3& b, const Point3& c) {
+  auto angle = [](const Point3& p, const Point3& q, const Point3& r) {
+    const Point3 u = q - p, v = r - p;
+    return std::atan2((u ^ v).Norm(), u * v);
+  };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
 // An input edge: mesh and its two vertices, smaller first.
 struct EdgeRef {
   std::uint32_t mesh, u, v;
@@ -334,6 +343,9 @@ class MeshSplitter {
       for (std::size_t j = 3; j < patch.vertex_of_input.size(); ++j)
         contactVertices_.push_back(global[patch.vertex_of_input[j]]);
       for (const auto& t : patch.triangles) {
+        smallestAngle_ = std::min(smallestAngle_, smallestAngleOf(patch.vertices[t[0]].approx(),
+                                                                  patch.vertices[t[1]].approx(),
+                                                                  patch.vertices[t[2]].approx()));
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
         birthFaces.push_back({int(index_), faceOrigin_[f]});
       }
@@ -348,7 +360,8 @@ class MeshSplitter {
   }
 
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
-  std::size_t keptFaces() const { return keptFaces_; }  // output faces before the new ones
+  std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
+  double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
   const std::vector<int>& contactVertices() const { return contactVertices_; }
   // Output vertices at curve points: the point's id.
   const std::unordered_map<int, int>& pointOfVertex() const { return pointOfVertex_; }
@@ -377,6 +390,7 @@ class MeshSplitter {
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
   std::size_t keptFaces_ = 0;
+  double smallestAngle_ = M_PI;
   std::vector<int> contactVertices_;  // output vertices at contact points
   std::unordered_map<int, int> pointOfVertex_;
 };
@@ -512,6 +526,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     r.faces_split += splitters[m].facesSplit();
     r.degenerate_faces_kept += splitters[m].degenerateKept();
     r.new_vertices += exactNew[m].size();
+    if (splitters[m].facesSplit() > 0)
+      r.smallest_new_angle_deg =
+          std::min(r.smallest_new_angle_deg, splitters[m].smallestAngle() * 180 / M_PI);
   }
 
   reportProgress(options.progress, 90, "Welding along the curves");
@@ -832,6 +849,7 @@ JsonObject toJson(const SplitResult& r) {
       .set("degenerate_faces_kept", r.degenerate_faces_kept)
       .set("vertices_welded", r.vertices_welded)
       .set("duplicate_faces_removed", r.duplicate_faces_removed)
+      .set("smallest_new_angle_deg", r.faces_split ? r.smallest_new_angle_deg : 0.0)
       .set("time_ms", r.time_ms);
   return j;
 }

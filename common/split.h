@@ -24,7 +24,7 @@ struct SplitOptions {
   // everywhere (decimated scans have them). The first of each group stays.
   bool remove_duplicate_faces = false;
   bool separate_meshes = true;  // also build `meshes` (one output per input); else merged only
-  Progress progress;  // called between stages
+  Progress progress;            // called between stages
 };
 
 struct SplitResult {
@@ -44,15 +44,16 @@ struct SplitResult {
   // mesh's own and those between meshes. Faces left as they were then cross
   // nothing, so the intersections left are among pairs with a new face.
   bool complete = false;
-  std::size_t intersecting_pairs = 0;     // pairs found (and split)
-  std::size_t faces_split = 0;            // input faces re-triangulated
-  std::size_t faces_added = 0;            // output faces minus input faces
-  std::size_t new_vertices = 0;           // curve points that are not input vertices
-  std::size_t degenerate_faces_kept = 0;  // zero-area faces a curve touches, left unsplit
-  std::size_t vertices_welded = 0;        // duplicates merged first (weld_duplicates)
+  std::size_t intersecting_pairs = 0;       // pairs found (and split)
+  std::size_t faces_split = 0;              // input faces re-triangulated
+  std::size_t faces_added = 0;              // output faces minus input faces
+  std::size_t new_vertices = 0;             // curve points that are not input vertices
+  std::size_t degenerate_faces_kept = 0;    // zero-area faces a curve touches, left unsplit
+  std::size_t vertices_welded = 0;          // duplicates merged first (weld_duplicates)
   std::size_t duplicate_faces_removed = 0;  // remove_duplicate_faces
-  std::size_t curve_loops = 0;            // closed curve components (merged output)
-  std::size_t open_curves = 0;            // curve components with end points
+  double smallest_new_angle_deg = 180;      // smallest angle of a face the split made
+  std::size_t curve_loops = 0;              // closed curve components (merged output)
+  std::size_t open_curves = 0;              // curve components with end points
   double time_ms = 0;
 };
 

@@ -37,6 +37,10 @@ TEST(Split, TwoSpheresMeetAlongOneClosedCurve) {
   EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
   EXPECT_EQ(merged.border_edges, 0u);
   EXPECT_EQ(merged.connected_components, 1u);
+  // The smallest angle the split made is reported, and it bounds the output's.
+  EXPECT_GT(r.smallest_new_angle_deg, 0);
+  EXPECT_LE(r.smallest_new_angle_deg, 60);
+  EXPECT_LE(merged.min_angle_deg, r.smallest_new_angle_deg + 1e-9);
 }
 
 TEST(Split, FacesNotCrossedStayBitIdentical) {

@@ -251,11 +251,10 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
 namespace {
 
 // Marks the curve edges of a written layer in its per-face attribute.
-void markCurveEdges(const Mesh& core, const std::vector<std::array<int, 2>>& curves,
-                    CMeshO& cm) {
+void markCurveEdges(const Mesh& core, const std::vector<std::array<int, 2>>& curves, CMeshO& cm) {
   const std::vector<std::uint8_t> flags = curveEdgeFlags(core, curves);
-  auto attribute = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(
-      cm, kCurveEdgesAttribute);
+  auto attribute =
+      vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(cm, kCurveEdgesAttribute);
   for (std::size_t f = 0; f < flags.size() && f < cm.face.size(); ++f) attribute[f] = flags[f];
 }
 
@@ -292,8 +291,9 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     o.cross = false;
     remaining = findIntersections({&r.merged}, o).pairs.size();
   }
-  r.time_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                         roundStart).count();
+  r.time_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - roundStart)
+          .count();
   if (verify)
     Log("  check of the float result: %zu intersecting pairs remain%s", remaining,
         r.complete ? " (all with a new face: the others are input faces as they were)" : "");
@@ -335,6 +335,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
       "curves; %zu faces re-triangulated into %zu more faces, %zu new vertices (%.0f ms)",
       r.intersecting_pairs, r.merged_curve_edges.size(), r.curve_loops, r.open_curves,
       r.faces_split, r.faces_added, r.new_vertices, r.time_ms);
+  Log("  smallest angle of a new face: %.2f degrees", r.smallest_new_angle_deg);
   if (r.degenerate_faces_kept)
     Log("  warning: %zu zero-area faces touched by a curve were kept unsplit",
         r.degenerate_faces_kept);
