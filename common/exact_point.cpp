@@ -30,7 +30,25 @@ Interval orient2dInterval(const Point3& a, const Point3& b, const Point3& c, int
          (Interval(b[v]) - a[v]) * (Interval(c[u]) - a[u]);
 }
 
-// ---- exact rational helpers --------------------------------------------------------
+double nearestDouble(const mpq_class& q) {
+  const double d = q.get_d();  // truncated toward zero
+  if (mpq_class(d) == q) return d;
+  const double away = std::nextafter(d, q > 0 ? INFINITY : -INFINITY);
+  return abs(q - mpq_class(away)) < abs(q - mpq_class(d)) ? away : d;
+}
+
+// The approximation and error of a point whose coordinates lie in `x`.
+void enclose(const Interval3& x, Point3& approx, double& error) {
+  error = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double mid = 0.5 * x[k].lo + 0.5 * x[k].hi;
+    approx[k] = mid;
+    error = std::max({error, up(x[k].hi - mid), up(mid - x[k].lo)});
+  }
+  if (!std::isfinite(error)) error = INFINITY;
+}
+
+}  // namespace
 
 RationalPoint rationalOf(const Point3& p) {
   return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
@@ -65,26 +83,6 @@ RationalPoint along(const RationalPoint& p, const RationalPoint& q, const mpq_cl
   return r;
 }
 
-double nearestDouble(const mpq_class& q) {
-  const double d = q.get_d();  // truncated toward zero
-  if (mpq_class(d) == q) return d;
-  const double away = std::nextafter(d, q > 0 ? INFINITY : -INFINITY);
-  return abs(q - mpq_class(away)) < abs(q - mpq_class(d)) ? away : d;
-}
-
-// The approximation and error of a point whose coordinates lie in `x`.
-void enclose(const Interval3& x, Point3& approx, double& error) {
-  error = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double mid = 0.5 * x[k].lo + 0.5 * x[k].hi;
-    approx[k] = mid;
-    error = std::max({error, up(x[k].hi - mid), up(mid - x[k].lo)});
-  }
-  if (!std::isfinite(error)) error = INFINITY;
-}
-
-}  // namespace
-
 Point3 nearestDoubles(const RationalPoint& p) {
   return {nearestDouble(p.x[0]), nearestDouble(p.x[1]), nearestDouble(p.x[2])};
 }
@@ -104,19 +102,27 @@ ExactPoint::ExactPoint(const RationalPoint& p) : kind_(Kind::kRational) {
   exact_ = std::move(exact);
 }
 
+namespace {
+
+// The interval of p + lambda (q - p), clamped to the segment's box.
+Interval3 onSegmentAt(const Point3& p, const Point3& q, const Interval& lambda) {
+  const Interval t = intersect(lambda, 0, 1);
+  Interval3 x;
+  for (int k = 0; k < 3; ++k)
+    x[k] = intersect(Interval(p[k]) + t * (Interval(q[k]) - p[k]), std::min(p[k], q[k]),
+                     std::max(p[k], q[k]));
+  return x;
+}
+
+}  // namespace
+
 ExactPoint ExactPoint::edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
                                  const Point3& t) {
   ExactPoint e;
   e.kind_ = Kind::kEdgePlane;
   e.definition_ = {p, q, r, s, t};
   const Interval sp = orient3dInterval(r, s, t, p), sq = orient3dInterval(r, s, t, q);
-  const Interval lambda = intersect(sp / (sp - sq), 0, 1);
-  Interval3 x;
-  for (int k = 0; k < 3; ++k)
-    x[k] = intersect(Interval(p[k]) + lambda * (Interval(q[k]) - p[k]), std::min(p[k], q[k]),
-                     std::max(p[k], q[k]));
-  enclose(x, e.approx_, e.error_);
-  if (!std::isfinite(e.error_)) e = ExactPoint(e.exact());  // out of double range on the way
+  e.approximate(onSegmentAt(p, q, sp / (sp - sq)));
   return e;
 }
 
@@ -127,14 +133,13 @@ ExactPoint ExactPoint::edgeLine(const Point3& p, const Point3& q, const Point3& 
   e.axis_ = std::uint8_t(axis);
   e.definition_ = {p, q, r, s, Point3(0, 0, 0)};
   const Interval op = orient2dInterval(r, s, p, axis), oq = orient2dInterval(r, s, q, axis);
-  const Interval lambda = intersect(op / (op - oq), 0, 1);
-  Interval3 x;
-  for (int k = 0; k < 3; ++k)
-    x[k] = intersect(Interval(p[k]) + lambda * (Interval(q[k]) - p[k]), std::min(p[k], q[k]),
-                     std::max(p[k], q[k]));
-  enclose(x, e.approx_, e.error_);
-  if (!std::isfinite(e.error_)) e = ExactPoint(e.exact());
+  e.approximate(onSegmentAt(p, q, op / (op - oq)));
   return e;
+}
+
+void ExactPoint::approximate(const Interval3& x) {
+  enclose(x, approx_, error_);
+  if (!std::isfinite(error_)) *this = ExactPoint(exact());  // out of double range on the way
 }
 
 const RationalPoint& ExactPoint::exact() const {

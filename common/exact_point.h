@@ -51,6 +51,9 @@ class ExactPoint {
  private:
   enum class Kind : std::uint8_t { kDouble, kRational, kEdgePlane, kEdgeLine };
   void computeExact() const;
+  // Sets the approximation and error to enclose `x`; computes the exact
+  // value instead when the intervals overflowed.
+  void approximate(const Interval3& x);
 
   Kind kind_ = Kind::kDouble;
   std::uint8_t axis_ = 0;
@@ -83,6 +86,17 @@ int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint&
 
 // Is p on the closed segment ab (collinear in 3-D and between them)?
 bool onSegment(const ExactPoint& p, const ExactPoint& a, const ExactPoint& b);
+
+// Rational arithmetic, for the exact fallbacks.
+RationalPoint rationalOf(const Point3& p);
+// det[b-a, c-a, d-a]
+mpq_class orient3dValue(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+                        const RationalPoint& d);
+// The orientation of the projections dropping `axis` (coordinates (axis+1)%3, (axis+2)%3).
+mpq_class orient2dValue(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+                        int axis);
+// p + t (q - p), canonical.
+RationalPoint along(const RationalPoint& p, const RationalPoint& q, const mpq_class& t);
 
 // Sign of det[b-a, c-a, d-a] on exact rational points.
 int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,

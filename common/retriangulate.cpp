@@ -80,10 +80,7 @@ class Retriangulator {
   // Orientation of (a, b, c) in the projection, exactly, relative to the
   // input triangle: positive = same turn as the input.
   mpq_class orientValue(int a, int b, int c) const {
-    const int u = (axis_ + 1) % 3, v = (axis_ + 2) % 3;
-    const RationalPoint &A = V_[a].exact(), &B = V_[b].exact(), &C = V_[c].exact();
-    const mpq_class r =
-        (B.x[u] - A.x[u]) * (C.x[v] - A.x[v]) - (B.x[v] - A.x[v]) * (C.x[u] - A.x[u]);
+    const mpq_class r = orient2dValue(V_[a].exact(), V_[b].exact(), V_[c].exact(), axis_);
     return sign_ > 0 ? r : mpq_class(-r);
   }
   int orient(int a, int b, int c) const {

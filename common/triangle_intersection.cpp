@@ -154,51 +154,6 @@ const char* toString(ContactKind kind) {
 
 namespace {
 
-struct Exact3 {
-  mpq_class x[3];
-};
-
-Exact3 exactOf(const Point3& p) {
-  return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
-}
-
-// The double nearest to q.
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();  // truncated toward zero
-  const double up = std::nextafter(d, q > 0 ? INFINITY : -INFINITY);
-  return abs(q - mpq_class(up)) < abs(q - mpq_class(d)) ? up : d;
-}
-
-Point3 rounded(const Exact3& p) {
-  return {nearest(p.x[0]), nearest(p.x[1]), nearest(p.x[2])};
-}
-
-// det[b-a, c-a, d-a], exactly.
-mpq_class orient3dValue(const Exact3& a, const Exact3& b, const Exact3& c, const Exact3& d) {
-  mpq_class m[3][3];
-  for (int k = 0; k < 3; ++k) {
-    m[0][k] = b.x[k] - a.x[k];
-    m[1][k] = c.x[k] - a.x[k];
-    m[2][k] = d.x[k] - a.x[k];
-  }
-  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-}
-
-// Orientation of the projections (dropping `axis`), exactly.
-mpq_class orient2Value(const Exact3& a, const Exact3& b, const Exact3& c, int axis) {
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  return (b.x[u] - a.x[u]) * (c.x[v] - a.x[v]) - (b.x[v] - a.x[v]) * (c.x[u] - a.x[u]);
-}
-
-// p + t (q - p)
-Exact3 along(const Exact3& p, const Exact3& q, const mpq_class& t) {
-  Exact3 r;
-  for (int k = 0; k < 3; ++k) r.x[k] = p.x[k] + t * (q.x[k] - p.x[k]);
-  return r;
-}
-
 // The ExactPoint a contact point's defining elements describe.
 ExactPoint exactPointOf(const ContactPoint& c, const TrianglePoints& a, const TrianglePoints& b) {
   const TrianglePoints& own = c.triangle == 0 ? a : b;
@@ -310,8 +265,8 @@ class Classifier {
  public:
   Classifier(const TrianglePoints& a, const TrianglePoints& b) : a_(a), b_(b) {
     for (int i = 0; i < 3; ++i) {
-      P_[0][i] = exactOf(a[i]);
-      P_[1][i] = exactOf(b[i]);
+      P_[0][i] = rationalOf(a[i]);
+      P_[1][i] = rationalOf(b[i]);
     }
     // All twelve doubles as integers times one power of two, 2^scale_: the
     // plane-side determinants are then integer arithmetic (no fractions to
@@ -357,7 +312,7 @@ class Classifier {
  private:
   struct Point {
     ContactPoint tag;
-    Exact3 exact;
+    RationalPoint exact;
   };
 
   Point vertex(int t, int i) const {
@@ -400,9 +355,9 @@ class Classifier {
         }
       }
     // Positions along the line: projections onto d = normal(a) x normal(b).
-    Exact3 n[2];
+    RationalPoint n[2];
     for (int t = 0; t < 2; ++t) {
-      Exact3 e1, e2;
+      RationalPoint e1, e2;
       for (int k = 0; k < 3; ++k) {
         e1.x[k] = P_[t][1].x[k] - P_[t][0].x[k];
         e2.x[k] = P_[t][2].x[k] - P_[t][0].x[k];
@@ -410,7 +365,7 @@ class Classifier {
       for (int k = 0; k < 3; ++k)
         n[t].x[k] = e1.x[(k + 1) % 3] * e2.x[(k + 2) % 3] - e1.x[(k + 2) % 3] * e2.x[(k + 1) % 3];
     }
-    Exact3 d;
+    RationalPoint d;
     for (int k = 0; k < 3; ++k)
       d.x[k] =
           n[0].x[(k + 1) % 3] * n[1].x[(k + 2) % 3] - n[0].x[(k + 2) % 3] * n[1].x[(k + 1) % 3];
@@ -460,9 +415,10 @@ class Classifier {
   // Hodgman). Every clipped edge lies on a line of a's or b's edges, so each
   // new corner is an edge-edge crossing or a corner of b.
   TriangleContact coplanar() {
-    const TrianglePoints a{rounded(P_[0][0]), rounded(P_[0][1]), rounded(P_[0][2])};
+    const TrianglePoints a{nearestDoubles(P_[0][0]), nearestDoubles(P_[0][1]),
+                           nearestDoubles(P_[0][2])};
     axis_ = projectionAxis(a[0], a[1], a[2]);
-    const int orientation = sgn(orient2Value(P_[1][0], P_[1][1], P_[1][2], axis_));
+    const int orientation = sgn(orient2dValue(P_[1][0], P_[1][1], P_[1][2], axis_));
     struct Corner {
       Point point;
       int line;  // line of the edge leaving this corner: 0..2 edges of a, 3..5 edges of b
@@ -470,9 +426,9 @@ class Classifier {
     std::vector<Corner> polygon;
     for (int i = 0; i < 3; ++i) polygon.push_back({vertex(0, i), i});
     for (int j = 0; j < 3 && !polygon.empty(); ++j) {
-      const Exact3 &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
+      const RationalPoint &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
       auto inside = [&](const Point& p) {
-        return sgn(orient2Value(b0, b1, p.exact, axis_)) * orientation >= 0;
+        return sgn(orient2dValue(b0, b1, p.exact, axis_)) * orientation >= 0;
       };
       std::vector<Corner> out;
       for (std::size_t k = 0; k < polygon.size(); ++k) {
@@ -503,7 +459,7 @@ class Classifier {
     if (points.empty()) return c;
     mpq_class area2 = 0;
     for (std::size_t k = 0; k + 2 < points.size(); ++k)
-      area2 += orient2Value(points[0].exact, points[k + 1].exact, points[k + 2].exact, axis_);
+      area2 += orient2dValue(points[0].exact, points[k + 1].exact, points[k + 2].exact, axis_);
     if (sgn(area2) != 0) {
       c.kind = ContactKind::kCoplanarOverlap;
       for (const Point& p : points) finish(c, p);
@@ -539,9 +495,9 @@ class Classifier {
     p.tag.other_index = std::uint8_t(j);
     // On a's edge `line` (from corner line to line+1), at the parameter where
     // it crosses b's edge line j.
-    const Exact3 &a0 = P_[0][line], &a1 = P_[0][(line + 1) % 3];
-    const Exact3 &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
-    const mpq_class o0 = orient2Value(b0, b1, a0, axis_), o1 = orient2Value(b0, b1, a1, axis_);
+    const RationalPoint &a0 = P_[0][line], &a1 = P_[0][(line + 1) % 3];
+    const RationalPoint &b0 = P_[1][j], &b1 = P_[1][(j + 1) % 3];
+    const mpq_class o0 = orient2dValue(b0, b1, a0, axis_), o1 = orient2dValue(b0, b1, a1, axis_);
     p.exact = along(a0, a1, o0 / (o0 - o1));
     return p;
   }
@@ -549,13 +505,13 @@ class Classifier {
   // Appends p to the contact: its defining elements, rounded and exact positions.
   void finish(TriangleContact& contact, const Point& p) const {
     ContactPoint c = p.tag;
-    c.position = rounded(p.exact);
+    c.position = nearestDoubles(p.exact);
     contact.points.push_back(c);
     contact.exact.push_back(exactPointOf(c, a_, b_));
   }
 
   TrianglePoints a_, b_;
-  Exact3 P_[2][3];
+  RationalPoint P_[2][3];
   // Corner i of triangle t against the other triangle's plane, as an
   // integer determinant (scaled by 2^(3 scale_)).
   mpz_class integerSide(int t, int i) const {
@@ -591,35 +547,6 @@ TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b
   TriangleContact contact;
   if (!coplanar && classifyCrossing(a, b, side, contact)) return contact;
   return Classifier(a, b).run();
-}
-
-RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
-                            const TrianglePoints& b) {
-  const TrianglePoints* t[2] = {&a, &b};
-  auto exact = [](const Point3& p) { return exactOf(p); };
-  Exact3 r;
-  switch (point.kind) {
-    case ContactPoint::Kind::kVertex:
-      r = exact((*t[point.triangle])[point.index]);
-      break;
-    case ContactPoint::Kind::kEdgeFace: {
-      const TrianglePoints &own = *t[point.triangle], &other = *t[1 - point.triangle];
-      const Exact3 p = exact(own[point.index]), q = exact(own[(point.index + 1) % 3]);
-      const Exact3 o0 = exact(other[0]), o1 = exact(other[1]), o2 = exact(other[2]);
-      const mpq_class sp = orient3dValue(o0, o1, o2, p), sq = orient3dValue(o0, o1, o2, q);
-      r = along(p, q, sp / (sp - sq));
-      break;
-    }
-    case ContactPoint::Kind::kEdgeEdge: {
-      const int axis = projectionAxis(a[0], a[1], a[2]);
-      const Exact3 p = exact(a[point.index]), q = exact(a[(point.index + 1) % 3]);
-      const Exact3 b0 = exact(b[point.other_index]), b1 = exact(b[(point.other_index + 1) % 3]);
-      const mpq_class op = orient2Value(b0, b1, p, axis), oq = orient2Value(b0, b1, q, axis);
-      r = along(p, q, op / (op - oq));
-      break;
-    }
-  }
-  return {{r.x[0], r.x[1], r.x[2]}};
 }
 
 }  // namespace meshmend

@@ -79,13 +79,6 @@ struct TriangleContact {
   std::vector<ExactPoint> exact;  // the same points, exactly
 };
 
-// The exact position of a contact point of classifyContact(a, b), from its
-// defining elements: an input corner, an edge of one triangle at the
-// parameter where it crosses the other's plane, or (coplanar) an edge of a
-// where it crosses an edge line of b. Predicates on it stay exact.
-RationalPoint exactPosition(const ContactPoint& point, const TrianglePoints& a,
-                            const TrianglePoints& b);
-
 // Full classification with exact end points. Slower than trianglesIntersect:
 // meant for pairs known to intersect. Crossing triangles (the common case)
 // are classified from rounded values with error bounds; touching and

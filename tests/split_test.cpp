@@ -41,6 +41,17 @@ TEST(Split, TwoSpheresMeetAlongOneClosedCurve) {
   EXPECT_GT(r.smallest_new_angle_deg, 0);
   EXPECT_LE(r.smallest_new_angle_deg, 60);
   EXPECT_LE(merged.min_angle_deg, r.smallest_new_angle_deg + 1e-9);
+  // Curve edges are flagged on every face that has them: four faces around
+  // each welded curve edge, two in each closed mesh.
+  auto flagged = [](const std::vector<std::uint8_t>& flags) {
+    std::size_t n = 0;
+    for (std::uint8_t f : flags) n += (f & 1) + ((f >> 1) & 1) + ((f >> 2) & 1);
+    return n;
+  };
+  EXPECT_EQ(flagged(curveEdgeFlags(r.merged, r.merged_curve_edges)),
+            4 * r.merged_curve_edges.size());
+  for (std::size_t m = 0; m < 2; ++m)
+    EXPECT_EQ(flagged(curveEdgeFlags(r.meshes[m], r.curve_edges[m])), 2 * r.curve_edges[m].size());
 }
 
 TEST(Split, FacesNotCrossedStayBitIdentical) {
