@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <set>
 #include <tuple>
@@ -395,6 +396,434 @@ class MeshSplitter {
   std::unordered_map<int, int> pointOfVertex_;
 };
 
+// Quality snapping (intersection paper §2.7). A curve point that lands very
+// close to an input vertex, or very close to an input edge, leaves a sliver:
+// a face with a tiny angle. With a tolerance τ > 0, scale-free (a fraction of
+// the local edge length, as the paper's local tolerances are), two changes
+// remove such slivers after the exact split:
+//  - a new vertex v within τ·L of an input vertex w it shares an edge with
+//    (L: the longest edge around v), or of the next new vertex w along its
+//    curve, is merged into w; the curve then runs through w and the
+//    surfaces bend by at most |vw| there;
+//  - a face (v, a, b) whose new vertex v lies within τ·|ab| of its input
+//    edge ab has ab split at v instead: the face across ab becomes two and
+//    the sliver goes.
+// A change is kept only if every surface stays manifold, no face flips or
+// degenerates, the smallest angle there gets larger, and no face it touches
+// crosses more faces than before (exact test). The curves stay shared by
+// the meshes they separate.
+class CurveSnapper {
+ public:
+  CurveSnapper(OutputArrays& mesh, std::set<std::array<int, 2>>& curves, std::vector<char>& newFace,
+               double tolerance)
+      : P_(mesh.positions),
+        T_(mesh.triangles),
+        faceOrigin_(mesh.face_origin),
+        vertexOrigin_(mesh.vertex_origin),
+        curves_(curves),
+        newFace_(newFace),
+        tolerance_(tolerance),
+        alive_(T_.size(), 1),
+        around_(P_.size()),
+        snappedTo_(P_.size(), -1),
+        fixed_(P_.size(), 0) {
+    for (std::size_t f = 0; f < T_.size(); ++f)
+      for (int v : T_[f]) around_[v].push_back(std::uint32_t(f));
+    for (const auto& e : curves_) {
+      curveNeighbours_[e[0]].push_back(e[1]);
+      curveNeighbours_[e[1]].push_back(e[0]);
+    }
+    std::vector<Box> boxes(T_.size());
+    for (std::size_t f = 0; f < T_.size(); ++f)
+      boxes[f] = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
+    tree_ = std::make_unique<BoxTree>(std::move(boxes));
+  }
+
+  // Merges new vertices into nearby input vertices; returns how many.
+  std::size_t snapVertices() {
+    struct Candidate {
+      double ratio;
+      int v, w;
+    };
+    std::vector<Candidate> candidates;
+    for (std::size_t v = 0; v < P_.size(); ++v) {
+      if (vertexOrigin_[v].vertex >= 0) continue;  // input vertices never move
+      double longest = 0;
+      for (std::uint32_t f : around_[v])
+        for (int i = 0; i < 3; ++i)
+          longest = std::max(longest, Distance(P_[T_[f][i]], P_[T_[f][(i + 1) % 3]]));
+      for (std::uint32_t f : around_[v])
+        for (int w : T_[f]) {
+          // Into an input vertex, or along the curve into another new vertex.
+          if (w == int(v) || (vertexOrigin_[w].vertex < 0 && !isCurveEdge(int(v), w))) continue;
+          const double d = Distance(P_[v], P_[w]);
+          if (d < tolerance_ * longest) candidates.push_back({d / longest, int(v), w});
+        }
+    }
+    std::sort(candidates.begin(), candidates.end(),
+              [](const Candidate& x, const Candidate& y) { return x.ratio < y.ratio; });
+    for (const Candidate& c : candidates) reach_ = std::max(reach_, Distance(P_[c.v], P_[c.w]));
+    std::size_t snapped = 0;
+    for (const Candidate& c : candidates)
+      if (snappedTo_[c.v] < 0 && snappedTo_[c.w] < 0 && !fixed_[c.v] && collapse(c.v, c.w)) {
+        fixed_[c.w] = 1;  // moves nothing more: every vertex moves once, by at most reach_
+        ++snapped;
+      }
+    return snapped;
+  }
+
+  // Splits input edges at new vertices that lie almost on them; returns how many.
+  std::size_t snapEdges() {
+    std::size_t snapped = 0;
+    const std::size_t faces = T_.size();
+    for (std::size_t s = 0; s < faces; ++s) {
+      if (!alive_[s] || !newFace_[s]) continue;
+      for (int i = 0; i < 3; ++i) {
+        const int v = T_[s][i], a = T_[s][(i + 1) % 3], b = T_[s][(i + 2) % 3];
+        if (vertexOrigin_[v].vertex >= 0 || isCurveEdge(a, b)) continue;
+        const Point3 ab = P_[b] - P_[a];
+        const double t = ((P_[v] - P_[a]) * ab) / ab.SquaredNorm();
+        if (!(t > 0 && t < 1)) continue;
+        const double distance = (P_[v] - (P_[a] + ab * t)).Norm();
+        if (distance < tolerance_ * ab.Norm() && splitEdgeAt(std::uint32_t(s), v, a, b)) {
+          ++snapped;
+          break;
+        }
+      }
+    }
+    return snapped;
+  }
+
+  // The output without the faces and vertices snapping removed: `index`
+  // receives each old vertex's new index (a snapped vertex: its target's).
+  void compact(OutputArrays& mesh, std::vector<int>& index) {
+    index.assign(P_.size(), -1);
+    OutputArrays out;
+    for (std::size_t v = 0; v < P_.size(); ++v) {
+      if (snappedTo_[v] >= 0) continue;
+      index[v] = int(out.positions.size());
+      out.positions.push_back(P_[v]);
+      out.vertex_origin.push_back(vertexOrigin_[v]);
+    }
+    for (std::size_t v = 0; v < P_.size(); ++v)
+      if (snappedTo_[v] >= 0) index[v] = index[snappedTo_[v]];
+    std::vector<char> newFace;
+    for (std::size_t f = 0; f < T_.size(); ++f) {
+      if (!alive_[f]) continue;
+      out.triangles.push_back({index[T_[f][0]], index[T_[f][1]], index[T_[f][2]]});
+      out.face_origin.push_back(faceOrigin_[f]);
+      newFace.push_back(newFace_[f]);
+    }
+    std::set<std::array<int, 2>> curves;
+    for (auto e : curves_) {
+      e = {index[e[0]], index[e[1]]};
+      if (e[0] > e[1]) std::swap(e[0], e[1]);
+      curves.insert(e);
+    }
+    curves_ = std::move(curves);
+    newFace_ = std::move(newFace);
+    mesh = std::move(out);
+  }
+
+  const std::vector<int>& snappedTo() const { return snappedTo_; }
+  const std::vector<char>& alive() const { return alive_; }
+
+ private:
+  int mesh(std::uint32_t f) const { return faceOrigin_[f].layer; }
+
+  bool isCurveEdge(int a, int b) const {
+    return curves_.count({std::min(a, b), std::max(a, b)}) > 0;
+  }
+
+  std::vector<std::uint32_t> facesAround(int v) const {
+    std::vector<std::uint32_t> faces;
+    for (std::uint32_t f : around_[v])
+      if (alive_[f] && (T_[f][0] == v || T_[f][1] == v || T_[f][2] == v)) faces.push_back(f);
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    return faces;
+  }
+
+  TrianglePoints at(const Triangle& t) const { return {P_[t[0]], P_[t[1]], P_[t[2]]}; }
+
+  static Point3 normalOf(const TrianglePoints& t) { return (t[1] - t[0]) ^ (t[2] - t[0]); }
+
+  // How many faces the triangle `t` (the new shape of face `self`) crosses,
+  // leaving out the faces `ignore` (sorted).
+  std::size_t crossings(const Triangle& t, std::uint32_t self,
+                        const std::vector<std::uint32_t>& ignore) {
+    Box b = boxOf(P_[t[0]], P_[t[1]], P_[t[2]]);
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = std::nextafter(float(double(b.lo[k]) - reach_), -INFINITY);
+      b.hi[k] = std::nextafter(float(double(b.hi[k]) + reach_), INFINITY);
+    }
+    std::size_t n = 0;
+    const TrianglePoints a = at(t);
+    auto test = [&](std::uint32_t g) {
+      if (g == self || !alive_[g] || std::binary_search(ignore.begin(), ignore.end(), g)) return;
+      if (collinear(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]])) return;
+      const SharedCorners c = sharedCorners(t, T_[g]);
+      n += intersectBeyondShared(a, at(T_[g]), c.count, c.ia, c.ib);
+    };
+    tree_->query(b, 0, [&](std::uint32_t g, unsigned) { test(g); });
+    for (std::size_t g = tree_->size(); g < T_.size(); ++g) {
+      const Box gb = boxOf(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]]);
+      if (overlap(b, gb)) test(std::uint32_t(g));
+    }
+    return n;
+  }
+
+  // Crossings of the faces `faces`, shaped as `triangles`, with all other
+  // faces (the normal checks keep a fan from folding onto itself).
+  std::size_t crossingsOf(const std::vector<std::uint32_t>& faces,
+                          const std::vector<Triangle>& triangles) {
+    std::size_t n = 0;
+    std::vector<std::uint32_t> sorted = faces;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < faces.size(); ++i) n += crossings(triangles[i], faces[i], sorted);
+    return n;
+  }
+
+  double smallestAngle(const std::vector<Triangle>& triangles) const {
+    double smallest = M_PI;
+    for (const Triangle& t : triangles)
+      smallest = std::min(smallest, smallestAngleOf(P_[t[0]], P_[t[1]], P_[t[2]]));
+    return smallest;
+  }
+
+  // With `faces` (of `meshes`) the faces around w after v collapsed into
+  // it: is every edge at w in at most two faces of one mesh, and in faces
+  // of several meshes only where it is (or comes from) a curve edge?
+  bool edgesStayManifold(int v, int w, const std::vector<Triangle>& faces,
+                         const std::vector<int>& meshes) const {
+    std::map<int, std::map<int, int>> count;  // other end -> mesh -> faces
+    for (std::size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        if (faces[i][k] == w) {
+          ++count[faces[i][(k + 1) % 3]][meshes[i]];
+          ++count[faces[i][(k + 2) % 3]][meshes[i]];
+        }
+    for (const auto& [x, perMesh] : count) {
+      const bool curve = isCurveEdge(w, x) || isCurveEdge(v, x);
+      if (perMesh.size() > 1 && !curve) return false;
+      for (const auto& [m, n] : perMesh)
+        if (n > 2 && !curve) return false;  // (a mesh's own curves join four of its faces)
+    }
+    return true;
+  }
+
+  std::size_t facesOfMesh(const std::vector<std::uint32_t>& faces, int m) const {
+    return std::size_t(
+        std::count_if(faces.begin(), faces.end(), [&](std::uint32_t f) { return mesh(f) == m; }));
+  }
+
+  // Is v (with `faces` around it) on the border of mesh m: an edge at v in one face of m only?
+  bool onBorder(int v, const std::vector<std::uint32_t>& faces, int m) const {
+    std::map<int, int> count;
+    for (std::uint32_t f : faces)
+      if (mesh(f) == m)
+        for (int x : T_[f])
+          if (x != v) ++count[x];
+    for (const auto& [x, n] : count)
+      if (n == 1) return true;
+    return false;
+  }
+
+  // Merges new vertex v into input vertex w (an edge collapse), if allowed.
+  bool collapse(int v, int w) {
+    if (curveNeighbours_.count(w) && !isCurveEdge(v, w)) return false;  // would join two curves
+    const std::vector<std::uint32_t> fv = facesAround(v);
+    std::vector<std::uint32_t> removed, moved;
+    for (std::uint32_t f : fv)
+      (T_[f][0] == w || T_[f][1] == w || T_[f][2] == w ? removed : moved).push_back(f);
+    if (removed.empty()) return false;
+    // Per mesh, the link condition: the common neighbours of v and w are
+    // the apexes of the faces on vw; and no border pinches.
+    std::map<int, std::map<int, int>> neighbours;  // mesh -> vertex -> bits (1: of v, 2: of w)
+    const std::vector<std::uint32_t> fw = facesAround(w);
+    for (std::uint32_t f : fv)
+      for (int x : T_[f]) neighbours[mesh(f)][x] |= 1;
+    for (std::uint32_t f : fw)
+      for (int x : T_[f]) neighbours[mesh(f)][x] |= 2;
+    for (auto& [m, marks] : neighbours) {
+      if (onBorder(v, fv, m) && onBorder(w, fw, m) && facesOfMesh(removed, m) != 1)
+        return false;  // both on the border, joined inside: the border would pinch
+      std::set<int> apexes;
+      for (std::uint32_t f : removed)
+        if (mesh(f) == int(m))
+          for (int x : T_[f])
+            if (x != v && x != w) apexes.insert(x);
+      for (const auto& [x, bits] : marks)
+        if (bits == 3 && x != v && x != w && !apexes.count(x)) return false;
+    }
+    // Geometry after the move.
+    std::vector<Triangle> after;
+    std::vector<int> meshes;
+    for (std::uint32_t f : moved) {
+      Triangle t = T_[f];
+      for (int& x : t)
+        if (x == v) x = w;
+      const TrianglePoints p = at(t);
+      if (collinear(p[0], p[1], p[2]) || normalOf(p) * normalOf(at(T_[f])) <= 0) return false;
+      after.push_back(t);
+      meshes.push_back(mesh(f));
+    }
+    {
+      std::vector<Triangle> all = after;
+      std::vector<int> allMeshes = meshes;
+      for (std::uint32_t f : fw)
+        if (!std::count(removed.begin(), removed.end(), f)) {
+          all.push_back(T_[f]);
+          allMeshes.push_back(mesh(f));
+        }
+      if (!edgesStayManifold(v, w, all, allMeshes)) return false;
+    }
+    std::vector<Triangle> before;
+    for (std::uint32_t f : fv) before.push_back(T_[f]);
+    if (smallestAngle(after) <= smallestAngle(before)) return false;
+    // Exact: no face crosses more than it did. The faces removed are
+    // ignored in the count after.
+    const std::size_t crossedBefore = crossingsOf(fv, before);
+    for (std::uint32_t f : removed) alive_[f] = 0;
+    const std::size_t crossedAfter = crossingsOf(moved, after);
+    if (crossedAfter > crossedBefore) {
+      for (std::uint32_t f : removed) alive_[f] = 1;
+      return false;
+    }
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      T_[moved[i]] = after[i];
+      newFace_[moved[i]] = 1;
+      around_[w].push_back(moved[i]);
+    }
+    around_[v].clear();
+    const auto curve = curveNeighbours_.find(v);
+    if (curve != curveNeighbours_.end()) {
+      for (int x : curve->second) {
+        curves_.erase({std::min(v, x), std::max(v, x)});
+        auto& back = curveNeighbours_[x];
+        back.erase(std::remove(back.begin(), back.end(), v), back.end());
+        if (x == w) continue;
+        if (curves_.insert({std::min(w, x), std::max(w, x)}).second) {
+          curveNeighbours_[w].push_back(x);
+          back.push_back(w);
+        }
+      }
+      curveNeighbours_.erase(v);
+    }
+    P_[v] = P_[w];
+    snappedTo_[v] = w;
+    return true;
+  }
+
+  // Removes the sliver s = (v, a, b) by splitting the face across ab at v.
+  bool splitEdgeAt(std::uint32_t s, int v, int a, int b) {
+    std::vector<std::uint32_t> across;
+    for (std::uint32_t f : facesAround(a))
+      if (f != s && (T_[f][0] == b || T_[f][1] == b || T_[f][2] == b)) across.push_back(f);
+    if (across.size() != 1 || mesh(across[0]) != mesh(s)) return false;
+    const std::uint32_t g = across[0];
+    int k = 0;
+    while (T_[g][k] != b) ++k;
+    if (T_[g][(k + 1) % 3] != a) return false;  // inconsistently oriented
+    const int c = T_[g][(k + 2) % 3];
+    if (c == v) return false;
+    for (std::uint32_t f : facesAround(v))
+      if (mesh(f) == mesh(s) && (T_[f][0] == c || T_[f][1] == c || T_[f][2] == c))
+        return false;  // vc is an edge already
+    const std::vector<Triangle> after{{b, v, c}, {v, a, c}};
+    const Point3 n = normalOf(at(T_[g]));
+    for (const Triangle& t : after) {
+      const TrianglePoints p = at(t);
+      if (collinear(p[0], p[1], p[2]) || normalOf(p) * n <= 0) return false;
+    }
+    const std::vector<Triangle> before{T_[s], T_[g]};
+    if (smallestAngle(after) <= smallestAngle(before)) return false;
+    const std::size_t crossedBefore = crossingsOf({s, g}, before);
+    alive_[s] = 0;
+    T_.push_back(after[1]);  // so that the count sees both new faces
+    alive_.push_back(1);
+    const Triangle old = T_[g];
+    T_[g] = after[0];
+    const std::uint32_t added = std::uint32_t(T_.size() - 1);
+    const std::size_t crossedAfter = crossingsOf({g, added}, after);
+    if (crossedAfter > crossedBefore) {
+      T_[g] = old;
+      T_.pop_back();
+      alive_.pop_back();
+      alive_[s] = 1;
+      return false;
+    }
+    faceOrigin_.push_back(faceOrigin_[g]);
+    newFace_.push_back(1);
+    newFace_[g] = 1;
+    for (int x : {v, a, c}) around_[x].push_back(added);
+    around_[v].push_back(g);
+    return true;
+  }
+
+  std::vector<Point3>& P_;
+  std::vector<Triangle>& T_;
+  std::vector<FaceOrigin>& faceOrigin_;
+  std::vector<VertexOrigin>& vertexOrigin_;
+  std::set<std::array<int, 2>>& curves_;
+  std::vector<char>& newFace_;
+  double tolerance_;
+  std::vector<char> alive_;
+  std::vector<std::vector<std::uint32_t>> around_;
+  std::vector<int> snappedTo_;
+  std::vector<char> fixed_;  // snapping targets
+  std::unordered_map<int, std::vector<int>> curveNeighbours_;
+  std::unique_ptr<BoxTree> tree_;
+  double reach_ = 0;  // the largest distance a vertex moved: boxes grow by at most this
+};
+
+// Each mesh's own output again after snapping, from the (compacted) merged
+// faces of that mesh: `index` maps old merged vertices to new ones (a
+// snapped vertex to its target). A snapped vertex of a mesh that has no
+// vertex at its target keeps its place in that mesh, moved to the target.
+void rebuildSeparate(const OutputArrays& merged, const std::vector<int>& index,
+                     const std::vector<int>& snappedTo, const std::set<std::array<int, 2>>& curves,
+                     std::vector<OutputArrays>& outputs,
+                     std::vector<std::vector<int>>& mergedVertex,
+                     std::vector<std::vector<std::array<int, 2>>>& curveEdges) {
+  for (std::size_t m = 0; m < outputs.size(); ++m) {
+    const OutputArrays& old = outputs[m];
+    const std::vector<int>& globalOf = mergedVertex[m];
+    std::unordered_map<int, int> localOf;  // new merged vertex -> old local vertex kept for it
+    for (std::size_t u = 0; u < globalOf.size(); ++u)
+      if (snappedTo[globalOf[u]] < 0) localOf.emplace(index[globalOf[u]], int(u));
+    for (std::size_t u = 0; u < globalOf.size(); ++u)
+      if (snappedTo[globalOf[u]] >= 0) localOf.emplace(index[globalOf[u]], int(u));
+    std::vector<int> renumbered(globalOf.size(), -1);
+    OutputArrays out;
+    std::vector<int> newGlobalOf;
+    for (std::size_t u = 0; u < globalOf.size(); ++u) {
+      const int g = index[globalOf[u]];
+      if (localOf.at(g) != int(u)) continue;
+      renumbered[u] = int(out.positions.size());
+      out.positions.push_back(merged.positions[g]);
+      out.vertex_origin.push_back(old.vertex_origin[u]);
+      newGlobalOf.push_back(g);
+    }
+    std::set<std::array<int, 2>> meshCurves;
+    for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
+      if (merged.face_origin[f].layer != int(m)) continue;
+      const Triangle& t = merged.triangles[f];
+      Triangle local;
+      for (int k = 0; k < 3; ++k) local[k] = renumbered[localOf.at(t[k])];
+      out.triangles.push_back(local);
+      out.face_origin.push_back(merged.face_origin[f]);
+      for (int k = 0; k < 3; ++k)
+        if (curves.count({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}))
+          meshCurves.insert(
+              {std::min(local[k], local[(k + 1) % 3]), std::max(local[k], local[(k + 1) % 3])});
+    }
+    outputs[m] = std::move(out);
+    mergedVertex[m] = std::move(newGlobalOf);
+    curveEdges[m].assign(meshCurves.begin(), meshCurves.end());
+  }
+}
+
 // Removes faces with the same three vertices as an earlier face (in any
 // order): the same surface twice, which would intersect itself everywhere.
 std::size_t removeDuplicateFaces(WeldedArrays& in) {
@@ -596,6 +1025,41 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         if (g[0] > g[1]) std::swap(g[0], g[1]);
         curves.insert(g);
       }
+    }
+    // The quality of the new faces: their smallest angle, and the slivers.
+    auto slivers = [&] {
+      std::size_t n = 0;
+      for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
+        const Triangle& t = merged.triangles[f];
+        n += r.merged_new_face[f] && smallestAngleOf(merged.positions[t[0]], merged.positions[t[1]],
+                                                     merged.positions[t[2]]) < M_PI / 180;
+      }
+      return n;
+    };
+    r.smallest_new_angle_deg_unsnapped = r.smallest_new_angle_deg;
+    r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers();
+    if (options.snap_tolerance > 0 && r.faces_split > 0) {
+      reportProgress(options.progress, 95, "Snapping curve points");
+      CurveSnapper snapper(merged, curves, r.merged_new_face, options.snap_tolerance);
+      r.vertices_snapped = snapper.snapVertices();
+      r.edges_snapped = snapper.snapEdges();
+      const std::vector<int> snappedTo = snapper.snappedTo();
+      const std::size_t facesBefore = merged.triangles.size();
+      std::vector<int> index;
+      snapper.compact(merged, index);
+      rebuildSeparate(merged, index, snappedTo, curves, outputs, r.merged_vertex, r.curve_edges);
+      r.new_vertices -= r.vertices_snapped;
+      r.faces_added = r.faces_added + merged.triangles.size() - facesBefore;
+      double smallest = M_PI;
+      for (std::size_t f = 0; f < merged.triangles.size(); ++f)
+        if (r.merged_new_face[f]) {
+          const Triangle& t = merged.triangles[f];
+          smallest =
+              std::min(smallest, smallestAngleOf(merged.positions[t[0]], merged.positions[t[1]],
+                                                 merged.positions[t[2]]));
+        }
+      r.smallest_new_angle_deg = smallest * 180 / M_PI;
+      r.new_faces_below_1deg = slivers();
     }
     r.merged = merged.toMesh();
     if (options.separate_meshes) {
@@ -850,6 +1314,12 @@ JsonObject toJson(const SplitResult& r) {
       .set("vertices_welded", r.vertices_welded)
       .set("duplicate_faces_removed", r.duplicate_faces_removed)
       .set("smallest_new_angle_deg", r.faces_split ? r.smallest_new_angle_deg : 0.0)
+      .set("smallest_new_angle_deg_unsnapped",
+           r.faces_split ? r.smallest_new_angle_deg_unsnapped : 0.0)
+      .set("new_faces_below_1deg", r.new_faces_below_1deg)
+      .set("new_faces_below_1deg_unsnapped", r.new_faces_below_1deg_unsnapped)
+      .set("vertices_snapped", r.vertices_snapped)
+      .set("edges_snapped", r.edges_snapped)
       .set("time_ms", r.time_ms);
   return j;
 }

@@ -54,6 +54,42 @@ TEST(Split, TwoSpheresMeetAlongOneClosedCurve) {
     EXPECT_EQ(flagged(curveEdgeFlags(r.meshes[m], r.curve_edges[m])), 2 * r.curve_edges[m].size());
 }
 
+TEST(Split, QualitySnappingRemovesSliversAndKeepsTheResultValid) {
+  // Offsets chosen so that the curves pass close to vertices and edges.
+  for (const Point3& offset :
+       {Point3(0.9, 0.13, 0.07), Point3(0.5, 0.31, 0.011), Point3(1.1, 0.0013, 0.2)}) {
+    const Mesh a = uvSphere(24, 32), b = uvSphere(40, 52, 0.8, offset);
+    const SplitResult plain = splitAlongIntersections({&a, &b});
+    SplitOptions o;
+    o.snap_tolerance = 0.1;
+    const SplitResult r = splitAlongIntersections({&a, &b}, o);
+    SCOPED_TRACE(offset[1]);
+    EXPECT_EQ(plain.vertices_snapped + plain.edges_snapped, 0u);
+    EXPECT_DOUBLE_EQ(r.smallest_new_angle_deg_unsnapped, plain.smallest_new_angle_deg);
+    EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
+    EXPECT_GT(r.smallest_new_angle_deg, plain.smallest_new_angle_deg);
+    EXPECT_EQ(r.curve_loops, plain.curve_loops);
+    EXPECT_EQ(r.open_curves, 0u);
+    // Still two closed manifold meshes that share their curves and cross nowhere.
+    for (std::size_t m = 0; m < 2; ++m) {
+      const InspectResult i = check(r.meshes[m]);
+      EXPECT_TRUE(i.is_closed);
+      EXPECT_EQ(i.non_manifold_edges, 0u);
+      EXPECT_EQ(i.non_manifold_vertices, 0u);
+      EXPECT_EQ(i.degenerate_faces, 0u);
+      EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+      EXPECT_EQ(r.curve_edges[m].size(), r.merged_curve_edges.size());
+    }
+    const InspectResult merged = check(r.merged);
+    EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+    EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
+    EXPECT_EQ(merged.border_edges, 0u);
+    EXPECT_LE(merged.min_angle_deg, r.smallest_new_angle_deg + 1e-9);
+    // Snapping merged vertices away: fewer vertices than without it.
+    EXPECT_EQ(r.merged.vn + r.vertices_snapped, plain.merged.vn);
+  }
+}
+
 TEST(Split, FacesNotCrossedStayBitIdentical) {
   const Mesh a = uvSphere(16, 20), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});

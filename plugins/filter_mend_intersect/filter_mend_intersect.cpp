@@ -97,6 +97,14 @@ void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
         "(after welding): the same surface twice, which intersects itself everywhere and "
         "cannot be split apart (decimated scans have hundreds). The first of each group "
         "stays."));
+    parameters.addParam(RichFloat(
+        "snap_tolerance", 0, "Quality snapping (0 = off)",
+        "Scale-free tolerance, as a fraction of the local edge length (0.05 is a good value). "
+        "A curve point closer than this to an existing vertex (or to the next curve point) is "
+        "merged into it, and one this close to an edge splits that edge, instead of leaving a "
+        "sliver triangle. Each snap is kept only if the result stays manifold and free of new "
+        "intersections; the surfaces move by at most the tolerance near the curves. The log "
+        "gives the smallest new angle with and without snapping."));
     parameters.addParam(RichEnum(
         "output", 0,
         QStringList() << "Keep the layers separate"
@@ -270,6 +278,9 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
   options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.remove_duplicate_faces = parameters.getBool("remove_duplicate_faces");
+  options.snap_tolerance = parameters.getFloat("snap_tolerance");
+  if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
+    throw InvalidInputError("the snapping tolerance must be at least 0 (off) and below 0.5");
   options.progress = progressFrom(cb);
   const bool merge = parameters.getEnum("output") == 1;
   options.separate_meshes = !merge;
@@ -335,7 +346,15 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
       "curves; %zu faces re-triangulated into %zu more faces, %zu new vertices (%.0f ms)",
       r.intersecting_pairs, r.merged_curve_edges.size(), r.curve_loops, r.open_curves,
       r.faces_split, r.faces_added, r.new_vertices, r.time_ms);
-  Log("  smallest angle of a new face: %.2f degrees", r.smallest_new_angle_deg);
+  if (options.snap_tolerance > 0)
+    Log("  smallest angle of a new face: %.3g degrees (%.3g without snapping); %zu faces under 1 "
+        "degree (%zu without); %zu curve points "
+        "merged into vertices, %zu edges split at curve points",
+        r.smallest_new_angle_deg, r.smallest_new_angle_deg_unsnapped, r.new_faces_below_1deg,
+        r.new_faces_below_1deg_unsnapped, r.vertices_snapped, r.edges_snapped);
+  else
+    Log("  smallest angle of a new face: %.3g degrees; %zu faces under 1 degree",
+        r.smallest_new_angle_deg, r.new_faces_below_1deg);
   if (r.degenerate_faces_kept)
     Log("  warning: %zu zero-area faces touched by a curve were kept unsplit",
         r.degenerate_faces_kept);

@@ -133,6 +133,37 @@ def test_split_of_closed_pairs_leaves_no_intersection(tmp_path, a, b):
     assert check["non_manifold_edges"] == r["curve_edges"]
 
 
+@pytest.mark.parametrize("a,b", [("pairs/blobby.off", "pairs/eight.off"),
+                                 ("pairs/cheburashka.off", "pairs/decimated-knight.off"),
+                                 ("pairs/sphere.obj", "pairs/xcylinder.obj"),
+                                 ("pairs/ballA.off", "pairs/ballB.off"),
+                                 ("stanford/bun_zipper_res3.ply", "stanford/dragon_vrip_res3.ply")])
+def test_quality_snapping_keeps_the_split_valid(tmp_path, a, b):
+    """Snapping removes most slivers (new faces with an angle under 1°) and
+    never makes the smallest new angle worse; the written
+    result is still free of intersections, closed where the inputs were, with
+    the curves as its only new non-manifold edges."""
+    require_shared_data()
+    out = tmp_path / "merged.ply"
+    script = (ROOT / "samples" / "intersect_split.mlx").read_text().replace(
+        'name="report_file" value=""', 'name="report_file" value="{report0}"').replace(
+        'name="snap_tolerance" value="0"', 'name="snap_tolerance" value="0.05"')
+    assert 'name="snap_tolerance" value="0.05"' in script
+    run = run_server(tmp_path, [DATA / a, DATA / b], script, outputs=[out])
+    assert run.returncode == 0, run.log[-2000:]
+    r, check = run.report, meshcheck(out)
+    assert r["vertices_snapped"] + r["edges_snapped"] > 0
+    assert r["smallest_new_angle_deg"] >= r["smallest_new_angle_deg_unsnapped"]
+    assert r["new_faces_below_1deg"] < r["new_faces_below_1deg_unsnapped"] / 2
+    assert "without snapping" in run.log
+    assert r["remaining_intersecting_pairs"] == 0
+    assert check["self_intersecting_pairs"] == 0
+    inputs = [meshcheck(DATA / p) for p in (a, b)]
+    if all(i["non_manifold_edges"] == 0 for i in inputs):  # (the decimated dragon has 2,094)
+        assert check["non_manifold_edges"] == r["curve_edges"]
+    assert check["is_closed"] == all(i["is_closed"] for i in inputs)
+
+
 def test_split_bunny_and_dragon_full_is_free_of_intersections(tmp_path):
     """The paper's benchmark pair, with the dragon's seams welded and its own
     self-intersections split in the same pass (samples/intersect_split.mlx)."""
