@@ -140,6 +140,46 @@ def test_split_refuses_layers_that_do_not_intersect(tmp_path):
     assert "do not intersect" in run.log and not run.reports
 
 
+def test_split_refuses_a_bad_snapping_tolerance(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out = tmp_path / "b_out.off"
+    for tolerance in (-0.1, 0.7):
+        script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 0,
+                              "snap_tolerance": tolerance, "report_file": "{report0}"}))
+        run = run_server(tmp_path, [a, b], script, outputs=[out])
+        assert run.returncode != 0
+        assert "snapping tolerance" in run.log and not run.reports
+
+
+def test_split_with_snapping_on_two_cubes(tmp_path):
+    """Cubes offset by a hair: the curves pass 1e-4 from the corners and make
+    slivers, which snapping removes; the result stays free of intersections."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", [(x + 0.5, y + 0.5001, z + 0.4999) for x, y, z in V], F)
+    out = tmp_path / "merged.ply"  # binary float, as MeshLab holds it
+    results = {}
+    for tolerance in (0, 0.05):
+        script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
+                              "snap_tolerance": tolerance, "report_file": "{report0}"}))
+        run = run_server(tmp_path, [a, b], script, outputs=[out])
+        assert run.returncode == 0, run.log
+        results[tolerance] = run.report
+        assert run.report["remaining_intersecting_pairs"] == 0
+        check = meshcheck_if_available(out)
+        if check:
+            assert check["self_intersecting_pairs"] == 0
+            assert check["non_manifold_edges"] == run.report["curve_edges"]
+            assert check["border_edges"] == 0
+    plain, snapped = results[0], results[0.05]
+    assert plain["vertices_snapped"] == 0 and snapped["vertices_snapped"] > 0
+    assert snapped["smallest_new_angle_deg_unsnapped"] == plain["smallest_new_angle_deg"]
+    assert snapped["smallest_new_angle_deg"] > 10 * plain["smallest_new_angle_deg"]
+    assert snapped["new_faces_below_1deg"] < plain["new_faces_below_1deg"]
+
+
 def test_split_sample_runs(tmp_path):
     V, F = cube()
     a = write_ply(tmp_path / "a.ply", V, F)
