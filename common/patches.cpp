@@ -1,0 +1,421 @@
+#include "common/patches.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <tuple>
+
+#include "common/errors.h"
+#include "common/parallel.h"
+
+namespace meshmend {
+
+namespace {
+
+int find(std::vector<int>& parent, int x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+Point3 normalOf(const Point3& a, const Point3& b, const Point3& c) {
+  return (b - a) ^ (c - a);
+}
+
+// One edge use: the edge (smaller vertex first), the face, and the corner it starts at.
+struct EdgeUse {
+  int u, v, face, corner;
+  bool operator<(const EdgeUse& o) const {
+    return std::tie(u, v, face) < std::tie(o.u, o.v, o.face);
+  }
+};
+
+std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int a = triangles[f][i], b = triangles[f][(i + 1) % 3];
+      uses.push_back({std::min(a, b), std::max(a, b), int(f), i});
+    }
+  std::sort(uses.begin(), uses.end());
+  return uses;
+}
+
+// Generalized winding number of one part's faces (Jacobson et al. 2013:
+// the sum of their signed solid angles over 4π), evaluated through a
+// hierarchy: a cluster far from the query point counts as its dipole
+// (area-weighted normal at its area centroid), as in Barill et al. 2018.
+class WindingTree {
+ public:
+  WindingTree(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+              std::vector<int> faces)
+      : P_(points), T_(triangles), faces_(std::move(faces)) {
+    if (!faces_.empty()) build(0, int(faces_.size()));
+  }
+
+  // At point p on face `onFace` (whose own solid angle there is 0), or -1.
+  double at(const Point3& p, int onFace) const {
+    if (nodes_.empty()) return 0;
+    double omega = 0;
+    visit(0, p, onFace, omega);
+    return omega / (4 * M_PI);
+  }
+
+ private:
+  struct Node {
+    Point3 centre{0, 0, 0}, dipole{0, 0, 0};  // area centroid; Σ area × unit normal
+    double radius = 0;                        // of a ball around centre holding all its faces
+    int begin = 0, end = 0, left = -1, right = -1;
+  };
+  static constexpr int kLeafSize = 8;
+  static constexpr double kFar =
+      4;  // far: beyond kFar radii (dipole error ~ 1/kFar², a few thousandths)
+
+  int build(int begin, int end) {
+    const int index = int(nodes_.size());
+    nodes_.emplace_back();
+    Node node;
+    node.begin = begin, node.end = end;
+    double area = 0;
+    Point3 lo(HUGE_VAL, HUGE_VAL, HUGE_VAL), hi = -lo, weighted(0, 0, 0);
+    for (int i = begin; i < end; ++i) {
+      const Triangle& t = T_[faces_[i]];
+      const Point3 n = normalOf(P_[t[0]], P_[t[1]], P_[t[2]]) * 0.5;
+      const double a = n.Norm();
+      const Point3 c = (P_[t[0]] + P_[t[1]] + P_[t[2]]) / 3.0;
+      node.dipole += n;
+      weighted += c * a;
+      area += a;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], c[k]);
+        hi[k] = std::max(hi[k], c[k]);
+      }
+    }
+    node.centre = area > 0 ? weighted / area : (lo + hi) / 2.0;
+    for (int i = begin; i < end; ++i)
+      for (int v : T_[faces_[i]]) node.radius = std::max(node.radius, Distance(P_[v], node.centre));
+    if (end - begin > kLeafSize) {
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+      const int middle = (begin + end) / 2;
+      auto centre = [&](int f) {
+        const Triangle& t = T_[f];
+        return P_[t[0]][axis] + P_[t[1]][axis] + P_[t[2]][axis];
+      };
+      std::nth_element(faces_.begin() + begin, faces_.begin() + middle, faces_.begin() + end,
+                       [&](int x, int y) { return centre(x) < centre(y); });
+      node.left = build(begin, middle);
+      node.right = build(middle, end);
+    }
+    nodes_[index] = node;
+    return index;
+  }
+
+  void visit(int n, const Point3& p, int onFace, double& omega) const {
+    const Node& node = nodes_[n];
+    const Point3 d = node.centre - p;
+    const double distance = d.Norm();
+    if (distance > kFar * node.radius) {
+      omega += (node.dipole * d) / (distance * distance * distance);
+      return;
+    }
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i)
+        if (faces_[i] != onFace) omega += solidAngle(T_[faces_[i]], p);
+      return;
+    }
+    visit(node.left, p, onFace, omega);
+    visit(node.right, p, onFace, omega);
+  }
+
+  // Van Oosterom and Strackee's formula.
+  double solidAngle(const Triangle& t, const Point3& p) const {
+    const Point3 a = P_[t[0]] - p, b = P_[t[1]] - p, c = P_[t[2]] - p;
+    const double la = a.Norm(), lb = b.Norm(), lc = c.Norm();
+    const double numerator = a * (b ^ c);
+    const double denominator = la * lb * lc + (a * b) * lc + (b * c) * la + (c * a) * lb;
+    return 2 * std::atan2(numerator, denominator);
+  }
+
+  const std::vector<Point3>& P_;
+  const std::vector<Triangle>& T_;
+  std::vector<int> faces_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace
+
+Patches paintPatches(const Mesh& mesh, const FaceLabels& labels, const PaintOptions& options) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<Point3> P = positionsOf(mesh);
+  auto sized = [&](std::size_t n) { return n == 0 || n == T.size(); };
+  if (!sized(labels.part.size()) || !sized(labels.curve_edges.size()) ||
+      !sized(labels.colour.size()))
+    throw InvalidInputError("the per-face labels do not match the mesh's " +
+                            std::to_string(T.size()) + " faces");
+  Patches result;
+  for (int p : labels.part) {
+    if (p < 0) throw InvalidInputError("a face has a negative part number");
+    result.parts = std::max(result.parts, p + 1);
+  }
+  const double creaseCos = std::cos(options.crease_angle_deg * M_PI / 180);
+  std::vector<int> parent(T.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    const std::size_t count = j - i;
+    bool bounds = (count == 1 && options.at_borders) || (count > 2 && options.at_non_manifold);
+    if (options.at_curves && !labels.curve_edges.empty())
+      for (std::size_t k = i; k < j; ++k)
+        bounds |= (labels.curve_edges[uses[k].face] >> uses[k].corner) & 1;
+    if (count == 2 && !bounds) {
+      const int f = uses[i].face, g = uses[i + 1].face;
+      if (!labels.part.empty() && labels.part[f] != labels.part[g]) bounds = true;
+      if (options.at_colour_changes && !labels.colour.empty() &&
+          labels.colour[f] != labels.colour[g])
+        bounds = true;
+      if (options.crease_angle_deg > 0) {
+        const Point3 nf = normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+        const Point3 ng = normalOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
+        const double norms = nf.Norm() * ng.Norm();
+        // Faces that traverse the edge the same way are inconsistently
+        // oriented: compare their normals turned to agree.
+        const bool sameWay = T[f][uses[i].corner] == T[g][uses[i + 1].corner];
+        const double cosine = norms > 0 ? (sameWay ? -1 : 1) * (nf * ng) / norms : 1;
+        if (cosine < creaseCos) bounds = true;
+      }
+    }
+    if (bounds) {
+      ++result.boundary_edges;
+    } else {
+      for (std::size_t k = i + 1; k < j; ++k) {
+        const int a = find(parent, uses[i].face), b = find(parent, uses[k].face);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+    i = j;
+  }
+  result.patch_of_face.assign(T.size(), -1);
+  std::vector<int> idOfRoot(T.size(), -1);
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    const int root = find(parent, int(f));
+    if (idOfRoot[root] < 0) {
+      idOfRoot[root] = int(result.patches.size());
+      Patch patch;
+      patch.part = labels.part.empty() ? 0 : labels.part[f];
+      patch.first_face = int(f);
+      result.patches.push_back(patch);
+    }
+    const int id = idOfRoot[root];
+    result.patch_of_face[f] = id;
+    Patch& patch = result.patches[id];
+    ++patch.faces;
+    patch.area += normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm() / 2;
+  }
+  return result;
+}
+
+void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patches) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<Point3> P = positionsOf(mesh);
+  if (patches.patch_of_face.size() != T.size())
+    throw InvalidInputError("the patches were painted on another mesh");
+  auto partOf = [&](std::size_t f) { return labels.part.empty() ? 0 : labels.part[f]; };
+  std::vector<std::vector<int>> facesOfPart(patches.parts);
+  for (std::size_t f = 0; f < T.size(); ++f) facesOfPart[partOf(f)].push_back(int(f));
+
+  // A part is closed when none of its edges has a single face of the part.
+  patches.part_closed.assign(patches.parts, true);
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    std::vector<int> count(patches.parts, 0);
+    for (std::size_t k = i; k < j; ++k) ++count[partOf(uses[k].face)];
+    for (int p = 0; p < patches.parts; ++p)
+      if (count[p] == 1) patches.part_closed[p] = false;
+    i = j;
+  }
+
+  std::vector<WindingTree> trees;
+  for (int p = 0; p < patches.parts; ++p) trees.emplace_back(P, T, facesOfPart[p]);
+
+  // Sample faces: the few largest of each patch, away from its edges where
+  // the winding number of a nearby surface changes fastest.
+  constexpr std::size_t kSamples = 3;
+  std::vector<std::vector<int>> samples(patches.patches.size());
+  {
+    std::vector<std::vector<std::pair<double, int>>> largest(patches.patches.size());
+    for (std::size_t f = 0; f < T.size(); ++f) {
+      auto& l = largest[patches.patch_of_face[f]];
+      const double area = normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm();
+      if (!(area > 0)) continue;
+      l.push_back({area, int(f)});
+      if (l.size() > 4 * kSamples) {
+        std::nth_element(l.begin(), l.begin() + kSamples, l.end(), std::greater<>());
+        l.resize(kSamples);
+      }
+    }
+    for (std::size_t id = 0; id < largest.size(); ++id) {
+      auto& l = largest[id];
+      std::sort(l.begin(), l.end(), std::greater<>());
+      for (std::size_t k = 0; k < l.size() && k < kSamples; ++k) samples[id].push_back(l[k].second);
+      if (samples[id].empty()) samples[id].push_back(patches.patches[id].first_face);
+    }
+  }
+  parallelChunks(
+      patches.patches.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t id = begin; id < end; ++id) {
+          Patch& patch = patches.patches[id];
+          patch.winding.assign(patches.parts, 0);
+          for (int p = 0; p < patches.parts; ++p) {
+            std::vector<double> values;
+            for (int f : samples[id]) {
+              const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
+              values.push_back(trees[p].at(c, f));
+            }
+            std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+            patch.winding[p] = values[values.size() / 2];  // the median: one odd sample is outvoted
+          }
+          const double total = std::accumulate(patch.winding.begin(), patch.winding.end(), 0.0);
+          patch.winding_outside = total - 0.5;
+          patch.winding_inside = total + 0.5;
+        }
+      },
+      4);
+}
+
+const char* toString(BooleanOperation op) {
+  switch (op) {
+    case BooleanOperation::kUnion:
+      return "union (outer surface)";
+    case BooleanOperation::kIntersection:
+      return "intersection (common interior)";
+    case BooleanOperation::kDifference:
+      return "difference (first minus the others)";
+  }
+  return "";
+}
+
+PatchChoice choosePatches(const Patches& patches, BooleanOperation op) {
+  PatchChoice choice;
+  const std::size_t n = patches.patches.size();
+  choice.keep.assign(n, 0);
+  choice.flip.assign(n, 0);
+  for (std::size_t id = 0; id < n; ++id) {
+    const Patch& patch = patches.patches[id];
+    if (patch.winding.size() != std::size_t(patches.parts))
+      throw InvalidInputError("the patches are not classified yet");
+    auto insideAllOthers = [&](bool inside, int except) {
+      for (int p = 0; p < patches.parts; ++p)
+        if (p != patch.part && p != except && patch.inside(p) != inside) return false;
+      return true;
+    };
+    switch (op) {
+      case BooleanOperation::kUnion:
+        choice.keep[id] = patch.onUnionSurface();
+        break;
+      case BooleanOperation::kIntersection:
+        choice.keep[id] = insideAllOthers(true, -1);
+        break;
+      case BooleanOperation::kDifference:
+        if (patch.part == 0) {
+          choice.keep[id] = insideAllOthers(false, -1);
+        } else {
+          choice.keep[id] = patch.inside(0) && insideAllOthers(false, 0);
+          choice.flip[id] = choice.keep[id];
+        }
+        break;
+    }
+  }
+  return choice;
+}
+
+Mesh extractPatches(const Mesh& mesh, const Patches& patches, const std::vector<char>& keep,
+                    const std::vector<char>& flip) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<Point3> P = positionsOf(mesh);
+  if (patches.patch_of_face.size() != T.size() || keep.size() != patches.patches.size())
+    throw InvalidInputError("the patches were painted on another mesh");
+  Mesh& source = const_cast<Mesh&>(mesh);  // (vcglib's attribute lookup is not const)
+  const bool hasOrigins = vcg::tri::Allocator<Mesh>::IsValidHandle(
+      source,
+      vcg::tri::Allocator<Mesh>::FindPerFaceAttribute<FaceOrigin>(source, kFaceOriginAttribute));
+  std::vector<int> vertexIndex(P.size(), -1);
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  std::vector<int> birthVertex, birthFace;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    const int id = patches.patch_of_face[f];
+    if (!keep[id]) continue;
+    Triangle t = T[f];
+    if (!flip.empty() && flip[id]) std::swap(t[1], t[2]);
+    for (int& v : t) {
+      if (vertexIndex[v] < 0) {
+        vertexIndex[v] = int(points.size());
+        points.push_back(P[v]);
+        birthVertex.push_back(v);
+      }
+      v = vertexIndex[v];
+    }
+    triangles.push_back(t);
+    birthFace.push_back(int(f));
+  }
+  // Coincident vertices (layers that met along a curve) become one.
+  const WeldedArrays welded = weldCoincident({points, triangles});
+  Mesh out = makeMesh(welded.mesh.points, welded.mesh.triangles);
+  VertexOriginHandle vo = vertexOrigins(out);
+  FaceOriginHandle fo = faceOrigins(out);
+  VertexOriginHandle inVertex = vertexOrigins(source);
+  FaceOriginHandle inFace = faceOrigins(source);
+  for (std::size_t v = 0; v < out.vert.size(); ++v) {
+    const int input = birthVertex[welded.vertex_origin[v]];
+    vo[v] = hasOrigins ? inVertex[input] : VertexOrigin{0, input, -1, {}};
+  }
+  for (std::size_t f = 0; f < out.face.size(); ++f) {
+    const int input = birthFace[welded.face_origin[f]];
+    fo[f] = hasOrigins ? inFace[input] : FaceOrigin{0, input};
+  }
+  return out;
+}
+
+std::string statusOf(const Patch& patch, int parts) {
+  if (patch.winding.empty()) return "not classified";
+  std::string inside;
+  for (int p = 0; p < parts; ++p)
+    if (p != patch.part && patch.inside(p))
+      inside += (inside.empty() ? "" : ",") + std::to_string(p);
+  std::string status = patch.onUnionSurface() ? "outer surface" : "interior";
+  if (parts > 1) status += inside.empty() ? "; outside the other parts" : "; inside part " + inside;
+  return status;
+}
+
+JsonObject toJson(const Patches& patches) {
+  std::vector<JsonObject> list;
+  for (std::size_t id = 0; id < patches.patches.size(); ++id) {
+    const Patch& p = patches.patches[id];
+    JsonObject j;
+    j.set("id", std::int64_t(id))
+        .set("part", p.part)
+        .set("faces", p.faces)
+        .set("area", p.area)
+        .set("status", statusOf(p, patches.parts));
+    if (!p.winding.empty())
+      j.set("winding", p.winding)
+          .set("winding_outside", p.winding_outside)
+          .set("winding_inside", p.winding_inside);
+    list.push_back(j);
+  }
+  JsonObject j;
+  j.set("patches", patches.patches.size())
+      .set("parts", patches.parts)
+      .set("boundary_edges", patches.boundary_edges)
+      .set("patch_list", list);
+  return j;
+}
+
+}  // namespace meshmend

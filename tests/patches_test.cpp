@@ -1,0 +1,211 @@
+#include "common/patches.h"
+
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "common/inspect.h"
+#include "common/split.h"
+#include "mesh_builders.h"
+
+namespace meshmend {
+namespace {
+
+using testing::box;
+using testing::uvSphere;
+
+InspectResult check(const Mesh& m) {
+  InspectOptions o;
+  o.self_intersections = true;
+  return inspect(m, o);
+}
+
+// Two crossing spheres split along their curve, merged, with labels.
+struct SplitPair {
+  Mesh mesh;
+  FaceLabels labels;
+  double volumeA = 0, volumeB = 0;
+};
+
+SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {
+  const Mesh a = uvSphere(24, 32), b = uvSphere(20, 28, radiusB, offset);
+  SplitOptions o;
+  o.separate_meshes = false;
+  SplitResult r = splitAlongIntersections({&a, &b}, o);
+  SplitPair pair;
+  pair.volumeA = *inspect(a).volume;
+  pair.volumeB = *inspect(b).volume;
+  pair.labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
+  FaceOriginHandle fo = faceOrigins(r.merged);
+  for (std::size_t f = 0; f < r.merged.face.size(); ++f) pair.labels.part.push_back(fo[f].layer);
+  pair.mesh = r.merged;
+  return pair;
+}
+
+TEST(Patches, AMeshWithoutBoundariesIsOnePatch) {
+  const Mesh sphere = uvSphere(12, 16);
+  const Patches p = paintPatches(sphere, {});
+  ASSERT_EQ(p.patches.size(), 1u);
+  EXPECT_EQ(p.patches[0].faces, sphere.face.size());
+  EXPECT_EQ(p.boundary_edges, 0u);
+  // Two separate spheres: one patch each.
+  const Mesh two = appended(sphere, uvSphere(12, 16, 1, {5, 0, 0}));
+  EXPECT_EQ(paintPatches(two, {}).patches.size(), 2u);
+}
+
+TEST(Patches, CurveEdgesBoundPatches) {
+  // A square of two triangles whose diagonal is a curve edge.
+  const Mesh square =
+      makeMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 3}});
+  FaceLabels labels;
+  labels.curve_edges = {0b100, 0b001};  // edge 2 -> 0 of the first face, 0 -> 1 of the second
+  EXPECT_EQ(paintPatches(square, labels).patches.size(), 2u);
+  PaintOptions ignore;
+  ignore.at_curves = false;
+  EXPECT_EQ(paintPatches(square, labels, ignore).patches.size(), 1u);
+}
+
+TEST(Patches, BordersNonManifoldEdgesColoursAndCreasesBoundPatches) {
+  // Three triangles on one edge (a non-manifold "book" of three pages).
+  const Mesh book = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}},
+                             {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+  EXPECT_EQ(paintPatches(book, {}).patches.size(), 3u);
+  PaintOptions across;
+  across.at_non_manifold = false;
+  EXPECT_EQ(paintPatches(book, {}, across).patches.size(), 1u);
+  // Colours: two triangles of a square, coloured differently.
+  const Mesh square =
+      makeMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 3}});
+  FaceLabels coloured;
+  coloured.colour = {0xff0000ffu, 0xff00ff00u};
+  EXPECT_EQ(paintPatches(square, coloured).patches.size(), 1u);
+  PaintOptions byColour;
+  byColour.at_colour_changes = true;
+  EXPECT_EQ(paintPatches(square, coloured, byColour).patches.size(), 2u);
+  // Creases: a box has six flat sides.
+  const Mesh cube = box();
+  EXPECT_EQ(paintPatches(cube, {}).patches.size(), 1u);
+  PaintOptions creases;
+  creases.crease_angle_deg = 30;
+  const Patches sides = paintPatches(cube, {}, creases);
+  ASSERT_EQ(sides.patches.size(), 6u);
+  for (const Patch& side : sides.patches) EXPECT_EQ(side.faces, 2u);
+  // Borders: a strip cut along a line (duplicated vertices) is two patches.
+  const Mesh cut = makeMesh(
+      {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}},
+      {{0, 1, 2}, {0, 2, 3}, {4, 6, 7}, {4, 7, 5}});
+  EXPECT_EQ(paintPatches(cut, {}).patches.size(), 2u);
+}
+
+TEST(Patches, BooleanResultsOfTwoCrossingSpheres) {
+  const SplitPair pair = splitSpheres({0.9, 0.13, 0.07});
+  Patches p = paintPatches(pair.mesh, pair.labels);
+  ASSERT_EQ(p.patches.size(), 4u);  // each sphere: the part inside the other, the part outside
+  classifyPatches(pair.mesh, pair.labels, p);
+  EXPECT_TRUE(p.part_closed[0] && p.part_closed[1]);
+  int inside = 0, onUnion = 0;
+  for (const Patch& patch : p.patches) {
+    const int other = 1 - patch.part;
+    // Closed parts: integer winding numbers, ½ on the own surface (up to
+    // the far-field approximation, a few thousandths).
+    EXPECT_NEAR(patch.winding[patch.part], 0.5, 0.01);
+    EXPECT_NEAR(patch.winding[other], std::round(patch.winding[other]), 0.01);
+    inside += patch.inside(other);
+    onUnion += patch.onUnionSurface();
+  }
+  EXPECT_EQ(inside, 2);
+  EXPECT_EQ(onUnion, 2);
+
+  double volumes[3];
+  for (BooleanOperation op :
+       {BooleanOperation::kUnion, BooleanOperation::kIntersection, BooleanOperation::kDifference}) {
+    const PatchChoice choice = choosePatches(p, op);
+    const Mesh result = extractPatches(pair.mesh, p, choice.keep, choice.flip);
+    const InspectResult i = check(result);
+    SCOPED_TRACE(toString(op));
+    EXPECT_TRUE(i.is_closed);
+    EXPECT_EQ(i.non_manifold_edges, 0u);
+    EXPECT_EQ(i.border_edges, 0u);
+    EXPECT_EQ(i.connected_components, 1u);
+    EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+    EXPECT_TRUE(i.consistently_oriented);
+    ASSERT_TRUE(i.volume.has_value());
+    EXPECT_GT(*i.volume, 0);
+    volumes[int(op)] = *i.volume;
+  }
+  // The three results partition the same faces: volumes add up exactly.
+  EXPECT_NEAR(volumes[0] + volumes[1], pair.volumeA + pair.volumeB, 1e-9);
+  EXPECT_NEAR(volumes[2], pair.volumeA - volumes[1], 1e-9);
+  EXPECT_LT(volumes[1], std::min(pair.volumeA, pair.volumeB));
+}
+
+TEST(Patches, ClassificationWithHolesInTheOtherPart) {
+  // A small sphere inside a big one with a hole cut at its top: the small
+  // one is still inside, well above the ½ threshold.
+  Mesh big = uvSphere(24, 32, 2.0);
+  {
+    std::vector<Triangle> kept;
+    const std::vector<Point3> P = positionsOf(big);
+    for (const Triangle& t : trianglesOf(big)) {
+      const Point3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
+      if (c[2] < 1.8) kept.push_back(t);  // a hole of radius ~0.9 around the top
+    }
+    big = makeMesh(P, kept);
+  }
+  const Mesh small = uvSphere(12, 16, 0.5, {0.2, 0.1, -0.3});
+  const Mesh both = appended(small, big);
+  FaceLabels labels;
+  labels.part.assign(small.face.size(), 0);
+  labels.part.resize(both.face.size(), 1);
+  Patches p = paintPatches(both, labels);
+  ASSERT_EQ(p.patches.size(), 2u);
+  classifyPatches(both, labels, p);
+  EXPECT_TRUE(p.part_closed[0]);
+  EXPECT_FALSE(p.part_closed[1]);
+  const Patch& inner = p.patches[p.patch_of_face[0]];
+  EXPECT_GT(inner.winding[1], 0.8);
+  EXPECT_LT(inner.winding[1], 1.0);
+  EXPECT_TRUE(inner.inside(1));
+  EXPECT_FALSE(inner.onUnionSurface());
+  const Patch& outer = p.patches[p.patch_of_face[small.face.size()]];
+  EXPECT_FALSE(outer.inside(0));
+  EXPECT_TRUE(outer.onUnionSurface());
+}
+
+TEST(Patches, SelfFoldsAreClassifiedLikeOverlaps) {
+  // One part made of two overlapping spheres (a mesh that folds through
+  // itself), split along its own curve: its interior patches are not on
+  // the union's surface, just as for two parts.
+  const Mesh a = uvSphere(16, 20), b = uvSphere(16, 20, 1, {1, 0.1, 0});
+  const Mesh one = appended(a, b);
+  SplitOptions o;
+  o.self = true;
+  o.between_meshes = false;
+  o.separate_meshes = false;
+  SplitResult r = splitAlongIntersections({&one}, o);
+  FaceLabels labels;
+  labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
+  Patches p = paintPatches(r.merged, labels);
+  ASSERT_EQ(p.patches.size(), 4u);
+  classifyPatches(r.merged, labels, p);
+  const PatchChoice choice = choosePatches(p, BooleanOperation::kUnion);
+  EXPECT_EQ(std::count(choice.keep.begin(), choice.keep.end(), 1), 2);
+  const InspectResult i = check(extractPatches(r.merged, p, choice.keep));
+  EXPECT_TRUE(i.is_closed);
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+}
+
+TEST(Patches, BadInput) {
+  const Mesh sphere = uvSphere(8, 8);
+  FaceLabels wrong;
+  wrong.part = {0, 1};
+  EXPECT_THROW(paintPatches(sphere, wrong), InvalidInputError);
+  Patches p = paintPatches(sphere, {});
+  EXPECT_THROW(choosePatches(p, BooleanOperation::kUnion), InvalidInputError);  // not classified
+  EXPECT_THROW(extractPatches(sphere, p, {}), InvalidInputError);
+  const Mesh other = uvSphere(10, 10);
+  EXPECT_THROW(classifyPatches(other, {}, p), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace meshmend
