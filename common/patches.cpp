@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <tuple>
+#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/parallel.h"
@@ -212,6 +213,33 @@ Patches paintPatches(const Mesh& mesh, const FaceLabels& labels, const PaintOpti
     const int id = idOfRoot[root];
     result.patch_of_face[f] = id;
     Patch& patch = result.patches[id];
+    ++patch.faces;
+    patch.area += normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm() / 2;
+  }
+  return result;
+}
+
+Patches patchesFromIds(const Mesh& mesh, const FaceLabels& labels, const std::vector<int>& ids) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<Point3> P = positionsOf(mesh);
+  if (ids.size() != T.size() || (!labels.part.empty() && labels.part.size() != T.size()))
+    throw InvalidInputError("the stored patch ids do not match the mesh's " +
+                            std::to_string(T.size()) + " faces: paint the patches again");
+  Patches result;
+  for (int p : labels.part) result.parts = std::max(result.parts, p + 1);
+  std::unordered_map<int, int> idOf;
+  result.patch_of_face.resize(T.size());
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (ids[f] < 0) throw InvalidInputError("a face has no patch id: paint the patches again");
+    const auto [it, added] = idOf.emplace(ids[f], int(result.patches.size()));
+    if (added) {
+      Patch patch;
+      patch.part = labels.part.empty() ? 0 : labels.part[f];
+      patch.first_face = int(f);
+      result.patches.push_back(patch);
+    }
+    result.patch_of_face[f] = it->second;
+    Patch& patch = result.patches[it->second];
     ++patch.faces;
     patch.area += normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm() / 2;
   }

@@ -60,6 +60,11 @@ struct Patches {
 // when `labels` do not match the mesh.
 Patches paintPatches(const Mesh& mesh, const FaceLabels& labels, const PaintOptions& options = {});
 
+// Patches as stored earlier (a patch id per face, e.g. read back from a
+// MeshLab attribute): ids are renumbered in order of first appearance.
+// Throws InvalidInputError for a negative id or a size mismatch.
+Patches patchesFromIds(const Mesh& mesh, const FaceLabels& labels, const std::vector<int>& ids);
+
 // Fills each patch's winding numbers. A closed part's winding number is an
 // integer away from its surface; an open part's (a scan with holes) is
 // fractional near the holes, and a patch counts as inside it above ½.

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "common/intersections.h"
+#include "common/patches.h"
 #include "common/split.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
@@ -266,6 +267,15 @@ void markCurveEdges(const Mesh& core, const std::vector<std::array<int, 2>>& cur
   for (std::size_t f = 0; f < flags.size() && f < cm.face.size(); ++f) attribute[f] = flags[f];
 }
 
+// Records in a written layer which input layer (part) each face came from,
+// so that the patch filters can classify the patches of a merged layer.
+void markParts(const Mesh& core, CMeshO& cm) {
+  FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(core));
+  auto attribute = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<int>(cm, kPartAttribute);
+  for (std::size_t f = 0; f < core.face.size() && f < cm.face.size(); ++f)
+    attribute[f] = fo[f].layer;
+}
+
 }  // namespace
 
 void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
@@ -322,11 +332,13 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     MeshModel* out = md.addNewMesh("", "intersected", true);
     writeMesh(r.merged, attributes, *out);
     markCurveEdges(r.merged, r.merged_curve_edges, out->cm);
+    markParts(r.merged, out->cm);
     out->cm.Tr.SetIdentity();
   } else {
     for (std::size_t i = 0; i < layers.size(); ++i) {
       writeMesh(r.meshes[i], {attributes[i]}, *layers[i]);  // in place
       markCurveEdges(r.meshes[i], r.curve_edges[i], layers[i]->cm);
+      markParts(r.meshes[i], layers[i]->cm);
       layers[i]->cm.Tr.SetIdentity();  // the geometry is now in the common frame
     }
   }

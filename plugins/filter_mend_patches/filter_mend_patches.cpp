@@ -1,0 +1,546 @@
+#include "filter_mend_patches.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "common/inspect.h"
+#include "common/intersections.h"
+#include "common/patches.h"
+#include "common/split.h"
+#include "plugins/bridge/filter_support.h"
+#include "plugins/bridge/mesh_bridge.h"
+
+using namespace meshmend;
+using namespace meshmend::bridge;
+
+namespace {
+
+enum Layers { kCurrentLayer, kAllVisible };
+enum SelectBy {
+  kByIds,
+  kTouchingSelection,
+  kOutsideOthers,
+  kInsideAllOthers,
+  kInsidePart,
+  kUnionInterior
+};
+enum Keep { kUnselected, kUnion, kIntersection, kDifference };
+
+using Clock = std::chrono::steady_clock;
+
+// The chosen layers as one core mesh (layer matrices applied) with the
+// per-face labels the patch functions take.
+struct Assembly {
+  std::vector<MeshModel*> layers;
+  std::vector<std::size_t> firstFace;  // per layer: its first face in `mesh`
+  Mesh mesh;
+  FaceLabels labels;
+  std::vector<int> storedPatch;  // per face: the painted patch id, if every layer has them
+};
+
+template <class T>
+bool hasFaceAttribute(CMeshO& cm, const char* name) {
+  return vcg::tri::Allocator<CMeshO>::IsValidHandle(
+      cm, vcg::tri::Allocator<CMeshO>::FindPerFaceAttribute<T>(cm, name));
+}
+
+// Calls fn(core face index, face) for the live faces of layer i of `a`.
+template <class Fn>
+void forEachFace(const Assembly& a, std::size_t i, Fn&& fn) {
+  std::size_t index = a.firstFace[i];
+  for (CFaceO& f : a.layers[i]->cm.face)
+    if (!f.IsD()) fn(index++, f);
+}
+
+Assembly assemble(MeshDocument& md, int which) {
+  Assembly a;
+  if (which == kCurrentLayer) {
+    if (!md.mm()) throw InvalidInputError("there is no current layer: open a mesh first");
+    a.layers = {md.mm()};
+  } else {
+    for (MeshModel* m : md.meshList)
+      if (m->isVisible() && m->cm.fn > 0) a.layers.push_back(m);
+    if (a.layers.empty()) throw InvalidInputError("no visible layer has faces");
+  }
+  bool allPainted = true;
+  for (std::size_t i = 0; i < a.layers.size(); ++i) {
+    CMeshO& cm = a.layers[i]->cm;
+    Mesh core = toCore(cm, {int(i), true});
+    requireFacesAndFiniteCoordinates(core, layerName(*a.layers[i]));
+    a.firstFace.push_back(a.mesh.face.size());
+    a.mesh = i == 0 ? std::move(core) : appended(a.mesh, core);
+    const bool parts = a.layers.size() == 1 && hasFaceAttribute<int>(cm, kPartAttribute);
+    const bool curves = hasFaceAttribute<unsigned char>(cm, kCurveEdgesAttribute);
+    const bool painted = hasFaceAttribute<int>(cm, kPatchAttribute);
+    allPainted &= painted;
+    auto part = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<int>(cm, kPartAttribute);
+    auto curve =
+        vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(cm, kCurveEdgesAttribute);
+    auto patch = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<int>(cm, kPatchAttribute);
+    const bool colours = a.layers[i]->hasDataMask(MeshModel::MM_FACECOLOR);
+    for (CFaceO& f : cm.face) {
+      if (f.IsD()) continue;
+      a.labels.part.push_back(parts ? std::max(0, part[f]) : int(i));
+      a.labels.curve_edges.push_back(curves ? curve[f] : 0);
+      a.labels.colour.push_back(colours ? f.C().V(0) | f.C().V(1) << 8 | f.C().V(2) << 16 : 0);
+      a.storedPatch.push_back(painted ? patch[f] : -1);
+    }
+    // GetPerFaceAttribute added the attributes a layer did not have: undo.
+    if (!parts) vcg::tri::Allocator<CMeshO>::DeletePerFaceAttribute(cm, kPartAttribute);
+    if (!curves) vcg::tri::Allocator<CMeshO>::DeletePerFaceAttribute(cm, kCurveEdgesAttribute);
+    if (!painted) vcg::tri::Allocator<CMeshO>::DeletePerFaceAttribute(cm, kPatchAttribute);
+  }
+  if (!allPainted) a.storedPatch.clear();
+  return a;
+}
+
+// Patches as painted before (stored ids), or painted now with the defaults.
+Patches patchesOf(const Assembly& a) {
+  if (!a.storedPatch.empty()) return patchesFromIds(a.mesh, a.labels, a.storedPatch);
+  return paintPatches(a.mesh, a.labels);
+}
+
+// Well-separated colours: hues a golden angle apart.
+vcg::Color4b colourOf(int id) {
+  const double h = std::fmod(id * 0.6180339887, 1.0) * 6, s = id % 2 ? 0.55 : 0.75, v = 0.95;
+  const int sector = int(h);
+  const double f = h - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  double r = v, g = t, b = p;
+  switch (sector % 6) {
+    case 1:
+      r = q, g = v, b = p;
+      break;
+    case 2:
+      r = p, g = v, b = t;
+      break;
+    case 3:
+      r = p, g = q, b = v;
+      break;
+    case 4:
+      r = t, g = p, b = v;
+      break;
+    case 5:
+      r = v, g = p, b = q;
+      break;
+  }
+  return vcg::Color4b(int(r * 255), int(g * 255), int(b * 255), 255);
+}
+
+// What a user needs to know about the threshold when a part is open.
+std::vector<std::string> openPartNotes(const Patches& p) {
+  std::vector<std::string> notes;
+  for (int part = 0; part < p.parts; ++part)
+    if (!p.part_closed[part])
+      notes.push_back("part " + std::to_string(part) +
+                      " is open (it has border edges): its winding number is fractional near "
+                      "the holes, and a patch counts as inside it where the winding number "
+                      "exceeds 0.5");
+  return notes;
+}
+
+std::string partsLegend(const Assembly& a) {
+  if (a.layers.size() > 1) {
+    std::string s;
+    for (std::size_t i = 0; i < a.layers.size(); ++i)
+      s += (i ? ", " : "") + std::to_string(i) + " = " + toStd(a.layers[i]->label());
+    return "parts: " + s;
+  }
+  return "parts: the input layers of the intersection, in their order";
+}
+
+// Patch ids from text such as "0, 3, 5-7".
+std::vector<int> parseIds(const std::string& text, std::size_t patches) {
+  std::vector<int> ids;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (item.empty()) continue;
+    int lo = 0, hi = 0;
+    char dash = 0;
+    std::stringstream range(item);
+    if (!(range >> lo)) throw InvalidInputError("'" + item + "' is not a patch id");
+    hi = lo;
+    if (range >> dash && !(dash == '-' && range >> hi))
+      throw InvalidInputError("'" + item + "' is not a patch id or a range like 5-7");
+    if (lo < 0 || hi < lo || std::size_t(hi) >= patches)
+      throw InvalidInputError("patch id '" + item + "' does not exist: the ids run from 0 to " +
+                              std::to_string(patches - 1));
+    for (int id = lo; id <= hi; ++id) ids.push_back(id);
+  }
+  if (ids.empty()) throw InvalidInputError("no patch ids given: write them like 0, 3, 5-7");
+  return ids;
+}
+
+}  // namespace
+
+PatchesPlugin::PatchesPlugin() {
+  typeList << PAINT_PATCHES << SELECT_PATCHES << REMOVE_PATCHES;
+  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+}
+
+QString PatchesPlugin::filterName(FilterIDType id) const {
+  switch (id) {
+    case PAINT_PATCHES:
+      return "MeshMend: Paint Surface Patches";
+    case SELECT_PATCHES:
+      return "MeshMend: Select Patches";
+    default:
+      return "MeshMend: Remove Patches";
+  }
+}
+
+QString PatchesPlugin::filterInfo(FilterIDType id) const {
+  switch (id) {
+    case PAINT_PATCHES:
+      return "Flood-fills the faces into surface patches bounded by the curves that "
+             "'Intersect and Split Layers' inserted, by border (free) edges and non-manifold "
+             "edges, and optionally by changes of face colour or creases sharper than an angle. "
+             "Each patch gets an id (stored per face in the attribute 'meshmend_patch' and in "
+             "the face quality) and a colour. Each patch is also classified with generalized "
+             "winding numbers: inside or outside each other part (input layer), and whether it "
+             "lies on the outer surface of all parts together (robust to holes: a scan with "
+             "holes is still 'inside' where its winding number exceeds 0.5; a layer's own folds "
+             "count like overlaps between layers). The log lists id, part, faces, area and "
+             "status.<br>Method: surface painting of <i>McLaurin et al.</i>, IJNME 2013 §2.6; "
+             "winding numbers of <i>Jacobson et al.</i>, SIGGRAPH 2013, evaluated through a "
+             "hierarchy as in <i>Barill et al.</i>, SIGGRAPH 2018.";
+    case SELECT_PATCHES:
+      return "Selects whole patches (as painted by 'Paint Surface Patches', or painted now with "
+             "its defaults): by id, those touching the faces already selected (click one face "
+             "with the selection tool, then run this), or by classification: outside all other "
+             "parts, inside all other parts, inside one part, or inside the union (the patches "
+             "'keep outer surface' removes).";
+    default:
+      return "Removes patches and joins what is left into one mesh: either the patches that "
+             "have a selected face, or by a boolean preset computed from the classification: "
+             "keep the outer surface (union), keep the common interior (intersection), or keep "
+             "the first part minus the others (difference; the other parts' patches that bound "
+             "it are turned over). Removed patches can be moved to a new layer, so nothing is "
+             "lost. Vertices that coincide exactly (where the layers met along a curve) are "
+             "welded. The result is checked (non-manifold and border edges, intersecting pairs) "
+             "and logged.";
+  }
+}
+
+MeshFilterInterface::FilterClass PatchesPlugin::getClass(QAction* a) {
+  switch (ID(a)) {
+    case PAINT_PATCHES:
+      return MeshFilterInterface::FaceColoring;
+    case SELECT_PATCHES:
+      return MeshFilterInterface::Selection;
+    default:
+      return MeshFilterInterface::Cleaning;
+  }
+}
+
+int PatchesPlugin::postCondition(QAction* a) const {
+  switch (ID(a)) {
+    case PAINT_PATCHES:
+      return MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY;
+    case SELECT_PATCHES:
+      return MeshModel::MM_FACEFLAGSELECT;
+    default:
+      return MeshModel::MM_ALL;
+  }
+}
+
+void PatchesPlugin::initParameterSet(QAction* a, MeshDocument&, RichParameterList& parameters) {
+  parameters.addParam(RichEnum(
+      "layers", kCurrentLayer,
+      QStringList() << "The current layer"
+                    << "All visible layers",
+      "Layers",
+      "The current layer (e.g. the merged output of 'Intersect and Split Layers', whose faces "
+      "remember their input layer), or all visible layers together (each one a part)."));
+  switch (ID(a)) {
+    case PAINT_PATCHES:
+      parameters.addParam(RichBool("at_curves", true, "Stop at intersection curves",
+                                   "Curve edges marked by 'Intersect and Split Layers' bound "
+                                   "patches."));
+      parameters.addParam(RichBool("at_non_manifold", true, "Stop at non-manifold edges",
+                                   "Edges shared by three or more faces bound patches (the "
+                                   "curves of a merged layer are such edges)."));
+      parameters.addParam(RichBool("at_colour_changes", false, "Stop at colour changes",
+                                   "An edge between faces of different colour bounds patches "
+                                   "(surface groups of a CAD export)."));
+      parameters.addParam(RichFloat("crease_angle", 0, "Stop at creases sharper than (degrees)",
+                                    "An edge whose faces' normals differ by more than this "
+                                    "angle bounds patches; 0 = off."));
+      parameters.addParam(RichBool("classify", true, "Classify inside / outside",
+                                   "Computes each patch's winding numbers (inside or outside "
+                                   "each other part; on the outer surface or not)."));
+      break;
+    case SELECT_PATCHES:
+      parameters.addParam(RichEnum("by", kTouchingSelection,
+                                   QStringList() << "Patch ids"
+                                                 << "Patches touching the selected faces"
+                                                 << "Outside all other parts"
+                                                 << "Inside all other parts"
+                                                 << "Inside one part"
+                                                 << "Inside the union (not on the outer surface)",
+                                   "Select", "Which patches to select."));
+      parameters.addParam(RichString("ids", "", "Patch ids",
+                                     "For 'Patch ids': ids as listed by 'Paint Surface Patches', "
+                                     "like 0, 3, 5-7."));
+      parameters.addParam(RichInt("part", 1, "Part",
+                                  "For 'Inside one part': the part (input layer number, from "
+                                  "0) the patches must lie inside."));
+      break;
+    default:
+      parameters.addParam(RichEnum(
+          "keep", kUnion,
+          QStringList() << "All but the patches with a selected face"
+                        << "Outer surface (union)"
+                        << "Common interior (intersection)"
+                        << "First part minus the others (difference)",
+          "Keep", "What to keep: everything except the selected patches, or a boolean result."));
+      parameters.addParam(RichBool("removed_to_layer", false, "Move removed patches to a layer",
+                                   "Puts the removed patches into a new layer named 'removed "
+                                   "patches' instead of deleting them."));
+      parameters.addParam(RichBool("verify", true, "Check the result",
+                                   "Counts intersecting pairs (exact), non-manifold and border "
+                                   "edges of the result and logs them."));
+      break;
+  }
+  parameters.addParam(RichString(
+      "report_file", "", "Report file (JSON)",
+      ID(a) == REMOVE_PATCHES
+          ? "When not empty, the result is also written to this path as one JSON object: "
+            "patches, patches_removed, faces_out, non_manifold_edges, border_edges, "
+            "remaining_intersecting_pairs, is_closed, volume and time_ms."
+          : "When not empty, the result is also written to this path as one JSON object: "
+            "patches (count), parts, patch_list (id, part, faces, area, status, winding "
+            "numbers) and time_ms."));
+}
+
+bool PatchesPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                                vcg::CallBackPos* cb) {
+  return guarded(*this, errorMessage, [&] {
+    switch (ID(a)) {
+      case PAINT_PATCHES:
+        paint(md, parameters, cb);
+        break;
+      case SELECT_PATCHES:
+        select(md, parameters, cb);
+        break;
+      default:
+        remove(md, parameters, cb);
+        break;
+    }
+  });
+}
+
+void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
+                          vcg::CallBackPos* cb) {
+  const auto start = Clock::now();
+  reportProgress(progressFrom(cb), 0, "Painting patches");
+  const Assembly a = assemble(md, parameters.getEnum("layers"));
+  PaintOptions options;
+  options.at_curves = parameters.getBool("at_curves");
+  options.at_non_manifold = parameters.getBool("at_non_manifold");
+  options.at_colour_changes = parameters.getBool("at_colour_changes");
+  options.crease_angle_deg = parameters.getFloat("crease_angle");
+  if (!(options.crease_angle_deg >= 0 && options.crease_angle_deg < 180))
+    throw InvalidInputError("the crease angle must be between 0 (off) and 180 degrees");
+  Patches p = paintPatches(a.mesh, a.labels, options);
+  const bool classify = parameters.getBool("classify");
+  if (classify) {
+    reportProgress(progressFrom(cb), 50, "Classifying patches");
+    classifyPatches(a.mesh, a.labels, p);
+  }
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  JsonObject report = toJson(p);
+  report.set("time_ms", ms);
+  writeReport(parameters.getString("report_file"), report);
+
+  // The document changes only from here on.
+  for (std::size_t i = 0; i < a.layers.size(); ++i) {
+    MeshModel* m = a.layers[i];
+    m->updateDataMask(MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY);
+    auto id = vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<int>(m->cm, kPatchAttribute);
+    forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
+      const int patch = p.patch_of_face[f];
+      id[face] = patch;
+      face.Q() = float(patch);
+      face.C() = colourOf(patch);
+    });
+  }
+  Log("MeshMend: %zu patches (%zu bounding edges) in %.0f ms; %s", p.patches.size(),
+      p.boundary_edges, ms, partsLegend(a).c_str());
+  Log("  id   part   faces   area   status");
+  constexpr std::size_t kListed = 200;
+  for (std::size_t id = 0; id < p.patches.size() && id < kListed; ++id) {
+    const Patch& patch = p.patches[id];
+    Log("  %zu   %d   %zu   %.6g   %s", id, patch.part, patch.faces, patch.area,
+        classify ? statusOf(patch, p.parts).c_str() : "-");
+  }
+  if (p.patches.size() > kListed)
+    Log("  ... %zu more patches (all of them are in the report file)", p.patches.size() - kListed);
+  if (classify)
+    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+}
+
+void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters,
+                           vcg::CallBackPos* cb) {
+  reportProgress(progressFrom(cb), 0, "Selecting patches");
+  const Assembly a = assemble(md, parameters.getEnum("layers"));
+  Patches p = patchesOf(a);
+  const int by = parameters.getEnum("by");
+  std::vector<char> chosen(p.patches.size(), 0);
+  if (by == kByIds) {
+    for (int id : parseIds(toStd(parameters.getString("ids")), p.patches.size())) chosen[id] = 1;
+  } else if (by == kTouchingSelection) {
+    bool any = false;
+    for (std::size_t i = 0; i < a.layers.size(); ++i)
+      forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
+        if (face.IsS()) chosen[p.patch_of_face[f]] = 1, any = true;
+      });
+    if (!any)
+      throw InvalidInputError(
+          "no face is selected: select a face of each patch you want "
+          "(e.g. with the selection tool), then run this again");
+  } else {
+    const int part = parameters.getInt("part");
+    if (by == kInsidePart && (part < 0 || part >= p.parts))
+      throw InvalidInputError("there is no part " + std::to_string(part) +
+                              ": the parts run from 0 to " + std::to_string(p.parts - 1));
+    if (by != kUnionInterior && p.parts < 2)
+      throw InvalidInputError(
+          "there is only one part: inside / outside other parts needs the "
+          "merged output of 'Intersect and Split Layers' or several layers");
+    classifyPatches(a.mesh, a.labels, p);
+    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+    for (std::size_t id = 0; id < p.patches.size(); ++id) {
+      const Patch& patch = p.patches[id];
+      bool allOut = true, allIn = true;
+      for (int q = 0; q < p.parts; ++q)
+        if (q != patch.part) (patch.inside(q) ? allOut : allIn) = false;
+      switch (by) {
+        case kOutsideOthers:
+          chosen[id] = allOut;
+          break;
+        case kInsideAllOthers:
+          chosen[id] = allIn;
+          break;
+        case kInsidePart:
+          chosen[id] = patch.part != part && patch.inside(part);
+          break;
+        default:
+          chosen[id] = !patch.onUnionSurface();
+          break;
+      }
+    }
+  }
+  std::size_t faces = 0, patches = 0;
+  for (char c : chosen) patches += c;
+  for (std::size_t i = 0; i < a.layers.size(); ++i)
+    forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
+      if (chosen[p.patch_of_face[f]]) {
+        face.SetS();
+        ++faces;
+      } else {
+        face.ClearS();
+      }
+    });
+  Log("MeshMend: selected %zu of %zu patches (%zu faces)", patches, p.patches.size(), faces);
+}
+
+void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters,
+                           vcg::CallBackPos* cb) {
+  const auto start = Clock::now();
+  reportProgress(progressFrom(cb), 0, "Choosing patches");
+  const int which = parameters.getEnum("layers");
+  const Assembly a = assemble(md, which);
+  Patches p = patchesOf(a);
+  const int keepMode = parameters.getEnum("keep");
+  PatchChoice choice;
+  if (keepMode == kUnselected) {
+    choice.keep.assign(p.patches.size(), 1);
+    bool any = false;
+    for (std::size_t i = 0; i < a.layers.size(); ++i)
+      forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
+        if (face.IsS()) choice.keep[p.patch_of_face[f]] = 0, any = true;
+      });
+    if (!any)
+      throw InvalidInputError(
+          "no face is selected: select the patches to remove first (e.g. "
+          "with 'Select Patches'), or choose a boolean preset");
+  } else {
+    const BooleanOperation op = keepMode == kUnion          ? BooleanOperation::kUnion
+                                : keepMode == kIntersection ? BooleanOperation::kIntersection
+                                                            : BooleanOperation::kDifference;
+    if (op != BooleanOperation::kUnion && p.parts < 2)
+      throw InvalidInputError(
+          "intersection and difference need two parts: use the merged "
+          "output of 'Intersect and Split Layers' of two layers, or two "
+          "visible layers");
+    reportProgress(progressFrom(cb), 20, "Classifying patches");
+    classifyPatches(a.mesh, a.labels, p);
+    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+    choice = choosePatches(p, op);
+  }
+  std::size_t kept = 0;
+  for (char k : choice.keep) kept += k;
+  if (kept == 0)
+    throw InvalidInputError(
+        "nothing would be left: every patch would be removed (are the "
+        "layers intersected and split first?)");
+  reportProgress(progressFrom(cb), 60, "Extracting the kept patches");
+  const Mesh result = extractPatches(a.mesh, p, choice.keep, choice.flip);
+  std::vector<char> removedPatches(choice.keep.size());
+  for (std::size_t id = 0; id < choice.keep.size(); ++id) removedPatches[id] = !choice.keep[id];
+  const bool toLayer = parameters.getBool("removed_to_layer");
+  Mesh removed;
+  if (toLayer && kept < p.patches.size()) removed = extractPatches(a.mesh, p, removedPatches);
+
+  JsonObject report;
+  report.set("patches", p.patches.size())
+      .set("patches_removed", p.patches.size() - kept)
+      .set("faces_out", std::size_t(result.fn))
+      .set("keep",
+           keepMode == kUnselected ? "unselected" : toString(BooleanOperation(keepMode - 1)));
+  InspectResult check;
+  std::size_t remaining = 0;
+  const bool verify = parameters.getBool("verify");
+  if (verify) {
+    reportProgress(progressFrom(cb), 80, "Checking the result");
+    check = inspect(result);
+    FindIntersectionsOptions o;
+    o.cross = false;
+    remaining = findIntersections({&result}, o).pairs.size();
+    report.set("non_manifold_edges", check.non_manifold_edges)
+        .set("border_edges", check.border_edges)
+        .set("is_closed", check.is_closed)
+        .set("volume", check.volume)
+        .set("remaining_intersecting_pairs", remaining);
+  }
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  report.set("time_ms", ms);
+  writeReport(parameters.getString("report_file"), report);
+
+  // The document changes only from here on.
+  std::vector<LayerAttributes> attributes;
+  for (MeshModel* m : a.layers) attributes.push_back(snapshot(*m));
+  MeshModel* out = which == kCurrentLayer ? a.layers[0] : md.addNewMesh("", "kept patches", true);
+  writeMesh(result, attributes, *out);
+  out->cm.Tr.SetIdentity();
+  for (const char* name : {kPatchAttribute, kPartAttribute, kCurveEdgesAttribute})
+    vcg::tri::Allocator<CMeshO>::DeletePerFaceAttribute(out->cm, name);
+  if (toLayer && removed.fn > 0) {
+    MeshModel* rest = md.addNewMesh("", "removed patches", false);
+    writeMesh(removed, attributes, *rest);
+    rest->cm.Tr.SetIdentity();
+  }
+  if (which == kAllVisible)
+    for (MeshModel* m : a.layers) m->visible = false;
+  Log("MeshMend: kept %zu of %zu patches: %d faces (%.0f ms)%s", kept, p.patches.size(), out->cm.fn,
+      ms, toLayer ? "; the removed ones are in layer 'removed patches'" : "");
+  if (verify)
+    Log("  check: %zu intersecting pairs, %zu non-manifold edges, %zu border edges%s", remaining,
+        check.non_manifold_edges, check.border_edges, check.is_closed ? ", closed" : "");
+}
+
+MESHLAB_PLUGIN_NAME_EXPORTER(PatchesPlugin)
