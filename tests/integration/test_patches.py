@@ -1,0 +1,142 @@
+"""Patch painting, classification and removal through meshlabserver: the
+sample pipelines (intersect -> paint -> classify -> remove -> weld) on real
+pairs, checked by meshcheck and against CGAL's boolean volumes."""
+import functools
+import subprocess
+
+import pytest
+
+from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, mlx, require_shared_data, run_server, \
+    write_off
+
+def shifted(V, d):
+    return [(x + d, y + d, z + d) for x, y, z in V]
+
+
+PAINT = "MeshMend: Paint Surface Patches"
+SELECT = "MeshMend: Select Patches"
+REMOVE = "MeshMend: Remove Patches"
+SPLIT = "MeshMend: Intersect and Split Layers"
+
+PAIRS = [("pairs/blobby.off", "pairs/eight.off"),
+         ("pairs/ballA.off", "pairs/ballB.off"),
+         ("pairs/cube.obj", "pairs/sphere.obj"),
+         ("pairs/cheburashka.off", "pairs/decimated-knight.off")]
+SAMPLES = {"union": "keep_outer_surface", "intersection": "keep_common_interior",
+           "difference": "difference"}
+
+
+def sample(name):
+    """A sample script whose last report_file is {report0}."""
+    text = (ROOT / "samples" / f"{name}.mlx").read_text()
+    head, tail = text.rsplit('value="" name="report_file"', 1)
+    return head + 'value="{report0}" name="report_file"' + tail
+
+
+@functools.lru_cache(maxsize=None)
+def cgal_volumes(a, b):
+    """Volumes of A, B and CGAL's union (peer_corefine)."""
+    peer = MESHCHECK.parent / "peer_corefine"
+    if not peer.is_file():
+        pytest.fail(f"{peer} is missing: scripts/test builds it from ../shared/tools")
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        out = f"{tmp}/union.off"
+        run = subprocess.run([str(peer), str(DATA / a), str(DATA / b), "--out", out],
+                             capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stdout + run.stderr
+        union = meshcheck(out)["volume"]
+    return meshcheck(DATA / a)["volume"], meshcheck(DATA / b)["volume"], union
+
+
+@pytest.mark.parametrize("operation", ["union", "intersection", "difference"])
+@pytest.mark.parametrize("a,b", PAIRS)
+def test_boolean_samples_match_cgal(tmp_path, a, b, operation):
+    require_shared_data()
+    out = tmp_path / "result.ply"
+    run = run_server(tmp_path, [DATA / a, DATA / b], sample(SAMPLES[operation]), outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    r, check = run.report, meshcheck(out)
+    assert r["patches"] >= 2 and 0 < r["patches_removed"] < r["patches"]
+    assert r["faces_out"] == check["faces"]
+    assert r["remaining_intersecting_pairs"] == 0 and check["self_intersecting_pairs"] == 0
+    assert r["non_manifold_edges"] == 0 and check["non_manifold_edges"] == 0
+    assert r["border_edges"] == 0 and check["border_edges"] == 0 and check["is_closed"]
+    va, vb, vu = cgal_volumes(a, b)
+    vi = va + vb - vu
+    expected = {"union": vu, "intersection": vi, "difference": va - vi}[operation]
+    assert check["volume"] == pytest.approx(expected, rel=1e-5), (check["volume"], expected)
+
+
+def test_paint_sample_lists_and_colours_patches(tmp_path):
+    require_shared_data()
+    out = tmp_path / "painted.ply"
+    run = run_server(tmp_path, [DATA / "pairs/blobby.off", DATA / "pairs/eight.off"],
+                     sample("paint_patches"), outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    r = run.report
+    assert r["patches"] == len(r["patch_list"]) >= 4 and r["parts"] == 2
+    assert sum(p["faces"] for p in r["patch_list"]) == meshcheck(out)["faces"]
+    assert {p["part"] for p in r["patch_list"]} == {0, 1}
+    # Closed parts: every patch is either inside the other part or not, clearly.
+    for p in r["patch_list"]:
+        other = p["winding"][1 - p["part"]]
+        assert abs(other - round(other)) < 0.05
+        assert ("inside part" in p["status"]) == (other > 0.5)
+    assert "id   part   faces   area   status" in run.log
+
+
+def test_a_mesh_without_boundaries_is_one_patch(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    run = run_server(tmp_path, [a], mlx((PAINT, {"report_file": "{report0}"})))
+    assert run.returncode == 0, run.log
+    assert run.report["patches"] == 1 and run.report["patch_list"][0]["faces"] == 12
+
+
+def test_select_and_remove_by_hand(tmp_path):
+    """Two crossing cubes: select the patches inside the union, remove them
+    (moved to a layer): the rest is one closed mesh, the removed ones kept."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out = tmp_path / "kept.ply"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1}),
+                 (PAINT, {}),
+                 (SELECT, {"by": 5}),
+                 (REMOVE, {"keep": 0, "removed_to_layer": True, "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["patches"] == 4 and r["patches_removed"] == 2
+    assert r["is_closed"] and r["non_manifold_edges"] == 0 and r["remaining_intersecting_pairs"] == 0
+    assert r["volume"] == pytest.approx(2 - 0.125, rel=1e-6)  # two unit cubes overlapping by 1/8
+    assert "layer 'removed patches'" in run.log
+
+
+def test_bad_input(tmp_path):
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    # Intersection on a single part: refused, says why.
+    run = run_server(tmp_path, [a], mlx((REMOVE, {"keep": 2, "report_file": "{report0}"})))
+    assert run.returncode != 0 and "need two parts" in run.log and not run.reports
+    # Removing the selected patches with nothing selected.
+    run = run_server(tmp_path, [a], mlx((REMOVE, {"keep": 0, "report_file": "{report0}"})))
+    assert run.returncode != 0 and "no face is selected" in run.log and not run.reports
+    # Ids that do not exist.
+    run = run_server(tmp_path, [a], mlx((SELECT, {"by": 0, "ids": "0, 4-6"})))
+    assert run.returncode != 0 and "does not exist" in run.log
+
+
+def test_open_layer_says_how_the_winding_number_is_thresholded(tmp_path):
+    """A cube with one face missing, crossing a closed cube: classification
+    works and the log explains the ½ threshold for the open part."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F[:-1])
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1}),
+                 (SELECT, {"by": 2}))
+    run = run_server(tmp_path, [a, b], script)
+    assert run.returncode == 0, run.log
+    assert "part 0 is open" in run.log and "exceeds 0.5" in run.log
+    assert "selected" in run.log
