@@ -824,59 +824,6 @@ void rebuildSeparate(const OutputArrays& merged, const std::vector<int>& index,
   }
 }
 
-// Curve ends joined by one mesh edge: where a contact ran exactly along an
-// input edge between two input vertices, the segment can be missing from
-// both faces' constraints (each saw only its corners). That edge is part of
-// the curve: marking it keeps the curves closed, so that patches do not leak
-// through the gap. Returns the edges added (also to each mesh's curves).
-std::size_t closeOneEdgeGaps(const OutputArrays& merged, std::set<std::array<int, 2>>& curves,
-                             const std::vector<OutputArrays>& outputs,
-                             const std::vector<std::vector<int>>& mergedVertex,
-                             std::vector<std::vector<std::array<int, 2>>>& curveEdges) {
-  std::unordered_map<int, int> degree;
-  for (const auto& e : curves) ++degree[e[0]], ++degree[e[1]];
-  std::set<std::array<int, 2>> gaps;
-  for (const Triangle& t : merged.triangles)
-    for (int k = 0; k < 3; ++k) {
-      std::array<int, 2> e{t[k], t[(k + 1) % 3]};
-      if (e[0] > e[1]) std::swap(e[0], e[1]);
-      const auto a = degree.find(e[0]), b = degree.find(e[1]);
-      if (a != degree.end() && b != degree.end() && a->second % 2 && b->second % 2 &&
-          !curves.count(e))
-        gaps.insert(e);
-    }
-  // Each end closes one gap: the shortest edge first.
-  std::vector<std::pair<double, std::array<int, 2>>> byLength;
-  for (const auto& e : gaps)
-    byLength.push_back({Distance(merged.positions[e[0]], merged.positions[e[1]]), e});
-  std::sort(byLength.begin(), byLength.end());
-  std::unordered_map<int, int> uses;
-  std::set<std::array<int, 2>> added;
-  for (const auto& [length, e] : byLength)
-    if (!uses.count(e[0]) && !uses.count(e[1])) {
-      uses[e[0]] = uses[e[1]] = 1;
-      added.insert(e);
-    }
-  for (std::size_t m = 0; m < outputs.size() && !added.empty(); ++m) {
-    std::unordered_map<int, int> localOf;
-    for (std::size_t v = 0; v < mergedVertex[m].size(); ++v)
-      if (uses.count(mergedVertex[m][v])) localOf[mergedVertex[m][v]] = int(v);
-    std::set<std::array<int, 2>> meshEdges;
-    for (const Triangle& t : outputs[m].triangles)
-      for (int k = 0; k < 3; ++k)
-        meshEdges.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-    for (const auto& e : added) {
-      const auto a = localOf.find(e[0]), b = localOf.find(e[1]);
-      if (a == localOf.end() || b == localOf.end()) continue;
-      const std::array<int, 2> local{std::min(a->second, b->second),
-                                     std::max(a->second, b->second)};
-      if (meshEdges.count(local)) curveEdges[m].push_back(local);
-    }
-  }
-  curves.insert(added.begin(), added.end());
-  return added.size();
-}
-
 // Removes faces with the same three vertices as an earlier face (in any
 // order): the same surface twice, which would intersect itself everywhere.
 std::size_t removeDuplicateFaces(WeldedArrays& in) {
@@ -1079,7 +1026,6 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         curves.insert(g);
       }
     }
-    r.curve_gaps_closed = closeOneEdgeGaps(merged, curves, outputs, r.merged_vertex, r.curve_edges);
     // The quality of the new faces: their smallest angle, and the slivers.
     auto slivers = [&] {
       std::size_t n = 0;
@@ -1361,7 +1307,6 @@ JsonObject toJson(const SplitResult& r) {
       .set("curve_edges", curveEdges)
       .set("curve_loops", r.curve_loops)
       .set("open_curves", r.open_curves)
-      .set("curve_gaps_closed", r.curve_gaps_closed)
       .set("faces_split", r.faces_split)
       .set("faces_added", r.faces_added)
       .set("new_vertices", r.new_vertices)

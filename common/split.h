@@ -69,9 +69,8 @@ struct SplitResult {
   std::size_t new_faces_below_1deg_unsnapped = 0;  // the same before quality snapping
   std::size_t vertices_snapped = 0;                // new vertices merged into input vertices
   std::size_t edges_snapped = 0;                   // input edges split at a new vertex
-  std::size_t curve_gaps_closed = 0;  // input edges between two curve ends marked as curve edges
-  std::size_t curve_loops = 0;        // closed curve components (merged output)
-  std::size_t open_curves = 0;        // curve components with end points
+  std::size_t curve_loops = 0;                     // closed curve components (merged output)
+  std::size_t open_curves = 0;                     // curve components with end points
   double time_ms = 0;
 };
 
