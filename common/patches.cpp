@@ -135,6 +135,9 @@ class WindingTree {
     const Point3 a = P_[t[0]] - p, b = P_[t[1]] - p, c = P_[t[2]] - p;
     const double la = a.Norm(), lb = b.Norm(), lc = c.Norm();
     const double numerator = a * (b ^ c);
+    // In the triangle's plane (a coplanar neighbour of the query face): no
+    // solid angle, whatever the sign of the denominator.
+    if (numerator == 0) return 0;
     const double denominator = la * lb * lc + (a * b) * lc + (b * c) * la + (c * a) * lb;
     return 2 * std::atan2(numerator, denominator);
   }
@@ -315,6 +318,116 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
         }
       },
       4);
+
+  // A patch can lie on both sides of another part where that part is open:
+  // a curve that ends at the other part's border does not separate the
+  // patch (a closed mesh passing through a scan's hole). Faces spread over
+  // each patch reveal it; such a patch is split by classifying every face,
+  // along the level set where the other part's winding number crosses ½.
+  auto statusOf = [&](const std::vector<double>& winding) {
+    std::uint64_t status = 0;
+    double total = 0;
+    for (int p = 0; p < patches.parts; ++p) {
+      total += winding[p];
+      if (winding[p] > 0.5 && p < 63) status |= std::uint64_t(1) << p;
+    }
+    if (total - 0.5 < 0.5 && total + 0.5 > 0.5) status |= std::uint64_t(1) << 63;
+    return status;
+  };
+  auto windingAt = [&](std::size_t f) {
+    std::vector<double> w(patches.parts);
+    const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
+    for (int p = 0; p < patches.parts; ++p) w[p] = trees[p].at(c, int(f));
+    return w;
+  };
+  std::vector<std::vector<int>> facesOfPatch(patches.patches.size());
+  for (std::size_t f = 0; f < T.size(); ++f)
+    facesOfPatch[patches.patch_of_face[f]].push_back(int(f));
+  constexpr std::size_t kProbes = 32;
+  std::vector<char> mixed(patches.patches.size(), 0);
+  parallelChunks(
+      patches.patches.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t id = begin; id < end; ++id) {
+          const std::vector<int>& faces = facesOfPatch[id];
+          const std::uint64_t status = statusOf(patches.patches[id].winding);
+          const std::size_t step = std::max<std::size_t>(1, faces.size() / kProbes);
+          for (std::size_t k = step / 2; k < faces.size() && !mixed[id]; k += step)
+            mixed[id] = statusOf(windingAt(faces[k])) != status;
+        }
+      },
+      1);
+  std::vector<int> refine;  // faces of mixed patches
+  for (std::size_t id = 0; id < mixed.size(); ++id)
+    if (mixed[id]) refine.insert(refine.end(), facesOfPatch[id].begin(), facesOfPatch[id].end());
+  if (refine.empty()) return;
+  // A closed part's winding number is the same all over a patch that does
+  // not cross it: only the open parts' change from face to face.
+  std::vector<std::vector<double>> faceWinding(T.size());
+  parallelChunks(
+      refine.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const int f = refine[i];
+          std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
+          const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
+          for (int p = 0; p < patches.parts; ++p)
+            if (!patches.part_closed[p]) w[p] = trees[p].at(c, f);
+          faceWinding[f] = std::move(w);
+        }
+      },
+      256);
+  std::vector<int> parent(T.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 2) {
+      const int f = uses[i].face, g = uses[i + 1].face;
+      const int id = patches.patch_of_face[f];
+      if (id == patches.patch_of_face[g] && mixed[id] &&
+          statusOf(faceWinding[f]) == statusOf(faceWinding[g])) {
+        const int a = find(parent, f), b = find(parent, g);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+    i = j;
+  }
+  // Each piece becomes a patch (the piece with the patch's first face keeps
+  // its id), with the mean winding numbers of its faces.
+  std::unordered_map<int, int> idOfRoot;
+  for (int f : refine) {
+    const int root = find(parent, f);
+    auto [it, added] = idOfRoot.emplace(root, -1);
+    Patch* patch = nullptr;
+    if (added) {
+      const int old = patches.patch_of_face[f];
+      if (patches.patches[old].first_face == root) {
+        it->second = old;
+      } else {
+        it->second = int(patches.patches.size());
+        patches.patches.push_back(patches.patches[old]);
+        patches.patches.back().first_face = root;
+      }
+      patch = &patches.patches[it->second];
+      patch->faces = 0;
+      patch->area = 0;
+      patch->winding.assign(patches.parts, 0);
+    }
+    patch = &patches.patches[it->second];
+    patches.patch_of_face[f] = it->second;
+    ++patch->faces;
+    patch->area += normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm() / 2;
+    for (int p = 0; p < patches.parts; ++p) patch->winding[p] += faceWinding[f][p];
+  }
+  for (const auto& [root, id] : idOfRoot) {
+    Patch& patch = patches.patches[id];
+    for (double& w : patch.winding) w /= double(patch.faces);
+    const double total = std::accumulate(patch.winding.begin(), patch.winding.end(), 0.0);
+    patch.winding_outside = total - 0.5;
+    patch.winding_inside = total + 0.5;
+  }
+  patches.patches_split_at_open_parts = std::count(mixed.begin(), mixed.end(), 1);
 }
 
 const char* toString(BooleanOperation op) {

@@ -49,10 +49,14 @@ struct Patch {
 
 struct Patches {
   std::vector<int> patch_of_face;  // per face: its patch id
-  std::vector<Patch> patches;      // by id; ids in the order of the patches' first faces
+  std::vector<Patch> patches;  // by id: in the order of their first faces, then pieces split off
   int parts = 1;
   std::vector<bool> part_closed;   // per part: no border edge (after classifyPatches)
   std::size_t boundary_edges = 0;  // edges that bound patches
+  // Patches classifyPatches found on both sides of an open part (a curve
+  // that ends at the part's border does not separate them) and split where
+  // that part's winding number crosses ½; the pieces get new ids.
+  std::size_t patches_split_at_open_parts = 0;
 };
 
 // Flood-fills the faces of `mesh` into patches. A mesh with no boundaries of
