@@ -334,10 +334,15 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
     if (total - 0.5 < 0.5 && total + 0.5 > 0.5) status |= std::uint64_t(1) << 63;
     return status;
   };
-  auto windingAt = [&](std::size_t f) {
-    std::vector<double> w(patches.parts);
+  // A closed part's winding number is the same all over a patch that does
+  // not cross it: only the open parts' change from face to face.
+  if (std::all_of(patches.part_closed.begin(), patches.part_closed.end(), [](bool c) { return c; }))
+    return;
+  auto windingAt = [&](int f) {
+    std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
     const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
-    for (int p = 0; p < patches.parts; ++p) w[p] = trees[p].at(c, int(f));
+    for (int p = 0; p < patches.parts; ++p)
+      if (!patches.part_closed[p]) w[p] = trees[p].at(c, f);
     return w;
   };
   std::vector<std::vector<int>> facesOfPatch(patches.patches.size());
@@ -361,20 +366,11 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
   for (std::size_t id = 0; id < mixed.size(); ++id)
     if (mixed[id]) refine.insert(refine.end(), facesOfPatch[id].begin(), facesOfPatch[id].end());
   if (refine.empty()) return;
-  // A closed part's winding number is the same all over a patch that does
-  // not cross it: only the open parts' change from face to face.
   std::vector<std::vector<double>> faceWinding(T.size());
   parallelChunks(
       refine.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const int f = refine[i];
-          std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
-          const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
-          for (int p = 0; p < patches.parts; ++p)
-            if (!patches.part_closed[p]) w[p] = trees[p].at(c, f);
-          faceWinding[f] = std::move(w);
-        }
+        for (std::size_t i = begin; i < end; ++i) faceWinding[refine[i]] = windingAt(refine[i]);
       },
       256);
   std::vector<int> parent(T.size());

@@ -140,3 +140,26 @@ def test_open_layer_says_how_the_winding_number_is_thresholded(tmp_path):
     assert run.returncode == 0, run.log
     assert "part 0 is open" in run.log and "exceeds 0.5" in run.log
     assert "selected" in run.log
+
+
+def test_outer_surface_of_bunny_and_dragon(tmp_path):
+    """The paper's pair: the bunny is open (five holes at its base) and the
+    dragon folds through itself; the outer surface is one mesh free of
+    intersections and non-manifold edges, with borders only at the bunny's
+    five holes."""
+    require_shared_data()
+    import gzip
+    import shutil
+    dragon = tmp_path / "dragon_vrip.ply"
+    with gzip.open(DATA / "stanford" / "dragon_vrip.ply.gz", "rb") as src, open(dragon, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    out = tmp_path / "union.ply"
+    run = run_server(tmp_path, [DATA / "stanford" / "bun_zipper.ply", dragon],
+                     sample("keep_outer_surface"), outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    r, check = run.report, meshcheck(out)
+    assert r["remaining_intersecting_pairs"] == 0 and check["self_intersecting_pairs"] == 0
+    assert r["non_manifold_edges"] == 0 and check["non_manifold_edges"] == 0
+    bunny = meshcheck(DATA / "stanford" / "bun_zipper.ply")
+    assert check["border_loops"] == bunny["border_loops"] == 5
+    assert "part 0 is open" in run.log
