@@ -520,6 +520,15 @@ Mesh extractPatches(const Mesh& mesh, const Patches& patches, const std::vector<
   return out;
 }
 
+std::array<std::uint8_t, 3> patchColour(int id) {
+  const double h = std::fmod(id * 0.6180339887, 1.0) * 6, s = id % 2 ? 0.55 : 0.75, v = 0.95;
+  const int sector = int(h);
+  const double f = h - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+  const double* c = rgb[sector % 6];
+  return {std::uint8_t(c[0] * 255), std::uint8_t(c[1] * 255), std::uint8_t(c[2] * 255)};
+}
+
 std::string statusOf(const Patch& patch, int parts) {
   if (patch.winding.empty()) return "not classified";
   std::string inside;

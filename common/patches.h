@@ -6,6 +6,7 @@
 // folds), and extracts the patches a boolean result keeps.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -98,6 +99,10 @@ Mesh extractPatches(const Mesh& mesh, const Patches& patches, const std::vector<
 // The log table and report: id, part, faces, area, windings, status.
 JsonObject toJson(const Patches& patches);
 std::string statusOf(const Patch& patch, int parts);
+
+// A colour per patch id, well separated from its neighbours in id order
+// (hues a golden angle apart, alternating saturation): RGB.
+std::array<std::uint8_t, 3> patchColour(int id);
 
 // Per-face attribute names the MeshLab filters use between steps.
 inline constexpr const char* kPatchAttribute = "meshmend_patch";  // int: patch id

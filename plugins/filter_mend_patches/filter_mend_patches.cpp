@@ -101,30 +101,9 @@ Patches patchesOf(const Assembly& a) {
   return paintPatches(a.mesh, a.labels);
 }
 
-// Well-separated colours: hues a golden angle apart.
 vcg::Color4b colourOf(int id) {
-  const double h = std::fmod(id * 0.6180339887, 1.0) * 6, s = id % 2 ? 0.55 : 0.75, v = 0.95;
-  const int sector = int(h);
-  const double f = h - sector, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-  double r = v, g = t, b = p;
-  switch (sector % 6) {
-    case 1:
-      r = q, g = v, b = p;
-      break;
-    case 2:
-      r = p, g = v, b = t;
-      break;
-    case 3:
-      r = p, g = q, b = v;
-      break;
-    case 4:
-      r = t, g = p, b = v;
-      break;
-    case 5:
-      r = v, g = p, b = q;
-      break;
-  }
-  return vcg::Color4b(int(r * 255), int(g * 255), int(b * 255), 255);
+  const auto c = patchColour(id);
+  return vcg::Color4b(c[0], c[1], c[2], 255);
 }
 
 // What a user needs to know about the threshold when a part is open.
