@@ -38,6 +38,13 @@ bool isFinite(const Point3& p) {
 
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer) {
+  Mesh mesh;
+  buildMesh(mesh, positions, triangles, layer);
+  return mesh;
+}
+
+void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
+               const std::vector<Triangle>& triangles, int layer) {
   const int n = int(positions.size());
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (int v : triangles[f])
@@ -46,7 +53,8 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
                                 std::to_string(v) + ", but the mesh has only " + std::to_string(n) +
                                 " vertices");
 
-  Mesh mesh;
+  mesh.Clear();
+  mesh.ClearAttributes();
   auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i, ++vi) vi->P() = positions[i];
   auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
@@ -57,7 +65,6 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
   for (std::size_t i = 0; i < mesh.vert.size(); ++i) vo[i] = VertexOrigin{layer, int(i), -1, {}};
   FaceOriginHandle fo = faceOrigins(mesh);
   for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
-  return mesh;
 }
 
 MeshArrays arraysOf(const Mesh& mesh) {

@@ -79,6 +79,10 @@ FaceOriginHandle faceOrigins(Mesh& mesh);
 // requireFacesAndFiniteCoordinates, and inspect() counts the others.
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,
               int layer = 0);
+// The same into an existing mesh (cleared first): Mesh has no move, and
+// copying a million faces costs as much as building them.
+void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
+               const std::vector<Triangle>& triangles, int layer = 0);
 
 // A mesh as plain arrays, for the inner loops of the core.
 struct MeshArrays {

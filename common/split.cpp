@@ -161,13 +161,12 @@ struct OutputArrays {
   std::vector<VertexOrigin> vertex_origin;
   std::vector<FaceOrigin> face_origin;
 
-  Mesh toMesh() const {
-    Mesh mesh = makeMesh(positions, triangles);
+  void toMesh(Mesh& mesh) const {
+    buildMesh(mesh, positions, triangles);
     VertexOriginHandle vo = vertexOrigins(mesh);
     FaceOriginHandle fo = faceOrigins(mesh);
     for (std::size_t v = 0; v < vertex_origin.size(); ++v) vo[v] = vertex_origin[v];
     for (std::size_t f = 0; f < face_origin.size(); ++f) fo[f] = face_origin[f];
-    return mesh;
   }
 };
 
@@ -288,8 +287,11 @@ class MeshSplitter {
     std::vector<FaceOrigin>& birthFaces = out.face_origin;
     std::vector<VertexOrigin>& origins = out.vertex_origin;
     positions = points_;
+    origins.reserve(points_.size() + 4 * work_.size());
     for (std::size_t v = 0; v < points_.size(); ++v)
       origins.push_back({int(index_), vertexOrigin_[v], -1, {}});
+    triangles.reserve(triangles_.size() + 8 * work_.size());
+    birthFaces.reserve(triangles.capacity());
     std::unordered_map<int, int> vertexOfPoint;              // curve point id -> output vertex
     std::map<RationalPoint, int, ExactLess> crossingPoints;  // made inside one face
     auto newVertex = [&](const ExactPoint& p, std::uint32_t f) {
@@ -996,6 +998,16 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     std::vector<int> mergedOfCurvePoint(curvePoints.size(), -1);
     OutputArrays merged;
     std::vector<Point3>& positions = merged.positions;
+    {
+      std::size_t vertices = 0, faces = 0;
+      for (const OutputArrays& mesh : outputs)
+        vertices += mesh.positions.size(), faces += mesh.triangles.size();
+      positions.reserve(vertices);
+      merged.vertex_origin.reserve(vertices);
+      merged.triangles.reserve(faces);
+      merged.face_origin.reserve(faces);
+      r.merged_new_face.reserve(faces);
+    }
     std::set<std::array<int, 2>> curves;
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const OutputArrays& mesh = outputs[m];
@@ -1061,10 +1073,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       r.smallest_new_angle_deg = smallest * 180 / M_PI;
       r.new_faces_below_1deg = slivers();
     }
-    r.merged = merged.toMesh();
+    merged.toMesh(r.merged);
     if (options.separate_meshes) {
       r.meshes.resize(meshes.size());
-      for (std::size_t m = 0; m < meshes.size(); ++m) r.meshes[m] = outputs[m].toMesh();
+      for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
     r.merged_curve_edges.assign(curves.begin(), curves.end());
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
