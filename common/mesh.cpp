@@ -32,6 +32,16 @@ FaceOriginHandle faceOrigins(Mesh& mesh) {
   return vcg::tri::Allocator<Mesh>::GetPerFaceAttribute<FaceOrigin>(mesh, kFaceOriginAttribute);
 }
 
+double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
+  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
+  // The apex opposite the shortest side, and its two sides.
+  const Point3& apex = ab <= bc && ab <= ca ? c : bc <= ca ? a : b;
+  const Point3& p = ab <= bc && ab <= ca ? a : bc <= ca ? b : c;
+  const Point3& q = ab <= bc && ab <= ca ? b : bc <= ca ? c : a;
+  const Point3 u = p - apex, v = q - apex;
+  return std::atan2((u ^ v).Norm(), u * v);
+}
+
 bool isFinite(const Point3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }

@@ -114,6 +114,10 @@ Mesh appended(const Mesh& a, const Mesh& b);
 std::vector<Point3> positionsOf(const Mesh& mesh);
 std::vector<Triangle> trianglesOf(const Mesh& mesh);
 
+// The smallest interior angle of triangle (a, b, c), in radians: the one
+// opposite the shortest side (one atan2 instead of three).
+double smallestAngle(const Point3& a, const Point3& b, const Point3& c);
+
 bool isFinite(const Point3& p);
 
 // Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh

@@ -281,11 +281,7 @@ class Retriangulator {
 
   // Smallest angle of triangle (a, b, c), from the rounded positions.
   double minAngle(int a, int b, int c) const {
-    auto angle = [&](int p, int q, int r) {
-      const Point3 u = V_[q].approx() - V_[p].approx(), v = V_[r].approx() - V_[p].approx();
-      return std::atan2((u ^ v).Norm(), u * v);
-    };
-    return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+    return smallestAngle(V_[a].approx(), V_[b].approx(), V_[c].approx());
   }
 
   // Max-min angle flips on unconstrained interior edges. The validity of each

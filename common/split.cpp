@@ -45,15 +45,6 @@ Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Poin
   return {wa, wb, 1 - wa - wb};
 }
 
-// The smallest angle of triangle (a, b, c), in radians.
-double smallestAngleOf(const Point3& a, const Point3& b, const Point3& c) {
-  auto angle = [](const Point3& p, const Point3& q, const Point3& r) {
-    const Point3 u = q - p, v = r - p;
-    return std::atan2((u ^ v).Norm(), u * v);
-  };
-  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
-}
-
 // An input edge: mesh and its two vertices, smaller first.
 struct EdgeRef {
   std::uint32_t mesh, u, v;
@@ -346,9 +337,10 @@ class MeshSplitter {
       for (std::size_t j = 3; j < patch.vertex_of_input.size(); ++j)
         contactVertices_.push_back(global[patch.vertex_of_input[j]]);
       for (const auto& t : patch.triangles) {
-        smallestAngle_ = std::min(smallestAngle_, smallestAngleOf(patch.vertices[t[0]].approx(),
-                                                                  patch.vertices[t[1]].approx(),
-                                                                  patch.vertices[t[2]].approx()));
+        smallestAngle_ =
+            std::min(smallestAngle_, meshmend::smallestAngle(patch.vertices[t[0]].approx(),
+                                                             patch.vertices[t[1]].approx(),
+                                                             patch.vertices[t[2]].approx()));
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
         birthFaces.push_back({int(index_), faceOrigin_[f]});
       }
@@ -589,7 +581,7 @@ class CurveSnapper {
   double smallestAngle(const std::vector<Triangle>& triangles) const {
     double smallest = M_PI;
     for (const Triangle& t : triangles)
-      smallest = std::min(smallest, smallestAngleOf(P_[t[0]], P_[t[1]], P_[t[2]]));
+      smallest = std::min(smallest, meshmend::smallestAngle(P_[t[0]], P_[t[1]], P_[t[2]]));
     return smallest;
   }
 
@@ -1043,8 +1035,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       std::size_t n = 0;
       for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
         const Triangle& t = merged.triangles[f];
-        n += r.merged_new_face[f] && smallestAngleOf(merged.positions[t[0]], merged.positions[t[1]],
-                                                     merged.positions[t[2]]) < M_PI / 180;
+        n += r.merged_new_face[f] &&
+             meshmend::smallestAngle(merged.positions[t[0]], merged.positions[t[1]],
+                                     merged.positions[t[2]]) < M_PI / 180;
       }
       return n;
     };
@@ -1066,9 +1059,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       for (std::size_t f = 0; f < merged.triangles.size(); ++f)
         if (r.merged_new_face[f]) {
           const Triangle& t = merged.triangles[f];
-          smallest =
-              std::min(smallest, smallestAngleOf(merged.positions[t[0]], merged.positions[t[1]],
-                                                 merged.positions[t[2]]));
+          smallest = std::min(
+              smallest, meshmend::smallestAngle(merged.positions[t[0]], merged.positions[t[1]],
+                                                merged.positions[t[2]]));
         }
       r.smallest_new_angle_deg = smallest * 180 / M_PI;
       r.new_faces_below_1deg = slivers();

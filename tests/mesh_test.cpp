@@ -112,5 +112,22 @@ TEST(Mesh, RoundingToFloatRoundsEveryCoordinate) {
   EXPECT_EQ(m.vert[0].cP()[0], -0.042701493948698044);
 }
 
+TEST(Mesh, SmallestAngleIsOppositeTheShortestSide) {
+  std::srand(7);
+  auto random = [] { return std::rand() / double(RAND_MAX) * 2 - 1; };
+  auto angle = [](const Point3& p, const Point3& q, const Point3& r) {
+    const Point3 u = q - p, v = r - p;
+    return std::atan2((u ^ v).Norm(), u * v);
+  };
+  for (int i = 0; i < 1000; ++i) {
+    const Point3 a(random(), random(), random()), b(random(), random(), random()),
+        c(random(), random(), random());
+    const double expected = std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+    EXPECT_NEAR(smallestAngle(a, b, c), expected, 1e-12);
+  }
+  EXPECT_NEAR(smallestAngle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}), M_PI / 4, 1e-15);
+  EXPECT_EQ(smallestAngle({0, 0, 0}, {1, 0, 0}, {2, 0, 0}), 0);  // collinear
+}
+
 }  // namespace
 }  // namespace meshmend
