@@ -279,9 +279,17 @@ class Retriangulator {
     return -1;
   }
 
-  // Smallest angle of triangle (a, b, c), from the rounded positions.
+  // A measure increasing with the smallest angle of triangle (a, b, c), from
+  // the rounded positions: the squared sine of that angle, opposite the
+  // shortest side (at most 60°, where the sine still grows with the angle).
   double minAngle(int a, int b, int c) const {
-    return smallestAngle(V_[a].approx(), V_[b].approx(), V_[c].approx());
+    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
+    const double ab = (pb - pa).SquaredNorm(), bc = (pc - pb).SquaredNorm(),
+                 ca = (pa - pc).SquaredNorm();
+    const double cross = ((pb - pa) ^ (pc - pa)).SquaredNorm();  // 4 × area²
+    // sin² at the apex opposite the shortest side = 4 area² / (product of the two others).
+    const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
+    return others > 0 ? cross / others : 0;
   }
 
   // Max-min angle flips on unconstrained interior edges. The validity of each
@@ -298,7 +306,7 @@ class Retriangulator {
           const int p = opposite(int(t), u, w), q = opposite(other, w, u);
           const double before = std::min(minAngle(u, w, p), minAngle(w, u, q));
           const double after = std::min(minAngle(p, q, w), minAngle(q, p, u));
-          if (after > before + 1e-9 && flipIfConvex(u, w)) changed = true;
+          if (after > before * (1 + 1e-9) && flipIfConvex(u, w)) changed = true;
         }
       if (!changed) return;
     }
