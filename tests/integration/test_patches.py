@@ -163,3 +163,23 @@ def test_outer_surface_of_bunny_and_dragon(tmp_path):
     bunny = meshcheck(DATA / "stanford" / "bun_zipper.ply")
     assert check["border_loops"] == bunny["border_loops"] == 5
     assert "part 0 is open" in run.log
+
+
+def test_union_of_separate_layers(tmp_path):
+    """Intersect-and-split keeping the layers separate, then paint and keep
+    the union of all visible layers: a new layer, the two welded into one
+    closed mesh along their shared curve vertices."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    out = tmp_path / "union.ply"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 0}),
+                 (PAINT, {"layers": 1}),
+                 (REMOVE, {"layers": 1, "keep": 1, "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["patches"] == 4 and r["patches_removed"] == 2
+    assert r["is_closed"] and r["non_manifold_edges"] == 0 and r["border_edges"] == 0
+    assert r["remaining_intersecting_pairs"] == 0
+    assert r["volume"] == pytest.approx(2 - 0.125, rel=1e-6)
