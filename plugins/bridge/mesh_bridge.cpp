@@ -11,6 +11,12 @@
 namespace meshmend::bridge {
 
 Mesh toCore(const CMeshO& cm, const ToCoreOptions& options) {
+  Mesh mesh;
+  toCore(cm, mesh, options);
+  return mesh;
+}
+
+void toCore(const CMeshO& cm, Mesh& mesh, const ToCoreOptions& options) {
   std::vector<Point3> positions;
   std::vector<int> vertexSlot;  // core vertex -> index in cm.vert
   std::vector<int> coreIndex(cm.vert.size(), -1);
@@ -47,12 +53,11 @@ Mesh toCore(const CMeshO& cm, const ToCoreOptions& options) {
     triangles.push_back(t);
     faceSlot.push_back(int(f));
   }
-  Mesh mesh = makeMesh(positions, triangles, options.layer);
+  buildMesh(mesh, positions, triangles, options.layer);
   VertexOriginHandle vo = vertexOrigins(mesh);
   FaceOriginHandle fo = faceOrigins(mesh);
   for (std::size_t i = 0; i < vertexSlot.size(); ++i) vo[i].vertex = vertexSlot[i];
   for (std::size_t f = 0; f < faceSlot.size(); ++f) fo[f].face = faceSlot[f];
-  return mesh;
 }
 
 LayerAttributes snapshot(const MeshModel& model) {

@@ -20,6 +20,8 @@ struct ToCoreOptions {
 // Live vertices and faces of `cm` (deleted ones skipped). Origins index
 // `cm.vert` / `cm.face` as they are (with their deleted slots).
 Mesh toCore(const CMeshO& cm, const ToCoreOptions& options = {});
+// The same into `out` (a Mesh cannot move: this saves a copy).
+void toCore(const CMeshO& cm, Mesh& out, const ToCoreOptions& options = {});
 
 // Everything the output may need from one input layer, copied out of the
 // CMeshO so that the layer itself can be overwritten (in-place filters).

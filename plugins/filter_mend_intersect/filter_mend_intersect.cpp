@@ -177,10 +177,10 @@ struct Inputs {
 Inputs inputsOf(MeshDocument& md, const RichParameterList& parameters) {
   Inputs in;
   in.layers = chosenLayers(md, parameters);
-  in.cores.reserve(in.layers.size());
+  in.cores.resize(in.layers.size());
   for (std::size_t i = 0; i < in.layers.size(); ++i) {
-    in.cores.push_back(toCore(in.layers[i]->cm, {int(i), true}));
-    requireFacesAndFiniteCoordinates(in.cores.back(), layerName(*in.layers[i]));
+    toCore(in.layers[i]->cm, in.cores[i], {int(i), true});
+    requireFacesAndFiniteCoordinates(in.cores[i], layerName(*in.layers[i]));
   }
   for (const Mesh& m : in.cores) in.meshes.push_back(&m);
   return in;

@@ -66,10 +66,15 @@ Assembly assemble(MeshDocument& md, int which) {
   bool allPainted = true;
   for (std::size_t i = 0; i < a.layers.size(); ++i) {
     CMeshO& cm = a.layers[i]->cm;
-    Mesh core = toCore(cm, {int(i), true});
-    requireFacesAndFiniteCoordinates(core, layerName(*a.layers[i]));
     a.firstFace.push_back(a.mesh.face.size());
-    a.mesh = i == 0 ? std::move(core) : appended(a.mesh, core);
+    if (i == 0) {
+      toCore(cm, a.mesh, {0, true});  // in place: a Mesh cannot move
+      requireFacesAndFiniteCoordinates(a.mesh, layerName(*a.layers[i]));
+    } else {
+      const Mesh core = toCore(cm, {int(i), true});
+      requireFacesAndFiniteCoordinates(core, layerName(*a.layers[i]));
+      a.mesh = appended(a.mesh, core);
+    }
     const bool parts = a.layers.size() == 1 && hasFaceAttribute<int>(cm, kPartAttribute);
     const bool curves = hasFaceAttribute<unsigned char>(cm, kCurveEdgesAttribute);
     const bool painted = hasFaceAttribute<int>(cm, kPatchAttribute);
