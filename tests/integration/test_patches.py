@@ -183,3 +183,26 @@ def test_union_of_separate_layers(tmp_path):
     assert r["is_closed"] and r["non_manifold_edges"] == 0 and r["border_edges"] == 0
     assert r["remaining_intersecting_pairs"] == 0
     assert r["volume"] == pytest.approx(2 - 0.125, rel=1e-6)
+
+
+def test_select_patches_touching_the_selected_faces(tmp_path):
+    """A user selects a few faces of one patch (here with MeshLab's
+    conditional selection on the patch id in the face quality and a
+    coordinate); 'touching the selection' selects that whole patch."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1}),
+                 (PAINT, {"report_file": "{report0}"}),
+                 (SELECT, {"by": 1}))
+    partial = ('<filter name="Conditional Face Selection">\n'
+               '  <Param type="RichString" value="(fq == 2) &amp;&amp; (x0 &gt; 0.75)" '
+               'name="condSelect" description="" tooltip=""/>\n </filter>\n')
+    script = script.replace(f' <filter name="{SELECT}">', partial + f' <filter name="{SELECT}">', 1)
+    run = run_server(tmp_path, [a, b], script)
+    assert run.returncode == 0, run.log
+    patch = run.report["patch_list"][2]
+    import re
+    clicked = int(re.search(r"selected (\d+) faces in", run.log).group(1))  # MeshLab's own log
+    assert 0 < clicked < patch["faces"]
+    assert f"selected 1 of 4 patches ({patch['faces']} faces)" in run.log
