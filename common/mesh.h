@@ -15,12 +15,12 @@ class Face;
 struct UsedTypes
     : public vcg::UsedTypes<vcg::Use<Vertex>::AsVertexType, vcg::Use<Face>::AsFaceType> {};
 
-class Vertex : public vcg::Vertex<UsedTypes, vcg::vertex::Coord3d, vcg::vertex::Normal3d,
-                                  vcg::vertex::BitFlags, vcg::vertex::VFAdj, vcg::vertex::Mark> {};
+// Only what the core uses: positions, corners and flags. Every output is a
+// new mesh of up to millions of faces, so each component left out is time
+// and memory saved (adjacency and normals would triple a face's size).
+class Vertex : public vcg::Vertex<UsedTypes, vcg::vertex::Coord3d, vcg::vertex::BitFlags> {};
 
-class Face
-    : public vcg::Face<UsedTypes, vcg::face::VertexRef, vcg::face::Normal3d, vcg::face::BitFlags,
-                       vcg::face::FFAdj, vcg::face::VFAdj, vcg::face::Mark> {};
+class Face : public vcg::Face<UsedTypes, vcg::face::VertexRef, vcg::face::BitFlags> {};
 
 // vcglib meshes are not copyable; this one copies its elements and every
 // per-element attribute (provenance included) through vcg::tri::Append.
