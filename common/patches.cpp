@@ -447,23 +447,18 @@ PatchChoice choosePatches(const Patches& patches, BooleanOperation op) {
     const Patch& patch = patches.patches[id];
     if (patch.winding.size() != std::size_t(patches.parts))
       throw InvalidInputError("the patches are not classified yet");
-    auto insideAllOthers = [&](bool inside, int except) {
-      for (int p = 0; p < patches.parts; ++p)
-        if (p != patch.part && p != except && patch.inside(p) != inside) return false;
-      return true;
-    };
     switch (op) {
       case BooleanOperation::kUnion:
         choice.keep[id] = patch.onUnionSurface();
         break;
       case BooleanOperation::kIntersection:
-        choice.keep[id] = insideAllOthers(true, -1);
+        choice.keep[id] = patch.insideAllOthers(true);
         break;
       case BooleanOperation::kDifference:
         if (patch.part == 0) {
-          choice.keep[id] = insideAllOthers(false, -1);
+          choice.keep[id] = patch.insideAllOthers(false);
         } else {
-          choice.keep[id] = patch.inside(0) && insideAllOthers(false, 0);
+          choice.keep[id] = patch.inside(0) && patch.insideAllOthers(false, 0);
           choice.flip[id] = choice.keep[id];
         }
         break;
@@ -560,6 +555,7 @@ JsonObject toJson(const Patches& patches) {
   j.set("patches", patches.patches.size())
       .set("parts", patches.parts)
       .set("boundary_edges", patches.boundary_edges)
+      .set("patches_split_at_open_parts", patches.patches_split_at_open_parts)
       .set("patch_list", list);
   return j;
 }

@@ -44,6 +44,12 @@ struct Patch {
   std::vector<double> winding;
   double winding_outside = 0, winding_inside = 0;
   bool inside(int otherPart) const { return winding[otherPart] > 0.5; }
+  // Inside (or, with inside = false, outside) every part but its own and `except`.
+  bool insideAllOthers(bool inside, int except = -1) const {
+    for (int p = 0; p < int(winding.size()); ++p)
+      if (p != part && p != except && this->inside(p) != inside) return false;
+    return true;
+  }
   // Is the patch part of the outer surface of the union of all parts?
   bool onUnionSurface() const { return winding_outside < 0.5 && winding_inside > 0.5; }
 };
@@ -81,6 +87,7 @@ enum class BooleanOperation {
   kDifference,    // part 0 minus all the others
 };
 const char* toString(BooleanOperation op);
+inline constexpr int kBooleanOperations = 3;
 
 // Which patches the boolean result keeps, and which of those it turns over
 // (the other parts' patches that bound a difference).

@@ -520,7 +520,6 @@ class CurveSnapper {
   }
 
   const std::vector<int>& snappedTo() const { return snappedTo_; }
-  const std::vector<char>& alive() const { return alive_; }
 
  private:
   int mesh(std::uint32_t f) const { return faceOrigin_[f].layer; }

@@ -171,6 +171,47 @@ TEST(Patches, ClassificationWithHolesInTheOtherPart) {
   EXPECT_TRUE(outer.onUnionSurface());
 }
 
+TEST(Patches, APatchOnBothSidesOfAnOpenPartIsSplit) {
+  // A big sphere with a hole across half of the circle where a small
+  // sphere crosses it: that curve ends at the hole's border, so it does not
+  // separate the small sphere, whose one patch lies both inside and
+  // outside the big one. Classification splits it at the ½ level set.
+  Mesh big = uvSphere(32, 48, 2.0);
+  {
+    std::vector<Triangle> kept;
+    const std::vector<Point3> P = positionsOf(big);
+    for (const Triangle& t : trianglesOf(big)) {
+      const Point3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
+      if (!(c[2] > 1.5 && c[0] > 0)) kept.push_back(t);
+    }
+    big = makeMesh(P, kept);
+  }
+  const Mesh small = uvSphere(20, 28, 1.0, {0.05, 0.03, 2.0});
+  SplitOptions o;
+  o.separate_meshes = false;
+  SplitResult r = splitAlongIntersections({&small, &big}, o);
+  ASSERT_GT(r.open_curves, 0u);
+  FaceLabels labels;
+  labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
+  FaceOriginHandle fo = faceOrigins(r.merged);
+  for (std::size_t f = 0; f < r.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
+  Patches p = paintPatches(r.merged, labels);
+  const std::size_t painted = p.patches.size();
+  classifyPatches(r.merged, labels, p);
+  EXPECT_FALSE(p.part_closed[1]);
+  EXPECT_GE(p.patches_split_at_open_parts, 1u);
+  EXPECT_GT(p.patches.size(), painted);
+  // Every patch of the small sphere is now clearly on one side of the big one.
+  for (const Patch& patch : p.patches)
+    if (patch.part == 0) {
+      EXPECT_GT(std::fabs(patch.winding[1] - 0.5), 0.05);
+    }
+  const PatchChoice choice = choosePatches(p, BooleanOperation::kUnion);
+  const InspectResult i = check(extractPatches(r.merged, p, choice.keep));
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+}
+
 TEST(Patches, SelfFoldsAreClassifiedLikeOverlaps) {
   // One part made of two overlapping spheres (a mesh that folds through
   // itself), split along its own curve: its interior patches are not on

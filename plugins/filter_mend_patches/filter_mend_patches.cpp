@@ -25,7 +25,12 @@ enum SelectBy {
   kInsidePart,
   kUnionInterior
 };
+// The "keep" choices: the unselected patches, then the boolean operations in their order.
 enum Keep { kUnselected, kUnion, kIntersection, kDifference };
+static_assert(kDifference - kUnion + 1 == kBooleanOperations);
+BooleanOperation operationOf(int keep) {
+  return BooleanOperation(keep - kUnion);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -354,6 +359,10 @@ void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
   }
   Log("MeshMend: %zu patches (%zu bounding edges) in %.0f ms; %s", p.patches.size(),
       p.boundary_edges, ms, partsLegend(a).c_str());
+  if (p.patches_split_at_open_parts)
+    Log("  %zu patches lay on both sides of an open part: split where its winding number "
+        "crosses 0.5",
+        p.patches_split_at_open_parts);
   Log("  id   part   faces   area   status");
   constexpr std::size_t kListed = 200;
   for (std::size_t id = 0; id < p.patches.size() && id < kListed; ++id) {
@@ -399,15 +408,12 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
     for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
     for (std::size_t id = 0; id < p.patches.size(); ++id) {
       const Patch& patch = p.patches[id];
-      bool allOut = true, allIn = true;
-      for (int q = 0; q < p.parts; ++q)
-        if (q != patch.part) (patch.inside(q) ? allOut : allIn) = false;
       switch (by) {
         case kOutsideOthers:
-          chosen[id] = allOut;
+          chosen[id] = patch.insideAllOthers(false);
           break;
         case kInsideAllOthers:
-          chosen[id] = allIn;
+          chosen[id] = patch.insideAllOthers(true);
           break;
         case kInsidePart:
           chosen[id] = patch.part != part && patch.inside(part);
@@ -453,9 +459,7 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
           "no face is selected: select the patches to remove first (e.g. "
           "with 'Select Patches'), or choose a boolean preset");
   } else {
-    const BooleanOperation op = keepMode == kUnion          ? BooleanOperation::kUnion
-                                : keepMode == kIntersection ? BooleanOperation::kIntersection
-                                                            : BooleanOperation::kDifference;
+    const BooleanOperation op = operationOf(keepMode);
     if (op != BooleanOperation::kUnion && p.parts < 2)
       throw InvalidInputError(
           "intersection and difference need two parts: use the merged "
@@ -484,8 +488,7 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
   report.set("patches", p.patches.size())
       .set("patches_removed", p.patches.size() - kept)
       .set("faces_out", std::size_t(result.fn))
-      .set("keep",
-           keepMode == kUnselected ? "unselected" : toString(BooleanOperation(keepMode - 1)));
+      .set("keep", keepMode == kUnselected ? "unselected" : toString(operationOf(keepMode)));
   InspectResult check;
   std::size_t remaining = 0;
   const bool verify = parameters.getBool("verify");
