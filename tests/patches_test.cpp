@@ -26,6 +26,25 @@ struct SplitPair {
   double volumeA = 0, volumeB = 0;
 };
 
+// The labels intersect-and-split gives its merged output: curves and parts.
+FaceLabels labelsOf(SplitResult& r) {
+  FaceLabels labels;
+  labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
+  FaceOriginHandle fo = faceOrigins(r.merged);
+  for (std::size_t f = 0; f < r.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
+  return labels;
+}
+
+// `mesh` without the faces whose centroid `cut` accepts (a hole).
+template <class Cut>
+Mesh withHole(const Mesh& mesh, Cut&& cut) {
+  std::vector<Triangle> kept;
+  const std::vector<Point3> P = positionsOf(mesh);
+  for (const Triangle& t : trianglesOf(mesh))
+    if (!cut((P[t[0]] + P[t[1]] + P[t[2]]) / 3.0)) kept.push_back(t);
+  return makeMesh(P, kept);
+}
+
 SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {
   const Mesh a = uvSphere(24, 32), b = uvSphere(20, 28, radiusB, offset);
   SplitOptions o;
@@ -34,9 +53,7 @@ SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {
   SplitPair pair;
   pair.volumeA = *inspect(a).volume;
   pair.volumeB = *inspect(b).volume;
-  pair.labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
-  FaceOriginHandle fo = faceOrigins(r.merged);
-  for (std::size_t f = 0; f < r.merged.face.size(); ++f) pair.labels.part.push_back(fo[f].layer);
+  pair.labels = labelsOf(r);
   pair.mesh = r.merged;
   return pair;
 }
@@ -141,16 +158,8 @@ TEST(Patches, BooleanResultsOfTwoCrossingSpheres) {
 TEST(Patches, ClassificationWithHolesInTheOtherPart) {
   // A small sphere inside a big one with a hole cut at its top: the small
   // one is still inside, well above the ½ threshold.
-  Mesh big = uvSphere(24, 32, 2.0);
-  {
-    std::vector<Triangle> kept;
-    const std::vector<Point3> P = positionsOf(big);
-    for (const Triangle& t : trianglesOf(big)) {
-      const Point3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
-      if (c[2] < 1.8) kept.push_back(t);  // a hole of radius ~0.9 around the top
-    }
-    big = makeMesh(P, kept);
-  }
+  // (A hole of radius ~0.9 around the top.)
+  const Mesh big = withHole(uvSphere(24, 32, 2.0), [](const Point3& c) { return c[2] >= 1.8; });
   const Mesh small = uvSphere(12, 16, 0.5, {0.2, 0.1, -0.3});
   const Mesh both = appended(small, big);
   FaceLabels labels;
@@ -176,25 +185,14 @@ TEST(Patches, APatchOnBothSidesOfAnOpenPartIsSplit) {
   // sphere crosses it: that curve ends at the hole's border, so it does not
   // separate the small sphere, whose one patch lies both inside and
   // outside the big one. Classification splits it at the ½ level set.
-  Mesh big = uvSphere(32, 48, 2.0);
-  {
-    std::vector<Triangle> kept;
-    const std::vector<Point3> P = positionsOf(big);
-    for (const Triangle& t : trianglesOf(big)) {
-      const Point3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
-      if (!(c[2] > 1.5 && c[0] > 0)) kept.push_back(t);
-    }
-    big = makeMesh(P, kept);
-  }
+  const Mesh big =
+      withHole(uvSphere(32, 48, 2.0), [](const Point3& c) { return c[2] > 1.5 && c[0] > 0; });
   const Mesh small = uvSphere(20, 28, 1.0, {0.05, 0.03, 2.0});
   SplitOptions o;
   o.separate_meshes = false;
   SplitResult r = splitAlongIntersections({&small, &big}, o);
   ASSERT_GT(r.open_curves, 0u);
-  FaceLabels labels;
-  labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
-  FaceOriginHandle fo = faceOrigins(r.merged);
-  for (std::size_t f = 0; f < r.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
+  const FaceLabels labels = labelsOf(r);
   Patches p = paintPatches(r.merged, labels);
   const std::size_t painted = p.patches.size();
   classifyPatches(r.merged, labels, p);
