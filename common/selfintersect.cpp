@@ -1,8 +1,8 @@
 #include "common/selfintersect.h"
 
+#include <gmpxx.h>
 #include <algorithm>
 #include <cfloat>
-#include <gmpxx.h>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -12,8 +12,8 @@
 
 #include "common/box_tree.h"
 #include "common/errors.h"
-#include "common/interval.h"
 #include "common/intersections.h"
+#include "common/interval.h"
 #include "common/predicates.h"
 #include "common/split.h"
 #include "common/triangle_intersection.h"
@@ -29,7 +29,9 @@ int find(std::vector<int>& parent, int x) {
   return x;
 }
 
-Point3 normalOf(const Point3& a, const Point3& b, const Point3& c) { return (b - a) ^ (c - a); }
+Point3 normalOf(const Point3& a, const Point3& b, const Point3& c) {
+  return (b - a) ^ (c - a);
+}
 
 TrianglePoints pointsOf(const std::vector<Point3>& P, const Triangle& t) {
   return {P[t[0]], P[t[1]], P[t[2]]};
@@ -331,16 +333,16 @@ class Pretreatment {
       for (int vv : T_[h])
         if (vv == x) return false;  // edge wx exists already
     const Triangle f2{u, x, w}, g2{v, w, x};
-    const Point3 before = normalOf(P_[t[0]], P_[t[1]], P_[t[2]]) +
-                          normalOf(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]]);
+    const Point3 before =
+        normalOf(P_[t[0]], P_[t[1]], P_[t[2]]) + normalOf(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]]);
     for (const Triangle& n : {f2, g2}) {
       const Point3 &a = P_[n[0]], &b = P_[n[1]], &c = P_[n[2]];
       if (collinear(a, b, c) || normalOf(a, b, c) * before <= 0) return false;
     }
     const double oldAngle = std::min(smallestAngle(P_[t[0]], P_[t[1]], P_[t[2]]),
                                      smallestAngle(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]]));
-    const double newAngle = std::min(smallestAngle(P_[u], P_[x], P_[w]),
-                                     smallestAngle(P_[v], P_[w], P_[x]));
+    const double newAngle =
+        std::min(smallestAngle(P_[u], P_[x], P_[w]), smallestAngle(P_[v], P_[w], P_[x]));
     if (newAngle <= oldAngle) return false;
     if (createsIntersection({f2, g2}, {f, g}, {})) return false;
     for (int h : {f, g})
@@ -389,8 +391,12 @@ N normalsDot(const TrianglePoints& a, const TrianglePoints& b) {
   return na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2];
 }
 
-int signOf(const Interval& x) { return x.positive() ? 1 : x.negative() ? -1 : 0; }
-int signOf(const mpq_class& x) { return sgn(x); }
+int signOf(const Interval& x) {
+  return x.positive() ? 1 : x.negative() ? -1 : 0;
+}
+int signOf(const mpq_class& x) {
+  return sgn(x);
+}
 
 // sign det(n_a, n_b, q - p), n = a triangle's normal.
 int signNormalsDet(const TrianglePoints& a, const TrianglePoints& b, const Point3& p,
@@ -469,7 +475,8 @@ class ValidRegionGrowing {
       const auto [fwd, bwd] = edges_.directions(int(e), T);
       if (fwd != bwd) closed_ = false;  // a border, or a fin: no winding number
       if (edges_.manifold(int(e), T))
-        region_[find(region_, edges_.uses[first].face)] = find(region_, edges_.uses[first + 1].face);
+        region_[find(region_, edges_.uses[first].face)] =
+            find(region_, edges_.uses[first + 1].face);
     }
     for (std::size_t f = 0; f < T.size(); ++f) region_[f] = find(region_, int(f));
   }
@@ -546,7 +553,8 @@ class ValidRegionGrowing {
     conflicts = conflictsWhileGrowing;
     for (std::size_t e = 0; e < edges_.count(); ++e) {
       int kept = 0;
-      for (int k = edges_.first[e]; k < edges_.first[e + 1]; ++k) kept += valid[edges_.uses[k].face];
+      for (int k = edges_.first[e]; k < edges_.first[e + 1]; ++k)
+        kept += valid[edges_.uses[k].face];
       s.edges_duplicated += kept > 2;
     }
     s.vertex_of_corner.assign(3 * T_.size(), -1);
@@ -613,7 +621,8 @@ class ValidRegionGrowing {
     const Triangle& t = T_[f];
     const int p = t[i], q = t[(i + 1) % 3];
     if (n == 2) {
-      const EdgeUse& other = edges_.uses[first].face == f ? edges_.uses[first + 1] : edges_.uses[first];
+      const EdgeUse& other =
+          edges_.uses[first].face == f ? edges_.uses[first + 1] : edges_.uses[first];
       return T_[other.face][other.corner] == q ? other.face : -1;
     }
     const RadialOrder order(P_[p], P_[q], {&births_[f], 1});
@@ -815,41 +824,68 @@ std::size_t removeDuplicateFaces(std::vector<Triangle>& T, std::vector<int>& ori
 
 // Copies of one vertex (singular vertices and edges split by stitching)
 // still coincide, so their fans touch: by the self-intersection rule they
-// intersect. Each copy moves a little (kSeparation of the way) towards the
-// centroid of its fan's other corners, into its own side; a copy stays if
-// that would turn over one of its faces. Returns the copies moved.
+// intersect. Each copy moves into its own side by kSeparation of its fan's
+// size: towards the centroid of its fan, or else against its fan's normal,
+// each tried at full, quarter and sixteenth length; a move is kept only if
+// the copy's faces then cross nothing (exact), else the copy goes back.
+// Returns the copies left moved.
 std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& T,
                            const std::vector<int>& source) {
   constexpr double kSeparation = 1e-3;
   std::vector<int> copies(*std::max_element(source.begin(), source.end()) + 1, 0);
   for (int s : source) ++copies[s];
-  std::vector<Point3> sum(P.size(), Point3(0, 0, 0));
+  std::vector<Point3> normal(P.size(), Point3(0, 0, 0)), centroid(P.size(), Point3(0, 0, 0));
+  std::vector<double> length(P.size(), 0);
   std::vector<int> count(P.size(), 0);
-  std::vector<std::vector<int>> fan(P.size());
-  for (std::size_t f = 0; f < T.size(); ++f)
+  for (const Triangle& t : T)
     for (int i = 0; i < 3; ++i) {
-      const int v = T[f][i];
+      const int v = t[i];
       if (copies[source[v]] < 2) continue;
-      sum[v] += P[T[f][(i + 1) % 3]] + P[T[f][(i + 2) % 3]];
-      count[v] += 2;
-      fan[v].push_back(int(f));
+      normal[v] += normalOf(P[t[0]], P[t[1]], P[t[2]]);
+      centroid[v] += P[t[(i + 1) % 3]] + P[t[(i + 2) % 3]];
+      length[v] += (P[t[(i + 1) % 3]] - P[v]).Norm();
+      ++count[v];
     }
-  std::size_t moved = 0;
+  // Candidate moves per copy, in the order tried; the last is none.
+  std::vector<int> moving;
+  std::vector<std::vector<Point3>> steps(P.size());
+  std::vector<Point3> home(P.size());
+  std::vector<int> tried(P.size(), 0);
   for (std::size_t v = 0; v < P.size(); ++v) {
     if (count[v] == 0) continue;
-    const Point3 target = P[v] + (sum[v] / count[v] - P[v]) * kSeparation;
-    bool flips = false;
-    for (int f : fan[v]) {
-      Point3 c[3] = {P[T[f][0]], P[T[f][1]], P[T[f][2]]};
-      const Point3 before = normalOf(c[0], c[1], c[2]);
-      for (int i = 0; i < 3; ++i)
-        if (T[f][i] == int(v)) c[i] = target;
-      if (normalOf(c[0], c[1], c[2]) * before <= 0) flips = true;
+    const Point3 towardsFan = (centroid[v] / (2.0 * count[v]) - P[v]) * kSeparation;
+    const double n = normal[v].Norm();
+    const Point3 inward =
+        n > 0 ? normal[v] * (-kSeparation * length[v] / count[v] / n) : Point3(0, 0, 0);
+    for (double scale : {1.0, 0.25, 0.0625}) {
+      steps[v].push_back(towardsFan * scale);
+      steps[v].push_back(inward * scale);
     }
-    if (flips || target == P[v]) continue;
-    P[v] = target;
-    ++moved;
+    steps[v].push_back(Point3(0, 0, 0));
+    home[v] = P[v];
+    P[v] = home[v] + steps[v][0];
+    moving.push_back(int(v));
   }
+  if (moving.empty()) return 0;
+  std::vector<char> isMoving(P.size(), 0);
+  for (int v : moving) isMoving[v] = 1;
+  for (;;) {
+    MeshArrays arrays{P, T};
+    FindIntersectionsOptions o;
+    o.cross = false;
+    const FindIntersectionsResult found = findIntersectionsInArrays({&arrays}, o);
+    std::vector<char> retry(P.size(), 0);
+    bool any = false;
+    for (const IntersectingPair& pair : found.pairs)
+      for (std::uint32_t f : {pair.a.face, pair.b.face})
+        for (int v : T[f])
+          if (isMoving[v] && tried[v] + 1 < int(steps[v].size())) retry[v] = 1, any = true;
+    if (!any) break;
+    for (int v : moving)
+      if (retry[v]) P[v] = home[v] + steps[v][++tried[v]];
+  }
+  std::size_t moved = 0;
+  for (int v : moving) moved += !(P[v] == home[v]);
   return moved;
 }
 
@@ -955,7 +991,8 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   std::vector<int> outFace;
   for (std::size_t f = 0; f < valid.size(); ++f)
     if (valid[f]) {
-      outTriangles.push_back({stitched.vertex_of_corner[3 * f], stitched.vertex_of_corner[3 * f + 1],
+      outTriangles.push_back({stitched.vertex_of_corner[3 * f],
+                              stitched.vertex_of_corner[3 * f + 1],
                               stitched.vertex_of_corner[3 * f + 2]});
       outFace.push_back(int(f));
     }
@@ -994,8 +1031,8 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
       if (valid[f]) continue;
       Triangle t = cut.triangles[f];
       for (int& v : t) {
-        if (index[v] < 0) index[v] = int(points.size()), points.push_back(cut.points[v]),
-                        source.push_back(v);
+        if (index[v] < 0)
+          index[v] = int(points.size()), points.push_back(cut.points[v]), source.push_back(v);
         v = index[v];
       }
       if (r.inside_out) std::swap(t[1], t[2]);

@@ -45,7 +45,7 @@ struct SelfIntersectionResult {
   Mesh mesh;
   Mesh removed;
 
-  std::size_t faces_in = 0;                  // input faces
+  std::size_t faces_in = 0;                   // input faces
   std::size_t intersecting_pairs_before = 0;  // self-intersecting pairs (exact) after pre-treatment
   std::size_t degenerate_faces_before = 0;    // faces under the threshold before pre-treatment
   std::size_t collapses = 0, flips = 0;       // pre-treatment operations
@@ -55,20 +55,21 @@ struct SelfIntersectionResult {
   std::size_t faces_split = 0;                // faces re-triangulated along the curves
   std::size_t faces_after_split = 0;          // faces the region growing chose from
   std::size_t faces_kept = 0, faces_removed = 0;
-  std::size_t seeds = 0;        // seed faces the growing started from
-  std::size_t rays = 0;         // exact ray tests cast to find them
+  std::size_t seeds = 0;           // seed faces the growing started from
+  std::size_t rays = 0;            // exact ray tests cast to find them
   std::size_t side_conflicts = 0;  // curve edges where no face continued the surface consistently
   std::size_t vertices_duplicated = 0;  // singular vertices split while stitching (§2.4)
   std::size_t edges_duplicated = 0;     // singular edges (more than two kept faces) split
   std::size_t vertices_separated = 0;   // copies moved apart (separate_touching)
-  bool inside_out = false;  // closed input with negative volume: grown turned over, returned as it was
+  bool inside_out =
+      false;  // closed input with negative volume: grown turned over, returned as it was
   bool input_closed = false, output_closed = false;
   std::size_t border_edges_before = 0, border_edges_after = 0;
   std::size_t non_manifold_edges_before = 0, non_manifold_edges_after = 0;
   int components_before = 0, components_after = 0;
   // Genus of a closed, edge-manifold mesh (summed over components), else -1.
   int genus_before = -1, genus_after = -1;
-  bool verified = false;                        // remaining_intersecting_pairs was counted
+  bool verified = false;                         // remaining_intersecting_pairs was counted
   std::size_t remaining_intersecting_pairs = 0;  // in the result, as stored (float if rounded)
   double time_ms = 0;
 };

@@ -1,0 +1,130 @@
+#include "filter_mend_selfintersect.h"
+
+#include "common/selfintersect.h"
+#include "plugins/bridge/filter_support.h"
+#include "plugins/bridge/mesh_bridge.h"
+
+using namespace meshmend;
+using namespace meshmend::bridge;
+
+SelfIntersectPlugin::SelfIntersectPlugin() {
+  typeList << REMOVE_SELF_INTERSECTIONS;
+  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+}
+
+QString SelfIntersectPlugin::filterName(FilterIDType) const {
+  return "MeshMend: Remove Self-Intersections";
+}
+
+QString SelfIntersectPlugin::filterInfo(FilterIDType) const {
+  return "Turns a consistently oriented mesh that folds through itself into a valid one: keeps "
+         "the part of the surface that is <i>outside</i> with respect to its orientation "
+         "(TransforMesh, Zaharescu, Boyer and Horaud, ACCV 2007). The mesh is cut along its "
+         "exact self-intersection curves; the valid region grows from seed faces (faces with "
+         "nothing in front of them, decided by an exact ray test) and, where sheets meet, "
+         "continues on the sheet that keeps the surface closed; the kept faces are stitched "
+         "into a manifold mesh. Parts that overlap merge, pieces turned inside out go, and "
+         "hollow parts keep their inner walls.<br>"
+         "Needs consistent orientation (run <i>Re-Orient all faces coherently</i> first "
+         "otherwise). A closed mesh turned inside out is handled and stays so. On a mesh with "
+         "borders a seed must see nothing in front of it, and borders stay borders. Where the "
+         "result touches itself at a vertex or edge, each side gets its own copy of the "
+         "vertex, moved apart by 1/1000 of the local edge length.";
+}
+
+void SelfIntersectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& parameters) {
+  const SelfIntersectionOptions defaults;
+  parameters.addParam(RichBool(
+      "pretreat", defaults.pretreat, "Remove degenerate faces first",
+      "Before anything else, removes faces with (nearly) zero area by collapsing their "
+      "shortest edge or flipping their longest one; each change is kept only if no face turns "
+      "over and no new intersection appears (exact test)."));
+  parameters.addParam(RichFloat(
+      "degenerate_angle_deg", float(defaults.degenerate_angle_deg), "Degenerate angle (degrees)",
+      "A face whose smallest angle is below this counts as degenerate for the pre-treatment "
+      "(zero-area faces always do). 0.1 touches only faces that are really slivers."));
+  parameters.addParam(RichBool(
+      "weld_duplicates", defaults.weld_duplicates, "Merge coincident vertices first",
+      "Merges vertices with exactly the same coordinates (scan seams, STL facets), so that a "
+      "seam is not taken for a border."));
+  parameters.addParam(RichBool(
+      "separate_touching", defaults.separate_touching, "Separate touching sheets",
+      "Where the outer surface touches itself at a vertex or along an edge, the stitched "
+      "copies of the vertex move apart by 1/1000 of the local edge length, so that the result "
+      "has no touching faces either (they count as self-intersections in exact checks)."));
+  parameters.addParam(RichBool(
+      "removed_to_layer", false, "Keep removed parts in a new layer",
+      "Also puts the faces that were removed (the inside pieces, cut along the curves) into a "
+      "new layer named 'removed parts', to see what went."));
+  parameters.addParam(
+      RichBool("verify", defaults.verify, "Verify the result",
+               "Counts the intersecting face pairs left in the result, exactly, as stored in float "
+               "(remaining_intersecting_pairs in the log and report)."));
+  parameters.addParam(RichString(
+      "report_file", "", "Report file (JSON)",
+      "When not empty, the outcome is also written to this path as one JSON object (keys: "
+      "faces_kept, faces_removed, components_before, components_after, genus_before, "
+      "genus_after, remaining_intersecting_pairs, time_ms, ...)."));
+}
+
+bool SelfIntersectPlugin::applyFilter(QAction*, MeshDocument& md,
+                                      const RichParameterList& parameters, vcg::CallBackPos* cb) {
+  return guarded(*this, errorMessage, [&] {
+    MeshModel* model = md.mm();
+    if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
+    SelfIntersectionOptions options;
+    options.pretreat = parameters.getBool("pretreat");
+    options.degenerate_angle_deg = parameters.getFloat("degenerate_angle_deg");
+    options.weld_duplicates = parameters.getBool("weld_duplicates");
+    options.separate_touching = parameters.getBool("separate_touching");
+    options.keep_removed = parameters.getBool("removed_to_layer");
+    options.verify = parameters.getBool("verify");
+    options.round_to_float = true;  // MeshLab stores float: decide on what it will store
+    options.progress = progressFrom(cb);
+
+    reportProgress(options.progress, 0, "MeshMend: reading the layer");
+    const Mesh core = toCore(model->cm);
+    const SelfIntersectionResult r = removeSelfIntersections(core, options);
+    if (r.mesh.fn == 0)
+      throw TopologyError(
+          "no face of the mesh is outside with respect to its orientation, so nothing would be "
+          "kept: check the orientation (Filters > Normals > Invert Faces Orientation) and try "
+          "again; the layer is unchanged");
+
+    JsonObject report = toJson(r);
+    report.set("layer", toStd(model->label()));
+    writeReport(parameters.getString("report_file"), report);
+
+    // The only changes to the document, made last.
+    const std::vector<LayerAttributes> attributes{snapshot(*model)};
+    if (options.keep_removed && r.removed.fn > 0) {
+      MeshModel* rest = md.addNewMesh("", "removed parts", false);
+      writeMesh(r.removed, attributes, *rest);
+    }
+    writeMesh(r.mesh, attributes, *model);
+
+    Log("MeshMend: removed self-intersections of %s in %.0f ms", layerName(*model).c_str(),
+        r.time_ms);
+    Log("  %zu intersecting pairs cut %zu faces; faces kept %zu, removed %zu",
+        r.intersecting_pairs_before, r.faces_split, r.faces_kept, r.faces_removed);
+    Log("  components %d -> %d; genus %s -> %s", r.components_before, r.components_after,
+        r.genus_before >= 0 ? std::to_string(r.genus_before).c_str() : "n/a",
+        r.genus_after >= 0 ? std::to_string(r.genus_after).c_str() : "n/a");
+    Log("  pre-treatment: %zu degenerate faces, %zu collapses, %zu flips, %zu left",
+        r.degenerate_faces_before, r.collapses, r.flips, r.degenerate_faces_left);
+    Log("  stitching: %zu vertices and %zu edges duplicated, %zu copies moved apart",
+        r.vertices_duplicated, r.edges_duplicated, r.vertices_separated);
+    Log("  result: %s, %zu border edges, %zu non-manifold edges",
+        r.output_closed ? "closed" : "open", r.border_edges_after, r.non_manifold_edges_after);
+    if (!r.input_closed)
+      Log("  note: the mesh has borders: seeds were faces with nothing in front of them, and "
+          "borders stay borders");
+    if (r.inside_out)
+      Log("  note: the mesh is closed and inside out (negative volume); it stays so: run "
+          "Filters > Normals > Invert Faces Orientation if that is not intended");
+    if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
+    reportProgress(options.progress, 100, "MeshMend: done");
+  });
+}
+
+MESHLAB_PLUGIN_NAME_EXPORTER(SelfIntersectPlugin)
