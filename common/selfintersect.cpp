@@ -897,6 +897,8 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   requireFacesAndFiniteCoordinates(input, "the mesh");
   if (!(options.degenerate_angle_deg >= 0 && options.degenerate_angle_deg < 60))
     throw InvalidInputError("the degenerate face angle must be between 0 and 60 degrees");
+  if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
+    throw InvalidInputError("the snapping tolerance must be between 0 and 0.5");
   SelfIntersectionResult r;
   r.faces_in = std::size_t(input.fn);
   reportProgress(options.progress, 0, "checking the input");
@@ -952,6 +954,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   so.between_meshes = false;
   so.self = true;
   so.separate_meshes = false;
+  so.snap_tolerance = options.snap_tolerance;
   SplitResult split = splitAlongIntersections({&work}, so);
   if (options.round_to_float) roundToFloat(split);
   r.intersecting_pairs_before = split.intersecting_pairs;

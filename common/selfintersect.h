@@ -25,6 +25,11 @@ struct SelfIntersectionOptions {
   // Merge exactly coincident vertices first (scan seams): otherwise a seam
   // is a border and the two sides are grown apart.
   bool weld_duplicates = true;
+  // Quality snapping of the split (split.h, SplitOptions::snap_tolerance):
+  // curve points within this fraction of the local edge length of a vertex
+  // or edge merge into it instead of leaving slivers, whose rounded corners
+  // could cross again. Moves the surface by at most that much near a curve.
+  double snap_tolerance = 0.05;
   // Round new vertices for float storage (MeshLab's) before the region
   // growing decides, so that its decisions hold for the stored mesh.
   bool round_to_float = false;

@@ -47,6 +47,12 @@ void SelfIntersectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterLi
       "weld_duplicates", defaults.weld_duplicates, "Merge coincident vertices first",
       "Merges vertices with exactly the same coordinates (scan seams, STL facets), so that a "
       "seam is not taken for a border."));
+  parameters.addParam(RichFloat(
+      "snap_tolerance", float(defaults.snap_tolerance), "Quality snapping",
+      "Where the self-intersection curves pass within this fraction of the local edge length "
+      "of a vertex or an edge, they snap to it instead of leaving sliver faces (whose rounded "
+      "corners could cross again). Moves the surface by at most that much near a curve; 0 "
+      "inserts the curves exactly as computed."));
   parameters.addParam(RichBool(
       "separate_touching", defaults.separate_touching, "Separate touching sheets",
       "Where the outer surface touches itself at a vertex or along an edge, the stitched "
@@ -76,6 +82,7 @@ bool SelfIntersectPlugin::applyFilter(QAction*, MeshDocument& md,
     options.pretreat = parameters.getBool("pretreat");
     options.degenerate_angle_deg = parameters.getFloat("degenerate_angle_deg");
     options.weld_duplicates = parameters.getBool("weld_duplicates");
+    options.snap_tolerance = parameters.getFloat("snap_tolerance");
     options.separate_touching = parameters.getBool("separate_touching");
     options.keep_removed = parameters.getBool("removed_to_layer");
     options.verify = parameters.getBool("verify");
