@@ -101,6 +101,16 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   return findIntersectionsInArrays(pointers, options);
 }
 
+std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat) {
+  MeshArrays arrays = arraysOf(mesh);
+  if (asFloat)
+    for (Point3& p : arrays.points)
+      for (int k = 0; k < 3; ++k) p[k] = double(float(p[k]));
+  FindIntersectionsOptions o;
+  o.cross = false;
+  return findIntersectionsInArrays({&arrays}, o).self_pairs[0];
+}
+
 FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
                                                   const FindIntersectionsOptions& options) {
   const auto start = Clock::now();

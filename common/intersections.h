@@ -59,6 +59,11 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
 FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
                                                   const FindIntersectionsOptions& options = {});
 
+// Self-intersecting pairs of one mesh (the self-intersection rule), with its
+// coordinates as stored or, with `asFloat`, rounded to float as MeshLab
+// stores them.
+std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false);
+
 // The contact segments of every pair (a coplanar overlap contributes its
 // outline, a single touching point nothing), with coinciding end points
 // merged: the intersection curves as a polyline soup. Needs options.contacts.

@@ -81,6 +81,18 @@ MeshArrays arraysOf(const Mesh& mesh) {
   return {positionsOf(mesh), trianglesOf(mesh)};
 }
 
+std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int a = triangles[f][i], b = triangles[f][(i + 1) % 3];
+      uses.push_back({std::min(a, b), std::max(a, b), int(f), i});
+    }
+  std::sort(uses.begin(), uses.end());
+  return uses;
+}
+
 WeldedArrays weldCoincident(const MeshArrays& in) {
   const std::vector<Point3>& points = in.points;
   // Each vertex goes to the first vertex with its exact coordinates, found

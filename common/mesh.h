@@ -110,6 +110,20 @@ std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces = nullp
 // The two meshes in one (b's vertices and faces after a's), provenance kept.
 Mesh appended(const Mesh& a, const Mesh& b);
 
+// One use of an edge by a face: the edge (smaller vertex first), the face,
+// and the corner the use starts at (it runs to the next corner).
+struct EdgeUse {
+  int u, v, face, corner;
+  bool operator<(const EdgeUse& o) const {
+    return u != o.u         ? u < o.u
+           : v != o.v       ? v < o.v
+           : face != o.face ? face < o.face
+                            : corner < o.corner;
+  }
+};
+// Every edge use of the faces, sorted: the uses of one edge are adjacent.
+std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles);
+
 // Vertex positions and face corner indices of a compact mesh (no deleted elements).
 std::vector<Point3> positionsOf(const Mesh& mesh);
 std::vector<Triangle> trianglesOf(const Mesh& mesh);

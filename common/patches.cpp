@@ -22,26 +22,6 @@ Point3 normalOf(const Point3& a, const Point3& b, const Point3& c) {
   return (b - a) ^ (c - a);
 }
 
-// One edge use: the edge (smaller vertex first), the face, and the corner it starts at.
-struct EdgeUse {
-  int u, v, face, corner;
-  bool operator<(const EdgeUse& o) const {
-    return std::tie(u, v, face) < std::tie(o.u, o.v, o.face);
-  }
-};
-
-std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * triangles.size());
-  for (std::size_t f = 0; f < triangles.size(); ++f)
-    for (int i = 0; i < 3; ++i) {
-      const int a = triangles[f][i], b = triangles[f][(i + 1) % 3];
-      uses.push_back({std::min(a, b), std::max(a, b), int(f), i});
-    }
-  std::sort(uses.begin(), uses.end());
-  return uses;
-}
-
 // Generalized winding number of one part's faces (Jacobson et al. 2013:
 // the sum of their signed solid angles over 4π), evaluated through a
 // hierarchy: a cluster far from the query point counts as its dipole

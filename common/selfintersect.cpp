@@ -39,30 +39,15 @@ TrianglePoints pointsOf(const std::vector<Point3>& P, const Triangle& t) {
 
 // ---- Edges ----------------------------------------------------------------
 
-// Every use of an edge by a face, grouped by edge: uses[first[e]..first[e+1])
-// are the uses of edge e. A use runs from the face's corner `corner` to the
-// next corner.
-struct EdgeUse {
-  int u, v;  // the edge, smaller vertex first
-  int face, corner;
-  bool operator<(const EdgeUse& o) const {
-    return std::tie(u, v, face, corner) < std::tie(o.u, o.v, o.face, o.corner);
-  }
-};
-
+// The edge uses of the faces (mesh.h), grouped by edge:
+// uses[first[e]..first[e+1]) are the uses of edge e.
 struct Edges {
   std::vector<EdgeUse> uses;
   std::vector<int> first;        // per edge: its first use; one extra at the end
   std::vector<int> edge_of_use;  // per face corner (3f + i): its edge
 
   explicit Edges(const std::vector<Triangle>& T) {
-    uses.reserve(3 * T.size());
-    for (std::size_t f = 0; f < T.size(); ++f)
-      for (int i = 0; i < 3; ++i) {
-        const int a = T[f][i], b = T[f][(i + 1) % 3];
-        uses.push_back({std::min(a, b), std::max(a, b), int(f), i});
-      }
-    std::sort(uses.begin(), uses.end());
+    uses = edgeUses(T);
     edge_of_use.resize(uses.size());
     for (std::size_t k = 0; k < uses.size(); ++k) {
       if (k == 0 || uses[k].u != uses[k - 1].u || uses[k].v != uses[k - 1].v)
@@ -1058,16 +1043,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
 
   if (options.verify && !outTriangles.empty()) {
     reportProgress(options.progress, 90, "verifying");
-    FindIntersectionsOptions fo;
-    fo.cross = false;
-    if (options.round_to_float) {
-      Mesh check = r.mesh;
-      for (Vertex& v : check.vert)
-        for (int k = 0; k < 3; ++k) v.P()[k] = double(float(v.P()[k]));
-      r.remaining_intersecting_pairs = findIntersections({&check}, fo).self_pairs[0];
-    } else {
-      r.remaining_intersecting_pairs = findIntersections({&r.mesh}, fo).self_pairs[0];
-    }
+    r.remaining_intersecting_pairs = selfIntersectingPairs(r.mesh, options.round_to_float);
     r.verified = true;
   }
   r.time_ms =

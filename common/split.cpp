@@ -1079,14 +1079,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 }
 
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
-  if (result.merged.fn == 0) return 0;
-  Mesh check = result.merged;
-  if (asFloat)
-    for (Vertex& v : check.vert)
-      for (int k = 0; k < 3; ++k) v.P()[k] = double(float(v.P()[k]));
-  FindIntersectionsOptions o;
-  o.cross = false;
-  return findIntersections({&check}, o).self_pairs[0];
+  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat);
 }
 
 namespace {

@@ -23,12 +23,6 @@ double volumeOf(const Mesh& m) {
   return v / 6;
 }
 
-std::size_t selfIntersections(const Mesh& m) {
-  FindIntersectionsOptions o;
-  o.cross = false;
-  return findIntersections({&m}, o).self_pairs[0];
-}
-
 // Both meshes in one layer (two components).
 Mesh together(const Mesh& a, const Mesh& b) {
   return appended(a, b);
@@ -109,7 +103,7 @@ double unionVolumeByWindingNumbers(const Mesh& a, const Mesh& b) {
 // What every result must be: no intersecting pair (exact), edge-manifold,
 // closed when the input was.
 void expectValid(const SelfIntersectionResult& r) {
-  EXPECT_EQ(selfIntersections(r.mesh), 0u) << toJson(r).str();
+  EXPECT_EQ(selfIntersectingPairs(r.mesh), 0u) << toJson(r).str();
   EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
   EXPECT_EQ(r.non_manifold_edges_after, 0u);
   if (r.input_closed) {
