@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -247,6 +248,109 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);
   return r;
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(const std::vector<Point3>& P,
+                                                                const std::vector<Triangle>& T,
+                                                                const std::vector<char>& changed,
+                                                                int widenSteps) {
+  std::vector<Box> changedBoxes;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (!changed[f]) continue;
+    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < widenSteps; ++i) {
+        b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
+        b.hi[k] = std::nextafter(b.hi[k], INFINITY);
+      }
+    changedBoxes.push_back(b);
+  }
+  return pairsWithChangedBoxes(P, T, changed, changedBoxes);
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T, const std::vector<char>& changed,
+    const std::vector<Box>& changedBoxes) {
+  std::vector<int> changedIndex(T.size(), -1);
+  std::vector<std::uint32_t> changedFaces;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (changed[f]) {
+      changedIndex[f] = int(changedFaces.size());
+      changedFaces.push_back(std::uint32_t(f));
+    }
+  if (changedFaces.empty()) return {};
+  const BoxTree tree(changedBoxes);
+  // A coarse grid of the cells that changed boxes touch turns away, cheaply,
+  // the faces far from every changed face (most of a large mesh).
+  const Box& bounds = tree.bounds();
+  constexpr int kCells = 64;
+  float cellSize[3];
+  for (int k = 0; k < 3; ++k)
+    cellSize[k] = std::max((bounds.hi[k] - bounds.lo[k]) / kCells, 1e-30f);
+  auto cellRange = [&](const Box& b, int k, int& lo, int& hi) {
+    lo = std::clamp(int((b.lo[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
+    hi = std::clamp(int((b.hi[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
+  };
+  std::vector<char> occupied(kCells * kCells * kCells, 0);
+  for (const Box& b : changedBoxes) {
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z) occupied[(x * kCells + y) * kCells + z] = 1;
+  }
+  auto nearChanged = [&](const Box& b) {
+    if (!overlap(b, bounds)) return false;
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          if (occupied[(x * kCells + y) * kCells + z]) return true;
+    return false;
+  };
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t g = begin; g < end; ++g) {
+      const Box b = changedIndex[g] >= 0 ? changedBoxes[changedIndex[g]]
+                                         : boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
+      if (!nearChanged(b)) continue;
+      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
+        const std::uint32_t f = changedFaces[i];
+        // A pair of two changed faces is found from both sides: keep one.
+        if (f != g && (changedIndex[g] < 0 || f < g))
+          found[worker].push_back({f, std::uint32_t(g)});
+      });
+    }
+  });
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (const auto& w : found) pairs.insert(pairs.end(), w.begin(), w.end());
+  return pairs;
+}
+
+bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+                    std::uint32_t g) {
+  const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
+  const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+  if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
+  const SharedCorners c = sharedCorners(T[f], T[g]);
+  return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+}
+
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs) {
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+  parallelChunks(
+      pairs.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (facesIntersect(P, T, pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
+      },
+      1024);
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+  return all;
 }
 
 SegmentSoup contactSegments(const FindIntersectionsResult& result) {

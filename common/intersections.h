@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/box_tree.h"
 #include "common/json.h"
 #include "common/mesh.h"
 #include "common/progress.h"
@@ -63,6 +64,30 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
 // coordinates as stored or, with `asFloat`, rounded to float as MeshLab
 // stores them.
 std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false);
+
+// Candidate pairs (box overlap) of faces of (points, triangles) where at
+// least one face is `changed`: after a local edit only those pairs can
+// intersect anew when every pair of two unchanged faces is known. Boxes of
+// changed faces are widened by `widenSteps` float steps (room for moving
+// their vertices by as many float steps). Each pair once, changed face first.
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(
+    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+    const std::vector<char>& changed, int widenSteps = 0);
+// The same with the caller's boxes for the changed faces (in face order),
+// e.g. covering every position their vertices may take.
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
+    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+    const std::vector<char>& changed, const std::vector<Box>& changedBoxes);
+
+// The self-intersection rule for faces f and g of one mesh (never for a
+// degenerate face): they meet beyond what their shared corners explain.
+bool facesIntersect(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+                    std::uint32_t f, std::uint32_t g);
+
+// Of `pairs`, those that intersect (facesIntersect), in parallel.
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs);
 
 // The contact segments of every pair (a coplanar overlap contributes its
 // outline, a single touching point nothing), with coinciding end points

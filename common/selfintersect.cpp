@@ -813,9 +813,10 @@ std::size_t removeDuplicateFaces(std::vector<Triangle>& T, std::vector<int>& ori
 // size: towards the centroid of its fan, or else against its fan's normal,
 // each tried at full, quarter and sixteenth length; a move is kept only if
 // the copy's faces then cross nothing (exact), else the copy goes back.
+// With `asFloat` the moved positions are rounded to float (as stored).
 // Returns the copies left moved.
 std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& T,
-                           const std::vector<int>& source) {
+                           const std::vector<int>& source, bool asFloat) {
   constexpr double kSeparation = 1e-3;
   std::vector<int> copies(*std::max_element(source.begin(), source.end()) + 1, 0);
   for (int s : source) ++copies[s];
@@ -831,11 +832,12 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
       length[v] += (P[t[(i + 1) % 3]] - P[v]).Norm();
       ++count[v];
     }
-  // Candidate moves per copy, in the order tried; the last is none.
+  auto stored = [asFloat](const Point3& p) {
+    return asFloat ? Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))) : p;
+  };
+  // Candidate positions per copy, in the order tried; the last is home.
   std::vector<int> moving;
   std::vector<std::vector<Point3>> steps(P.size());
-  std::vector<Point3> home(P.size());
-  std::vector<int> tried(P.size(), 0);
   for (std::size_t v = 0; v < P.size(); ++v) {
     if (count[v] == 0) continue;
     const Point3 towardsFan = (centroid[v] / (2.0 * count[v]) - P[v]) * kSeparation;
@@ -843,34 +845,70 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
     const Point3 inward =
         n > 0 ? normal[v] * (-kSeparation * length[v] / count[v] / n) : Point3(0, 0, 0);
     for (double scale : {1.0, 0.25, 0.0625}) {
-      steps[v].push_back(towardsFan * scale);
-      steps[v].push_back(inward * scale);
+      steps[v].push_back(stored(P[v] + towardsFan * scale));
+      steps[v].push_back(stored(P[v] + inward * scale));
     }
-    steps[v].push_back(Point3(0, 0, 0));
-    home[v] = P[v];
-    P[v] = home[v] + steps[v][0];
+    steps[v].push_back(P[v]);
     moving.push_back(int(v));
   }
   if (moving.empty()) return 0;
-  std::vector<char> isMoving(P.size(), 0);
+  // Candidate pairs of faces around moving copies, from boxes that hold
+  // every position their corners may take.
+  std::vector<char> isMoving(P.size(), 0), aroundMoving(T.size(), 0);
   for (int v : moving) isMoving[v] = 1;
-  for (;;) {
-    MeshArrays arrays{P, T};
-    FindIntersectionsOptions o;
-    o.cross = false;
-    const FindIntersectionsResult found = findIntersectionsInArrays({&arrays}, o);
-    std::vector<char> retry(P.size(), 0);
-    bool any = false;
-    for (const IntersectingPair& pair : found.pairs)
-      for (std::uint32_t f : {pair.a.face, pair.b.face})
-        for (int v : T[f])
-          if (isMoving[v] && tried[v] + 1 < int(steps[v].size())) retry[v] = 1, any = true;
-    if (!any) break;
-    for (int v : moving)
-      if (retry[v]) P[v] = home[v] + steps[v][++tried[v]];
+  std::vector<Box> reach;
+  std::vector<int> reachIndex(T.size(), -1);
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    for (int v : T[f]) aroundMoving[f] |= isMoving[v];
+    if (!aroundMoving[f]) continue;
+    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+    for (int v : T[f])
+      for (const Point3& q : steps[v]) {
+        const Box c = boxOf(q, q, q);
+        for (int k = 0; k < 3; ++k)
+          b.lo[k] = std::min(b.lo[k], c.lo[k]), b.hi[k] = std::max(b.hi[k], c.hi[k]);
+      }
+    reachIndex[f] = int(reach.size());
+    reach.push_back(b);
   }
+  std::vector<std::vector<std::uint32_t>> others(reach.size());
+  for (const auto& [f, g] : pairsWithChangedBoxes(P, T, aroundMoving, reach)) {
+    others[reachIndex[f]].push_back(g);
+    if (reachIndex[g] >= 0) others[reachIndex[g]].push_back(f);
+  }
+  std::vector<std::vector<std::uint32_t>> around(P.size());
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (aroundMoving[f])
+      for (int v : T[f])
+        if (isMoving[v]) around[v].push_back(std::uint32_t(f));
+  auto crossings = [&](int v) {
+    std::size_t n = 0;
+    for (std::uint32_t f : around[v])
+      for (std::uint32_t g : others[reachIndex[f]]) n += facesIntersect(P, T, f, g);
+    return n;
+  };
+  // One copy at a time, against the others where they are now: the first
+  // step that leaves its faces crossing nothing, else the one that crosses
+  // least if it beats home. Two sweeps: a copy that had to stay home may
+  // move once its twin has.
+  for (int sweep = 0; sweep < 2; ++sweep)
+    for (int v : moving) {
+      const Point3 home = steps[v].back();
+      if (sweep == 1 && !(P[v] == home)) continue;
+      P[v] = home;
+      Point3 best = home;
+      std::size_t fewest = crossings(v);
+      if (fewest == 0) continue;
+      for (const Point3& q : steps[v]) {
+        P[v] = q;
+        const std::size_t n = crossings(v);
+        if (n < fewest) best = q, fewest = n;
+        if (n == 0) break;
+      }
+      P[v] = best;
+    }
   std::size_t moved = 0;
-  for (int v : moving) moved += !(P[v] == home[v]);
+  for (int v : moving) moved += !(P[v] == steps[v].back());
   return moved;
 }
 
@@ -879,6 +917,14 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
 SelfIntersectionResult removeSelfIntersections(const Mesh& input,
                                                const SelfIntersectionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  auto lap = start;
+  // Milliseconds since the previous lap.
+  auto elapsed = [&lap] {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - lap).count();
+    lap = now;
+    return ms;
+  };
   requireFacesAndFiniteCoordinates(input, "the mesh");
   if (!(options.degenerate_angle_deg >= 0 && options.degenerate_angle_deg < 60))
     throw InvalidInputError("the degenerate face angle must be between 0 and 60 degrees");
@@ -921,6 +967,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   }
 
   // §2.1 Pre-treatment.
+  elapsed();
   {
     Pretreatment pre(P, T, faceOrigin, options.degenerate_angle_deg);
     r.degenerate_faces_before = pre.countDegenerate();
@@ -930,6 +977,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
     }
     r.degenerate_faces_left = pre.countDegenerate();
   }
+  r.stage_ms.pretreat = elapsed();
 
   // §2.2 Self-intersections, cut into the faces (split.h).
   reportProgress(options.progress, 10, "splitting along the self-intersections");
@@ -946,6 +994,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   r.faces_split = split.faces_split;
   const MeshArrays cut = arraysOf(split.merged);
   r.faces_after_split = cut.triangles.size();
+  r.stage_ms.split = elapsed();
 
   // §2.3 Valid region growing.
   reportProgress(options.progress, 60, "growing the valid region");
@@ -961,6 +1010,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   r.side_conflicts = growing.conflicts;
   for (char v : valid) r.faces_kept += v;
   r.faces_removed = valid.size() - r.faces_kept;
+  r.stage_ms.growing = elapsed();
 
   // §2.4 Stitching.
   reportProgress(options.progress, 80, "stitching");
@@ -984,8 +1034,11 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
                               stitched.vertex_of_corner[3 * f + 2]});
       outFace.push_back(int(f));
     }
+  r.stage_ms.stitching = elapsed();
   if (options.separate_touching)
-    r.vertices_separated = separateCopies(outPoints, outTriangles, stitched.source_vertex);
+    r.vertices_separated =
+        separateCopies(outPoints, outTriangles, stitched.source_vertex, options.round_to_float);
+  r.stage_ms.separation = elapsed();
   if (r.inside_out)
     for (Triangle& t : outTriangles) std::swap(t[1], t[2]);
   buildMesh(r.mesh, outPoints, outTriangles);
@@ -1041,11 +1094,34 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   r.non_manifold_edges_after = after.non_manifold_edges;
   r.output_closed = !outTriangles.empty() && after.border_edges == 0;
 
+  elapsed();
   if (options.verify && !outTriangles.empty()) {
     reportProgress(options.progress, 90, "verifying");
-    r.remaining_intersecting_pairs = selfIntersectingPairs(r.mesh, options.round_to_float);
+    // The split searched every pair of the mesh it cut, and the faces it
+    // left as they were cross nothing. So only a face that is new, moved
+    // (rounding, separation) or re-connected (a corner on a copied vertex)
+    // can cross anything: every pair with one of those is tested, exactly,
+    // on the coordinates as stored.
+    std::vector<int> copies(cut.points.size(), 0);
+    for (int v : stitched.source_vertex) ++copies[v];
+    std::vector<char> vertexChanged(outPoints.size(), 0);
+    for (std::size_t v = 0; v < outPoints.size(); ++v) {
+      const int c = stitched.source_vertex[v];
+      const int birth = cutVertex[c].vertex;
+      vertexChanged[v] = copies[c] > 1 || birth < 0 || !(outPoints[v] == P[birth]);
+    }
+    std::vector<char> faceChanged(outTriangles.size(), 0);
+    for (std::size_t f = 0; f < outTriangles.size(); ++f) {
+      faceChanged[f] = split.merged_new_face[outFace[f]];
+      for (int v : outTriangles[f]) faceChanged[f] |= vertexChanged[v];
+    }
+    r.remaining_intersecting_pairs =
+        intersectingOf(outPoints, outTriangles,
+                       pairsWithChangedFaces(outPoints, outTriangles, faceChanged))
+            .size();
     r.verified = true;
   }
+  r.stage_ms.verify = elapsed();
   r.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   reportProgress(options.progress, 100, "done");
@@ -1085,6 +1161,14 @@ JsonObject toJson(const SelfIntersectionResult& r) {
       .set("edges_duplicated", r.edges_duplicated);
   if (r.verified) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
   j.set("time_ms", r.time_ms);
+  const auto& t = r.stage_ms;
+  j.set("stage_ms", JsonObject()
+                        .set("pretreat", t.pretreat)
+                        .set("split", t.split)
+                        .set("growing", t.growing)
+                        .set("stitching", t.stitching)
+                        .set("separation", t.separation)
+                        .set("verify", t.verify));
   return j;
 }
 

@@ -1106,77 +1106,20 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
 
   // Only faces that are new or that rounding moves can cross anything they
   // did not cross before: every other face is an input face, exactly as it was.
+  std::vector<char> isChanged(T.size(), 0);
   std::vector<int> changedIndex(T.size(), -1);
   std::vector<std::uint32_t> changed;
   for (std::size_t f = 0; f < T.size(); ++f) {
-    bool isChanged = f < r.merged_new_face.size() && r.merged_new_face[f];
-    for (int v : T[f]) isChanged |= P[v] != exact[v];
-    if (isChanged) {
+    isChanged[f] = f < r.merged_new_face.size() && r.merged_new_face[f];
+    for (int v : T[f]) isChanged[f] |= P[v] != exact[v];
+    if (isChanged[f]) {
       changedIndex[f] = int(changed.size());
       changed.push_back(std::uint32_t(f));
     }
   }
   if (changed.empty()) return 0;
-
-  // Candidate pairs: a changed face and any face whose box overlaps its box
-  // widened by a few float steps (re-rounding moves a vertex by one step).
-  auto widened = [](Box b) {
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < 3; ++i) {
-        b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
-        b.hi[k] = std::nextafter(b.hi[k], INFINITY);
-      }
-    return b;
-  };
-  std::vector<Box> changedBoxes;
-  for (std::uint32_t f : changed)
-    changedBoxes.push_back(widened(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]])));
-  const BoxTree tree(changedBoxes);
-  // A coarse grid of the cells that changed boxes touch turns away, cheaply,
-  // the faces far from every changed face (most of a large mesh).
-  const Box& bounds = tree.bounds();
-  constexpr int kCells = 64;
-  float cellSize[3];
-  for (int k = 0; k < 3; ++k)
-    cellSize[k] = std::max((bounds.hi[k] - bounds.lo[k]) / kCells, 1e-30f);
-  auto cellRange = [&](const Box& b, int k, int& lo, int& hi) {
-    lo = std::clamp(int((b.lo[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
-    hi = std::clamp(int((b.hi[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
-  };
-  std::vector<char> occupied(kCells * kCells * kCells, 0);
-  for (const Box& b : changedBoxes) {
-    int lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
-    for (int x = lo[0]; x <= hi[0]; ++x)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z) occupied[(x * kCells + y) * kCells + z] = 1;
-  }
-  auto nearChanged = [&](const Box& b) {
-    if (!overlap(b, bounds)) return false;
-    int lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
-    for (int x = lo[0]; x <= hi[0]; ++x)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z)
-          if (occupied[(x * kCells + y) * kCells + z]) return true;
-    return false;
-  };
-  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
-  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-    for (std::size_t g = begin; g < end; ++g) {
-      Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
-      if (changedIndex[g] >= 0) b = widened(b);
-      if (!nearChanged(b)) continue;
-      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
-        const std::uint32_t f = changed[i];
-        // A pair of two changed faces is found from both sides: keep one.
-        if (f != g && (changedIndex[g] < 0 || f < g))
-          found[worker].push_back({f, std::uint32_t(g)});
-      });
-    }
-  });
-  std::vector<std::array<std::uint32_t, 2>> pairs;
-  for (const auto& w : found) pairs.insert(pairs.end(), w.begin(), w.end());
+  // Candidates: boxes widened by a few float steps (re-rounding moves a vertex by one).
+  const std::vector<std::array<std::uint32_t, 2>> pairs = pairsWithChangedFaces(P, T, isChanged, 3);
   // Candidates of each changed face, both ways (compressed rows).
   std::vector<std::uint32_t> offsets(changed.size() + 1, 0), others;
   for (const auto& [f, g] : pairs) {
@@ -1204,32 +1147,7 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
       for (int v : T[f]) around[next[v]++] = f;
   }
 
-  auto at = [&](std::uint32_t f) -> TrianglePoints { return {P[T[f][0]], P[T[f][1]], P[T[f][2]]}; };
-  // Degenerate faces never count; the flags of changed faces follow their vertices.
-  std::vector<char> degenerate(T.size(), 0);
-  auto updateDegenerate = [&](std::uint32_t f) {
-    degenerate[f] = collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
-  };
-  for (const auto& [f, g] : pairs) updateDegenerate(f), updateDegenerate(g);
-  auto crosses = [&](std::uint32_t f, std::uint32_t g) {
-    if (degenerate[f] || degenerate[g]) return false;
-    const TrianglePoints a = at(f), b = at(g);
-    const SharedCorners c = sharedCorners(T[f], T[g]);
-    return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
-  };
-  auto crossingPairs = [&] {
-    std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
-    parallelChunks(
-        pairs.size(),
-        [&](std::size_t begin, std::size_t end, unsigned worker) {
-          for (std::size_t i = begin; i < end; ++i)
-            if (crosses(pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
-        },
-        1024);
-    std::vector<std::array<std::uint32_t, 2>> all;
-    for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
-    return all;
-  };
+  auto crosses = [&](std::uint32_t f, std::uint32_t g) { return facesIntersect(P, T, f, g); };
   // How many crossings the changed faces around v take part in.
   auto localCrossings = [&](int v) {
     std::size_t n = 0;
@@ -1243,7 +1161,7 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
 
   std::size_t remaining = 0;
   for (int pass = 0; pass <= passes; ++pass) {
-    const std::vector<std::array<std::uint32_t, 2>> crossing = crossingPairs();
+    const std::vector<std::array<std::uint32_t, 2>> crossing = intersectingOf(P, T, pairs);
     remaining = crossing.size();
     if (remaining == 0 || pass == passes) break;
     std::set<int> candidates;
@@ -1254,19 +1172,15 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
     for (int v : candidates) {
       const Point3 e = exact[v];
       Point3 best = P[v];
-      std::size_t bestCount = localCrossings(v);  // (flags of its faces are current here)
+      std::size_t bestCount = localCrossings(v);
       for (int choice = 0; choice < 8 && bestCount > 0; ++choice) {
         P[v] =
             Point3(choice & 1 ? above(e[0]) : below(e[0]), choice & 2 ? above(e[1]) : below(e[1]),
                    choice & 4 ? above(e[2]) : below(e[2]));
-        for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k)
-          updateDegenerate(around[k]);
         const std::size_t n = localCrossings(v);
         if (n < bestCount) best = P[v], bestCount = n;
       }
       P[v] = best;
-      for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k)
-        updateDegenerate(around[k]);
     }
   }
   // Write the float positions back, to the merged output and to each mesh.
