@@ -82,14 +82,24 @@ MeshArrays arraysOf(const Mesh& mesh) {
 }
 
 std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * triangles.size());
+  // A counting sort by the smaller vertex, then a small sort within each
+  // vertex's few uses: linear in the mesh size, where one sort is not.
+  int vertexCount = 0;
+  for (const Triangle& t : triangles)
+    for (int v : t) vertexCount = std::max(vertexCount, v + 1);
+  std::vector<int> start(std::size_t(vertexCount) + 1, 0);
+  for (const Triangle& t : triangles)
+    for (int i = 0; i < 3; ++i) ++start[std::min(t[i], t[(i + 1) % 3]) + 1];
+  for (int v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
+  std::vector<EdgeUse> uses(3 * triangles.size());
+  std::vector<int> next(start.begin(), start.end() - 1);
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (int i = 0; i < 3; ++i) {
       const int a = triangles[f][i], b = triangles[f][(i + 1) % 3];
-      uses.push_back({std::min(a, b), std::max(a, b), int(f), i});
+      uses[next[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), int(f), i};
     }
-  std::sort(uses.begin(), uses.end());
+  for (int v = 0; v < vertexCount; ++v)
+    std::sort(uses.begin() + start[v], uses.begin() + start[v + 1]);
   return uses;
 }
 

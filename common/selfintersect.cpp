@@ -758,14 +758,28 @@ double signedVolume(const std::vector<Point3>& P, const std::vector<Triangle>& T
 // same surface twice. Of a group, one face stays if they all run alike; two
 // opposite copies bound nothing and both go.
 std::size_t removeDuplicateFaces(std::vector<Triangle>& T, std::vector<int>& origin) {
+  // Faces on the same vertices share their smallest vertex: a counting sort
+  // by it, then a small sort within each vertex's faces, puts them together.
+  std::vector<Triangle> keys(T.size());
+  int vertexCount = 0;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    keys[f] = T[f];
+    std::sort(keys[f].begin(), keys[f].end());
+    vertexCount = std::max(vertexCount, keys[f][2] + 1);
+  }
+  std::vector<int> start(std::size_t(vertexCount) + 1, 0);
+  for (const Triangle& k : keys) ++start[k[0] + 1];
+  for (int v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
   std::vector<int> order(T.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int f) {
-    Triangle s = T[f];
-    std::sort(s.begin(), s.end());
-    return s;
-  };
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  {
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < T.size(); ++f) order[next[keys[f][0]]++] = int(f);
+  }
+  auto byKey = [&](int a, int b) { return keys[a] < keys[b] || (keys[a] == keys[b] && a < b); };
+  for (int v = 0; v < vertexCount; ++v)
+    if (start[v + 1] - start[v] > 1)
+      std::sort(order.begin() + start[v], order.begin() + start[v + 1], byKey);
+  auto key = [&](int f) -> const Triangle& { return keys[f]; };
   std::vector<char> drop(T.size(), 0);
   for (std::size_t i = 0; i < order.size();) {
     std::size_t j = i + 1;
@@ -773,7 +787,7 @@ std::size_t removeDuplicateFaces(std::vector<Triangle>& T, std::vector<int>& ori
     if (j - i > 1) {
       // A face's direction: is its corner sequence an even rotation of the sorted one?
       auto even = [&](int f) {
-        const Triangle s = key(f);
+        const Triangle& s = key(f);
         const Triangle& t = T[f];
         for (int r = 0; r < 3; ++r)
           if (t[r] == s[0]) return t[(r + 1) % 3] == s[1];
