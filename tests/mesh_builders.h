@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "common/mesh.h"
@@ -63,6 +64,61 @@ inline Mesh moved(const Mesh& m, Point3 by) {
   std::vector<Point3> p = positionsOf(m);
   for (Point3& q : p) q += by;
   return makeMesh(p, trianglesOf(m));
+}
+
+// Icosahedron subdivided `levels` times, projected onto the sphere of radius
+// r around c: near-uniform triangles (20 * 4^levels), closed, outward normals.
+inline Mesh icosphere(int levels, double r = 1, Point3 c = {0, 0, 0}) {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Point3> p{{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                        {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Triangle> f{{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                          {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                          {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                          {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (Point3& q : p) q.Normalize();
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<int, int>, int> middle;
+    auto mid = [&](int a, int b) {
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      const auto it = middle.find(key);
+      if (it != middle.end()) return it->second;
+      Point3 m = (p[a] + p[b]) / 2;
+      m.Normalize();
+      p.push_back(m);
+      return middle[key] = int(p.size()) - 1;
+    };
+    std::vector<Triangle> next;
+    for (const Triangle& q : f) {
+      const int ab = mid(q[0], q[1]), bc = mid(q[1], q[2]), ca = mid(q[2], q[0]);
+      next.push_back({q[0], ab, ca});
+      next.push_back({q[1], bc, ab});
+      next.push_back({q[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    f = std::move(next);
+  }
+  for (Point3& q : p) q = c + q * r;
+  return makeMesh(p, f);
+}
+
+// Grid of nx x ny squares of side `cell` in the xy plane from the origin,
+// each cut into two triangles (normals +z), lifted to z = height(x, y);
+// `keep(x, y)` (the square's centre) decides which squares are kept.
+template <class Height, class Keep>
+Mesh heightGrid(int nx, int ny, double cell, Height&& height, Keep&& keep) {
+  std::vector<Point3> p;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) p.emplace_back(i * cell, j * cell, height(i * cell, j * cell));
+  auto at = [&](int i, int j) { return j * (nx + 1) + i; };
+  std::vector<Triangle> t;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (!keep((i + 0.5) * cell, (j + 0.5) * cell)) continue;
+      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return makeMesh(p, t);
 }
 
 }  // namespace meshmend::testing

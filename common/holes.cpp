@@ -1,0 +1,2034 @@
+#include "common/holes.h"
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <queue>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/box_tree.h"
+#include "common/errors.h"
+#include "common/predicates.h"
+#include "common/triangle_intersection.h"
+
+namespace meshmend {
+
+const char* toString(HoleFairing fairing) {
+  switch (fairing) {
+    case HoleFairing::Flat:
+      return "flat";
+    case HoleFairing::Harmonic:
+      return "harmonic";
+    case HoleFairing::Biharmonic:
+      return "biharmonic";
+    case HoleFairing::LaplacianRegression:
+      return "laplacian_regression";
+  }
+  return "unknown";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+std::uint64_t edgeKey(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+}
+
+std::uint64_t directedKey(int from, int to) {
+  return (std::uint64_t(std::uint32_t(from)) << 32) | std::uint32_t(to);
+}
+
+bool hasCorner(const Triangle& t, int v) {
+  return t[0] == v || t[1] == v || t[2] == v;
+}
+
+// ---- Faces around vertices ------------------------------------------------------
+
+// Faces around each vertex: a compressed table of the input faces plus the
+// faces added or given a new corner since. Entries are checked on use: a
+// split face loses a corner, so its entry at that corner goes stale.
+class VertexFaces {
+ public:
+  VertexFaces(const std::vector<Triangle>& triangles, std::size_t vertexCount)
+      : triangles_(triangles), tableVertices_(vertexCount) {
+    start_.assign(vertexCount + 1, 0);
+    for (const Triangle& t : triangles)
+      for (int v : t) ++start_[std::size_t(v) + 1];
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    faces_.resize(start_.back());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+      for (int v : triangles[f]) faces_[fill[v]++] = int(f);
+  }
+
+  // Face f is new, or has v as a new corner.
+  void add(int v, int f) { extra_[v].push_back(f); }
+
+  // Forgets what was added for vertices and faces beyond these counts (an
+  // undone hole).
+  void truncate(std::size_t vertexCount, std::size_t faceCount) {
+    for (auto it = extra_.begin(); it != extra_.end();) {
+      if (std::size_t(it->first) >= vertexCount) {
+        it = extra_.erase(it);
+        continue;
+      }
+      auto& list = it->second;
+      list.erase(std::remove_if(list.begin(), list.end(),
+                                [&](int f) { return std::size_t(f) >= faceCount; }),
+                 list.end());
+      ++it;
+    }
+  }
+
+  template <class Visit>
+  void forEach(int v, Visit&& visit) const {
+    const auto current = [&](int f) {
+      return std::size_t(f) < triangles_.size() && hasCorner(triangles_[f], v);
+    };
+    if (std::size_t(v) < tableVertices_)
+      for (int i = start_[v]; i < start_[v + 1]; ++i)
+        if (current(faces_[i])) visit(faces_[i]);
+    const auto it = extra_.find(v);
+    if (it != extra_.end())
+      for (int f : it->second)
+        if (current(f)) visit(f);
+  }
+
+ private:
+  const std::vector<Triangle>& triangles_;
+  std::size_t tableVertices_;
+  std::vector<int> start_, faces_;
+  std::unordered_map<int, std::vector<int>> extra_;
+};
+
+// ---- Border loops ------------------------------------------------------------------
+
+struct BorderLoop {
+  std::vector<int> vertices;  // mesh direction: a face runs vertices[i] -> vertices[i+1]
+  bool closed = true;
+  int brokenAt = -1;  // open loops: a vertex where the border cannot be followed
+};
+
+struct BorderEdge {
+  int from, to, face;
+};
+
+struct BorderLoops {
+  std::vector<BorderLoop> loops;
+  std::unordered_set<int> pinched;  // boundary vertices with more than one border through them
+};
+
+Point3 faceNormal(const std::vector<Point3>& P, const Triangle& t) {
+  return (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
+}
+
+// At a boundary vertex with several fans of faces (a bow-tie), decides which
+// outgoing border edge follows each incoming one: the border leaving a fan
+// continues along the next fan counter-clockwise around the vertex (the gap
+// between them is the hole). Returns false when a fan is not a plain open
+// fan (a non-manifold edge or inconsistent orientation around the vertex).
+bool pairAtPinch(int v, const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                 const VertexFaces& adjacency, const std::vector<int>& ins,
+                 const std::vector<int>& outs, const std::vector<BorderEdge>& edges,
+                 std::unordered_map<int, int>& next) {
+  std::vector<int> faces;
+  adjacency.forEach(v, [&](int f) { faces.push_back(f); });
+  // Faces sharing an edge through v that exactly two faces use are in one fan.
+  std::vector<int> parent(faces.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::function<int(int)> root = [&](int i) {
+    return parent[i] == i ? i : parent[i] = root(parent[i]);
+  };
+  std::unordered_map<int, std::vector<int>> byNeighbour;
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int c : T[faces[i]])
+      if (c != v) byNeighbour[c].push_back(int(i));
+  for (const auto& [neighbour, list] : byNeighbour)
+    if (list.size() == 2) parent[root(list[0])] = root(list[1]);
+  auto fanOf = [&](int face) {
+    for (std::size_t i = 0; i < faces.size(); ++i)
+      if (faces[i] == face) return root(int(i));
+    return -1;
+  };
+  std::unordered_map<int, int> fanIn, fanOut;  // fan -> its border edge in / out
+  for (int e : ins) {
+    const int fan = fanOf(edges[e].face);
+    if (fan < 0 || fanIn.count(fan)) return false;
+    fanIn[fan] = e;
+  }
+  for (int e : outs) {
+    const int fan = fanOf(edges[e].face);
+    if (fan < 0 || fanOut.count(fan)) return false;
+    fanOut[fan] = e;
+  }
+  if (fanIn.size() != fanOut.size()) return false;
+  for (const auto& [fan, e] : fanIn)
+    if (!fanOut.count(fan)) return false;
+  // Angles of the border edges around the vertex's mean normal.
+  Point3 n(0, 0, 0);
+  for (int f : faces) n += faceNormal(P, T[f]);
+  if (n.Norm() == 0) n = Point3(0, 0, 1);
+  n.Normalize();
+  Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
+  u.Normalize();
+  const Point3 w = n ^ u;
+  auto angle = [&](int other) {
+    const Point3 d = P[other] - P[v];
+    return std::atan2(d * w, d * u);
+  };
+  for (const auto& [fan, in] : fanIn) {
+    const double from = angle(edges[in].from);
+    int best = -1;
+    double bestTurn = 1e300;
+    for (const auto& [otherFan, out] : fanOut) {
+      if (otherFan == fan && fanOut.size() > 1) continue;
+      double turn = angle(edges[out].to) - from;
+      while (turn <= 0) turn += 2 * M_PI;
+      if (turn < bestTurn) bestTurn = turn, best = out;
+    }
+    next[in] = best;
+  }
+  return true;
+}
+
+// A closed walk that passes a vertex twice is cut there into simple loops.
+std::vector<std::vector<int>> simpleLoops(const std::vector<int>& walk) {
+  std::vector<std::vector<int>> out;
+  std::vector<int> stack;
+  std::unordered_map<int, std::size_t> at;
+  for (int v : walk) {
+    const auto it = at.find(v);
+    if (it != at.end()) {
+      const std::size_t k = it->second;
+      out.emplace_back(stack.begin() + std::ptrdiff_t(k), stack.end());
+      for (std::size_t j = k + 1; j < stack.size(); ++j) at.erase(stack[j]);
+      stack.resize(k + 1);
+      continue;
+    }
+    at[v] = stack.size();
+    stack.push_back(v);
+  }
+  out.push_back(stack);
+  return out;
+}
+
+BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                            const VertexFaces& adjacency) {
+  BorderLoops result;
+  std::vector<BorderEdge> edges;
+  {
+    const std::vector<EdgeUse> uses = edgeUses(T);
+    for (std::size_t i = 0; i < uses.size();) {
+      std::size_t j = i + 1;
+      while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+      if (j - i == 1) {
+        const Triangle& t = T[uses[i].face];
+        edges.push_back({t[uses[i].corner], t[(uses[i].corner + 1) % 3], uses[i].face});
+      }
+      i = j;
+    }
+  }
+  if (edges.empty()) return result;
+  std::unordered_map<int, std::vector<int>> outOf, inTo;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    outOf[edges[e].from].push_back(int(e));
+    inTo[edges[e].to].push_back(int(e));
+  }
+  // The border edge that follows each border edge (-1: none can be chosen).
+  std::unordered_map<int, int> pinchNext;
+  std::unordered_set<int> broken;
+  for (const auto& [v, outs] : outOf) {
+    const auto in = inTo.find(v);
+    const std::size_t ins = in == inTo.end() ? 0 : in->second.size();
+    if (outs.size() == 1 && ins == 1) continue;
+    if (outs.size() == ins && pairAtPinch(v, P, T, adjacency, in->second, outs, edges, pinchNext)) {
+      result.pinched.insert(v);
+      continue;
+    }
+    broken.insert(v);
+  }
+  for (const auto& [v, ins] : inTo)
+    if (!outOf.count(v)) broken.insert(v);
+  std::vector<int> next(edges.size(), -1), previous(edges.size(), -1);
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const int to = edges[e].to;
+    if (broken.count(to)) continue;
+    if (result.pinched.count(to)) {
+      const auto it = pinchNext.find(int(e));
+      next[e] = it == pinchNext.end() ? -1 : it->second;
+    } else {
+      next[e] = outOf[to][0];
+    }
+    if (next[e] >= 0) previous[next[e]] = int(e);
+  }
+  // Open borders first from their start, so that each is followed whole.
+  std::vector<int> starts;
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    if (previous[e] < 0) starts.push_back(int(e));
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    if (previous[e] >= 0) starts.push_back(int(e));
+  std::vector<char> visited(edges.size(), 0);
+  for (int start : starts) {
+    if (visited[start]) continue;
+    BorderLoop loop;
+    int e = start;
+    while (true) {
+      visited[e] = 1;
+      loop.vertices.push_back(edges[e].from);
+      const int n = next[e];
+      if (n == start) break;
+      if (n < 0 || visited[n]) {
+        loop.closed = false;
+        loop.vertices.push_back(edges[e].to);
+        loop.brokenAt = edges[e].to;
+        break;
+      }
+      e = n;
+    }
+    if (!loop.closed) {
+      result.loops.push_back(std::move(loop));
+      continue;
+    }
+    for (std::vector<int>& part : simpleLoops(loop.vertices)) {
+      BorderLoop simple;
+      simple.vertices = std::move(part);
+      result.loops.push_back(std::move(simple));
+    }
+  }
+  return result;
+}
+
+double loopDiameter(const std::vector<Point3>& P, const std::vector<int>& loop) {
+  double best = 0;
+  if (loop.size() <= 3000) {
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      for (std::size_t j = i + 1; j < loop.size(); ++j)
+        best = std::max(best, (P[loop[i]] - P[loop[j]]).SquaredNorm());
+    return std::sqrt(best);
+  }
+  // Large loops: repeated farthest-point sweeps (a lower bound within a few percent).
+  int from = loop[0];
+  for (int sweep = 0; sweep < 4; ++sweep) {
+    int far = from;
+    for (int v : loop) {
+      const double d = (P[v] - P[from]).SquaredNorm();
+      if (d > best) best = d, far = v;
+    }
+    from = far;
+  }
+  return std::sqrt(best);
+}
+
+// ---- 2-D geometry of the patch domain ------------------------------------------
+
+struct Vec2 {
+  double x = 0, y = 0;
+};
+Vec2 operator+(Vec2 a, Vec2 b) {
+  return {a.x + b.x, a.y + b.y};
+}
+Vec2 operator-(Vec2 a, Vec2 b) {
+  return {a.x - b.x, a.y - b.y};
+}
+Vec2 operator*(double s, Vec2 a) {
+  return {s * a.x, s * a.y};
+}
+double dot(Vec2 a, Vec2 b) {
+  return a.x * b.x + a.y * b.y;
+}
+double cross(Vec2 a, Vec2 b) {
+  return a.x * b.y - a.y * b.x;
+}
+double norm(Vec2 a) {
+  return std::sqrt(dot(a, a));
+}
+Vec2 rotated(Vec2 a, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * a.x - s * a.y, s * a.x + c * a.y};
+}
+
+int orient(Vec2 a, Vec2 b, Vec2 c) {
+  return orient2d(a.x, a.y, b.x, b.y, c.x, c.y);
+}
+
+// Exact: is r inside the bounding box of p and q (r collinear with them)?
+bool withinBox(Vec2 p, Vec2 q, Vec2 r) {
+  return std::min(p.x, q.x) <= r.x && r.x <= std::max(p.x, q.x) && std::min(p.y, q.y) <= r.y &&
+         r.y <= std::max(p.y, q.y);
+}
+
+// Exact: do the closed segments ab and cd share a point?
+bool segmentsMeet(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  return (o1 == 0 && withinBox(a, b, c)) || (o2 == 0 && withinBox(a, b, d)) ||
+         (o3 == 0 && withinBox(c, d, a)) || (o4 == 0 && withinBox(c, d, b));
+}
+
+// Exact: do segments sa and sb, which share the end point s, overlap beyond it?
+bool overlapFromShared(Vec2 s, Vec2 a, Vec2 b) {
+  return orient(s, a, b) == 0 && dot(a - s, b - s) > 0;
+}
+
+double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = dot(ab, ab);
+  const double t = len2 > 0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * ab));
+}
+
+// Uniform grid over a rectangle: ids registered in the cells their box
+// covers (points and boxes outside are clamped to the border cells).
+class Grid {
+ public:
+  Grid(Vec2 lo, Vec2 hi, double cell, std::size_t maxCells) : lo_(lo) {
+    const double w = std::max(hi.x - lo.x, 1e-300), h = std::max(hi.y - lo.y, 1e-300);
+    cell = std::max(cell, std::sqrt(w * h / double(std::max<std::size_t>(maxCells, 1))));
+    inverse_ = 1 / cell;
+    nx_ = std::max(1, std::min(4096, int(w * inverse_) + 1));
+    ny_ = std::max(1, std::min(4096, int(h * inverse_) + 1));
+    cells_.resize(std::size_t(nx_) * std::size_t(ny_));
+  }
+  void insert(int id, Vec2 lo, Vec2 hi) {
+    const auto [x0, y0] = cellOf(lo);
+    const auto [x1, y1] = cellOf(hi);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) cells_[std::size_t(y) * nx_ + x].push_back(id);
+  }
+  // Calls visit(id) for the ids in the cells the box covers (an id may come more than once).
+  template <class Visit>
+  void query(Vec2 lo, Vec2 hi, Visit&& visit) const {
+    const auto [x0, y0] = cellOf(lo);
+    const auto [x1, y1] = cellOf(hi);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        for (int id : cells_[std::size_t(y) * nx_ + x]) visit(id);
+  }
+
+ private:
+  std::pair<int, int> cellOf(Vec2 p) const {
+    const double fx = (p.x - lo_.x) * inverse_, fy = (p.y - lo_.y) * inverse_;
+    const int x = std::isfinite(fx) ? int(std::clamp(fx, 0.0, double(nx_ - 1))) : 0;
+    const int y = std::isfinite(fy) ? int(std::clamp(fy, 0.0, double(ny_ - 1))) : 0;
+    return {x, y};
+  }
+  Vec2 lo_;
+  double inverse_ = 1;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::vector<int>> cells_;
+};
+
+Vec2 boxLo(Vec2 a, Vec2 b) {
+  return {std::min(a.x, b.x), std::min(a.y, b.y)};
+}
+Vec2 boxHi(Vec2 a, Vec2 b) {
+  return {std::max(a.x, b.x), std::max(a.y, b.y)};
+}
+
+// Exact: is the closed polygon simple (no edge meets a non-adjacent edge,
+// adjacent edges do not fold back, no edge has zero length)?
+bool isSimplePolygon(const std::vector<Vec2>& poly) {
+  const std::size_t n = poly.size();
+  if (n < 3) return false;
+  Vec2 lo = poly[0], hi = poly[0];
+  double length = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 a = poly[i], b = poly[(i + 1) % n];
+    if (a.x == b.x && a.y == b.y) return false;
+    lo = boxLo(lo, a);
+    hi = boxHi(hi, a);
+    length += norm(b - a);
+  }
+  Grid grid(lo, hi, length / double(n), 4 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 a = poly[i], b = poly[(i + 1) % n];
+    grid.insert(int(i), boxLo(a, b), boxHi(a, b));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 a = poly[i], b = poly[(i + 1) % n];
+    bool meets = false;
+    grid.query(boxLo(a, b), boxHi(a, b), [&](int j) {
+      if (meets || std::size_t(j) <= i) return;
+      const Vec2 c = poly[j], d = poly[(j + 1) % n];
+      if (std::size_t(j) == i + 1)
+        meets = overlapFromShared(b, a, d);
+      else if (i == 0 && std::size_t(j) == n - 1)
+        meets = overlapFromShared(a, b, c);
+      else
+        meets = segmentsMeet(a, b, c, d);
+    });
+    if (meets) return false;
+  }
+  return true;
+}
+
+double signedArea(const std::vector<Vec2>& poly) {
+  double a = 0;
+  for (std::size_t i = 0; i < poly.size(); ++i) a += cross(poly[i], poly[(i + 1) % poly.size()]);
+  return a / 2;
+}
+
+// ---- Advancing front (§3.2) ----------------------------------------------------------
+
+// Triangulates a simple counter-clockwise polygon of the plane with an
+// advancing front: the front vertex with the smallest interior angle is
+// treated first; below 75 degrees its two neighbours are joined, below 135
+// one new vertex is put on its bisector, above that two (the three rules of
+// §3.2); a new vertex closer than the merge distance to a front vertex is
+// replaced by it, which splits the front in two. New triangles are added one
+// at a time, each only after exact tests that it lies in the part still
+// uncovered (orientation, no front edge crossing a new edge, no front vertex
+// inside), so the front stays a set of simple polygons whatever happens;
+// when no rule applies any more, the rest is cut into ears.
+class AdvancingFront {
+ public:
+  struct Settings {
+    double growth = 1.1;     // target size growth per front layer
+    double maxSize = 1e300;  // cap on the target size
+    double merge = 0.6;      // merge distance, relative to the target size
+  };
+
+  std::vector<Vec2> uv;                    // boundary vertices first, then new ones
+  std::vector<double> size;                // target edge length at each vertex
+  std::vector<std::array<int, 2>> parent;  // new vertices: the front edge they were built on
+  std::vector<Triangle> triangles;         // counter-clockwise in the plane
+
+  AdvancingFront(std::vector<Vec2> boundary, std::vector<double> boundarySize,
+                 const std::vector<std::pair<int, int>>& existingEdges, Settings settings)
+      : uv(std::move(boundary)), size(std::move(boundarySize)), settings_(settings) {
+    const std::size_t n = uv.size();
+    boundaryCount_ = n;
+    Vec2 lo = uv[0], hi = uv[0];
+    double mean = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      lo = boxLo(lo, uv[i]);
+      hi = boxHi(hi, uv[i]);
+      mean += size[i];
+    }
+    mean /= double(n);
+    minSize_ = std::max(*std::min_element(size.begin(), size.end()), 1e-3 * mean);
+    const double area = std::abs(signedArea(uv));
+    // Cells about one boundary edge long, at most a few per expected triangle.
+    const std::size_t expected = std::size_t(area / (0.43 * mean * mean)) + n;
+    points_ = std::make_unique<Grid>(lo, hi, mean, 2 * expected + 16);
+    edgeGrid_ = std::make_unique<Grid>(lo, hi, mean, 2 * expected + 16);
+    budget_ = 8 * (std::size_t(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000;
+    for (const auto& [a, b] : existingEdges) edges_.insert(edgeKey(a, b));
+    for (std::size_t i = 0; i < n; ++i)
+      nodes_.push_back({int(i), int((i + n - 1) % n), int((i + 1) % n)});
+    alive_ = n;
+    for (std::size_t i = 0; i < n; ++i) {
+      points_->insert(int(i), uv[i], uv[i]);
+      recordEdge(int(i));
+    }
+    for (std::size_t i = 0; i < n; ++i) push(int(i));
+  }
+
+  // Covers the polygon; false when it could not (no valid triangle left).
+  bool run() {
+    std::size_t failuresInARow = 0;
+    while (!heap_.empty() && alive_ > 0) {
+      const Entry top = heap_.top();
+      heap_.pop();
+      const Node& node = nodes_[top.node];
+      if (!node.alive || node.stamp != top.stamp) continue;
+      if (triangles.size() > budget_) break;
+      if (advanceAt(top.node)) {
+        failuresInARow = 0;
+        continue;
+      }
+      // Try the others first; give up on the rules once every node failed.
+      if (++failuresInARow > 2 * alive_ + 8) break;
+      Node& failed = nodes_[top.node];
+      ++failed.failures;
+      heap_.push({angleAt(top.node) + 2 * M_PI * failed.failures, top.node, failed.stamp});
+    }
+    return clipEars();
+  }
+
+  std::size_t boundaryCount() const { return boundaryCount_; }
+
+ private:
+  struct Node {
+    int vertex, prev, next;
+    unsigned stamp = 0;
+    bool alive = true;
+    int failures = 0;
+  };
+  struct Entry {
+    double key;
+    int node;
+    unsigned stamp;
+    bool operator>(const Entry& o) const { return key > o.key; }
+  };
+  struct EdgeRecord {
+    int node, from, to;
+  };
+
+  double angleAt(int n) const {
+    const Node& node = nodes_[n];
+    const Vec2 v = uv[node.vertex];
+    const Vec2 toNext = uv[nodes_[node.next].vertex] - v, toPrev = uv[nodes_[node.prev].vertex] - v;
+    double a = std::atan2(cross(toNext, toPrev), dot(toNext, toPrev));
+    if (a < 0) a += 2 * M_PI;
+    return a;
+  }
+
+  void push(int n) {
+    Node& node = nodes_[n];
+    ++node.stamp;
+    node.failures = 0;
+    heap_.push({angleAt(n), n, node.stamp});
+  }
+
+  void recordEdge(int n) {
+    const Node& node = nodes_[n];
+    const int from = node.vertex, to = nodes_[node.next].vertex;
+    edgeRecords_.push_back({n, from, to});
+    edgeGrid_->insert(int(edgeRecords_.size() - 1), boxLo(uv[from], uv[to]),
+                      boxHi(uv[from], uv[to]));
+  }
+
+  bool liveEdge(const EdgeRecord& r) const {
+    const Node& node = nodes_[r.node];
+    return node.alive && node.vertex == r.from && nodes_[node.next].vertex == r.to;
+  }
+
+  void kill(int n) {
+    if (!nodes_[n].alive) return;
+    nodes_[n].alive = false;
+    --alive_;
+  }
+
+  int newNode(int vertex) {
+    nodes_.push_back({vertex, -1, -1});
+    ++alive_;
+    points_->insert(int(nodes_.size() - 1), uv[vertex], uv[vertex]);
+    return int(nodes_.size() - 1);
+  }
+
+  // Exact: does the new edge ab (a, b vertices) stay clear of the front?
+  bool edgeIsClear(int a, int b) const {
+    const Vec2 pa = uv[a], pb = uv[b];
+    bool clear = true;
+    edgeGrid_->query(boxLo(pa, pb), boxHi(pa, pb), [&](int id) {
+      if (!clear) return;
+      const EdgeRecord& r = edgeRecords_[id];
+      if (!liveEdge(r)) return;
+      const int c = r.from, d = r.to;
+      const Vec2 pc = uv[c], pd = uv[d];
+      if (c == a && d == b) return;
+      if (c == b && d == a) return;
+      if (c == a || c == b || d == a || d == b) {
+        const int shared = (c == a || c == b) ? c : d;
+        const int mine = shared == a ? b : a, theirs = shared == c ? d : c;
+        clear = !overlapFromShared(uv[shared], uv[mine], uv[theirs]);
+        return;
+      }
+      clear = !segmentsMeet(pa, pb, pc, pd);
+    });
+    return clear;
+  }
+
+  // Exact: is no front vertex other than a, b, c in the closed triangle abc?
+  bool triangleIsEmpty(int a, int b, int c) const {
+    const Vec2 pa = uv[a], pb = uv[b], pc = uv[c];
+    const Vec2 lo = boxLo(boxLo(pa, pb), pc), hi = boxHi(boxHi(pa, pb), pc);
+    bool empty = true;
+    points_->query(lo, hi, [&](int n) {
+      if (!empty || !nodes_[n].alive) return;
+      const int v = nodes_[n].vertex;
+      if (v == a || v == b || v == c) return;
+      const Vec2 p = uv[v];
+      if (orient(pa, pb, p) >= 0 && orient(pb, pc, p) >= 0 && orient(pc, pa, p) >= 0) empty = false;
+    });
+    return empty;
+  }
+
+  // Adds triangle (a, b, c) on the front edge a->b that starts at node na,
+  // with c a front vertex at node nc or a new vertex (nc < 0); updates the
+  // front. Returns the node that now carries c (-1: the triangle is not valid).
+  int advance(int na, int c, int nc) {
+    const int nb = nodes_[na].next;
+    const int a = nodes_[na].vertex, b = nodes_[nb].vertex;
+    if (c == a || c == b) return -1;
+    if (orient(uv[a], uv[b], uv[c]) <= 0) return -1;
+    const bool closesNext = nc >= 0 && nc == nodes_[nb].next;
+    const bool closesPrev = nc >= 0 && nc == nodes_[na].prev;
+    if (!closesNext && (edges_.count(edgeKey(b, c)) || !edgeIsClear(b, c))) return -1;
+    if (!closesPrev && (edges_.count(edgeKey(c, a)) || !edgeIsClear(c, a))) return -1;
+    if (!triangleIsEmpty(a, b, c)) return -1;
+
+    triangles.push_back({a, b, c});
+    edges_.insert(edgeKey(b, c));
+    edges_.insert(edgeKey(c, a));
+    std::vector<int> touched;
+    int result = nc;
+    if (nc < 0) {  // a -> c -> b
+      const int nw = newNode(c);
+      nodes_[nw].prev = na;
+      nodes_[nw].next = nb;
+      nodes_[na].next = nw;
+      nodes_[nb].prev = nw;
+      recordEdge(na);
+      recordEdge(nw);
+      touched = {na, nw, nb};
+      result = nw;
+    } else if (closesNext && closesPrev) {  // the last triangle of a loop
+      kill(na);
+      kill(nb);
+      kill(nc);
+      return nc;
+    } else if (closesNext) {  // a -> c
+      kill(nb);
+      nodes_[na].next = nc;
+      nodes_[nc].prev = na;
+      recordEdge(na);
+      touched = {na, nc};
+    } else if (closesPrev) {  // c -> b
+      kill(na);
+      nodes_[nc].next = nb;
+      nodes_[nb].prev = nc;
+      recordEdge(nc);
+      touched = {nc, nb};
+    } else {  // the front splits: a -> c' -> (after c) ...  and  c -> b -> ...
+      const int copy = newNode(c);
+      const int after = nodes_[nc].next;
+      nodes_[copy].prev = na;
+      nodes_[copy].next = after;
+      nodes_[after].prev = copy;
+      nodes_[na].next = copy;
+      nodes_[nc].next = nb;
+      nodes_[nb].prev = nc;
+      recordEdge(na);
+      recordEdge(copy);
+      recordEdge(nc);
+      touched = {na, copy, after, nc, nb};
+    }
+    // A loop of two edges encloses nothing: both sides are covered.
+    for (int n : touched)
+      if (nodes_[n].alive && nodes_[nodes_[n].next].next == n) {
+        kill(nodes_[n].next);
+        kill(n);
+      }
+    for (int n : touched)
+      if (nodes_[n].alive) push(n);
+    return result;
+  }
+
+  int addVertex(Vec2 p, double s, int from, int to) {
+    uv.push_back(p);
+    size.push_back(s);
+    parent.push_back({from, to});
+    return int(uv.size() - 1);
+  }
+  void dropVertex() {
+    uv.pop_back();
+    size.pop_back();
+    parent.pop_back();
+  }
+
+  // Front nodes (not at the excluded vertices) within `radius` of p, nearest first.
+  std::vector<int> nodesNear(Vec2 p, double radius, std::initializer_list<int> exclude) const {
+    std::vector<std::pair<double, int>> found;
+    points_->query(p - Vec2{radius, radius}, p + Vec2{radius, radius}, [&](int n) {
+      if (!nodes_[n].alive) return;
+      const int v = nodes_[n].vertex;
+      for (int x : exclude)
+        if (v == x) return;
+      const double d = norm(uv[v] - p);
+      if (d < radius) found.push_back({d, n});
+    });
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    std::vector<int> out;
+    for (const auto& f : found) out.push_back(f.second);
+    return out;
+  }
+
+  // Would a new vertex at p make thin triangles with a front edge close by
+  // (one not at p's own neighbours)? Quality only, not validity.
+  bool crowded(Vec2 p, double s, int pv, int iv, int qv) const {
+    const double limit = 0.35 * s;
+    bool near = false;
+    edgeGrid_->query(p - Vec2{limit, limit}, p + Vec2{limit, limit}, [&](int id) {
+      if (near) return;
+      const EdgeRecord& r = edgeRecords_[id];
+      if (!liveEdge(r)) return;
+      for (int x : {pv, iv, qv})
+        if (r.from == x || r.to == x) return;
+      near = pointSegmentDistance(p, uv[r.from], uv[r.to]) < limit;
+    });
+    return near;
+  }
+
+  // Triangle (p, i, v) then (i, q, v) with v a front vertex at node nv (rule 2, merged).
+  bool joinTo(int np, int ni, int nv) {
+    const int at = advance(np, nodes_[nv].vertex, nv);
+    if (at < 0) return false;
+    if (nodes_[ni].alive && nodes_[ni].prev == nv) advance(ni, nodes_[nv].vertex, nv);
+    return true;
+  }
+
+  bool advanceAt(int ni) {
+    const int np = nodes_[ni].prev, nq = nodes_[ni].next;
+    const int i = nodes_[ni].vertex, p = nodes_[np].vertex, q = nodes_[nq].vertex;
+    const double angle = angleAt(ni);
+    const Vec2 pi = uv[i];
+    const double target =
+        std::min(settings_.maxSize, settings_.growth * (size[p] + size[i] + size[q]) / 3);
+    auto close = [&] { return angle < M_PI && advance(np, q, nq) >= 0; };
+    const double deg = 180 / M_PI;
+    if (angle * deg < 75 && close()) return true;
+
+    const Vec2 along = uv[q] - pi;
+    const double alongLength = norm(along);
+    if (alongLength == 0) return false;
+    const Vec2 unit = (1 / alongLength) * along;
+
+    if (angle * deg >= 135) {  // rule 3: two new vertices
+      const Vec2 w1 = pi + target * rotated(unit, angle / 3);
+      const Vec2 w2 = pi + target * rotated(unit, 2 * angle / 3);
+      const double r = settings_.merge * target;
+      if (nodesNear(w1, r, {i}).empty() && nodesNear(w2, r, {i}).empty() &&
+          !crowded(w1, target, p, i, q) && !crowded(w2, target, p, i, q)) {
+        const int v1 = addVertex(w1, target, i, q);
+        const int n1 = advance(ni, v1, -1);
+        if (n1 >= 0) {
+          const int v2 = addVertex(w2, target, p, i);
+          const int n2 = advance(np, v2, -1);
+          if (n2 < 0) {
+            dropVertex();
+          } else if (nodes_[ni].alive && nodes_[n2].next == ni && nodes_[ni].next == n1) {
+            advance(n2, v1, n1);
+          }
+          return true;
+        }
+        dropVertex();
+      }
+    }
+
+    // Rule 2: one vertex on the bisector, or the front vertex close to it.
+    const Vec2 w = pi + target * rotated(unit, angle / 2);
+    for (double radius : {settings_.merge * target, 0.0}) {
+      if (radius > 0) {
+        const std::vector<int> near = nodesNear(w, radius, {i});
+        if (!near.empty() && (nodes_[near[0]].vertex == p || nodes_[near[0]].vertex == q)) {
+          if (close()) return true;
+        }
+        for (int nv : near) {
+          const int v = nodes_[nv].vertex;
+          if (v == p || v == q) continue;
+          if (joinTo(np, ni, nv)) return true;
+        }
+        continue;
+      }
+      if (!crowded(w, target, p, i, q)) {
+        const int v = addVertex(w, target, p, i);
+        const int nw = advance(np, v, -1);
+        if (nw >= 0) {
+          if (nodes_[ni].alive && nodes_[ni].prev == nw) advance(ni, v, nw);
+          return true;
+        }
+        dropVertex();
+      }
+    }
+    // A wider search for a vertex to join, then closing.
+    for (int nv : nodesNear(w, 1.5 * target, {i, p, q}))
+      if (joinTo(np, ni, nv)) return true;
+    return close();
+  }
+
+  // Cuts what is left of the front into ears (any valid triangle of two
+  // consecutive front edges).
+  bool clipEars() {
+    bool progress = true;
+    while (alive_ > 0 && progress) {
+      progress = false;
+      std::vector<std::pair<double, int>> order;
+      for (std::size_t n = 0; n < nodes_.size(); ++n)
+        if (nodes_[n].alive) order.push_back({angleAt(int(n)), int(n)});
+      std::sort(order.begin(), order.end());
+      for (const auto& [angle, n] : order) {
+        if (!nodes_[n].alive || angle >= M_PI) continue;
+        const int np = nodes_[n].prev, nq = nodes_[n].next;
+        if (advance(np, nodes_[nq].vertex, nq) >= 0) progress = true;
+      }
+    }
+    return alive_ == 0;
+  }
+
+  Settings settings_;
+  std::size_t boundaryCount_ = 0, alive_ = 0, budget_ = 0;
+  double minSize_ = 0;
+  std::vector<Node> nodes_;
+  std::vector<EdgeRecord> edgeRecords_;
+  std::unordered_set<std::uint64_t> edges_;
+  std::unique_ptr<Grid> points_, edgeGrid_;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap_;
+};
+
+// Moves each new vertex towards the centroid of its neighbours (a few rounds)
+// where no triangle around it turns over (exact): rounder triangles for the
+// fairing's cotangent weights. `height` moves along.
+void relaxInterior(std::vector<Vec2>& uv, std::vector<double>& height, std::size_t fixed,
+                   const std::vector<Triangle>& triangles, int rounds) {
+  const std::size_t n = uv.size();
+  if (n == fixed) return;
+  std::vector<std::vector<int>> around(n);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int v : triangles[t]) around[v].push_back(int(t));
+  for (int round = 0; round < rounds; ++round)
+    for (std::size_t v = fixed; v < n; ++v) {
+      Vec2 centroid;
+      double h = 0;
+      int count = 0;
+      for (int t : around[v])
+        for (int c : triangles[t])
+          if (std::size_t(c) != v) {
+            centroid = centroid + uv[c];
+            h += height[c];
+            ++count;
+          }
+      if (count == 0) continue;
+      const Vec2 old = uv[v];
+      uv[v] = (1.0 / count) * centroid;
+      bool valid = true;
+      for (int t : around[v]) {
+        const Triangle& tri = triangles[t];
+        if (orient(uv[tri[0]], uv[tri[1]], uv[tri[2]]) <= 0) {
+          valid = false;
+          break;
+        }
+      }
+      if (valid)
+        height[v] = h / count;
+      else
+        uv[v] = old;
+    }
+}
+
+// ---- Where the patch lies: the hole's plane, or a disk ---------------------------
+
+struct Domain {
+  std::vector<Vec2> uv;  // boundary vertices, front order
+  bool planar = true;    // over a plane: a patch point is origin + u U + v V + h N
+  Point3 origin, U, V, N;
+  std::vector<double> height;  // boundary heights over the plane
+};
+
+bool projectOnPlane(const std::vector<Point3>& pts, Point3 origin, Point3 normal, Domain& d) {
+  normal.Normalize();
+  Point3 u = std::abs(normal[0]) < 0.9 ? Point3(1, 0, 0) ^ normal : Point3(0, 1, 0) ^ normal;
+  u.Normalize();
+  Point3 v = normal ^ u;
+  d.uv.clear();
+  d.height.clear();
+  for (const Point3& p : pts) {
+    const Point3 r = p - origin;
+    d.uv.push_back({r * u, r * v});
+    d.height.push_back(r * normal);
+  }
+  if (signedArea(d.uv) < 0) {  // the front must run counter-clockwise
+    v = -v;
+    normal = -normal;
+    for (Vec2& q : d.uv) q.y = -q.y;
+    for (double& h : d.height) h = -h;
+  }
+  if (!isSimplePolygon(d.uv)) return false;
+  d.planar = true;
+  d.origin = origin;
+  d.U = u;
+  d.V = v;
+  d.N = normal;
+  return true;
+}
+
+// The front's domain: the best-fit plane of the boundary if the boundary
+// projects onto it as a simple polygon, else the plane of the faces' mean
+// normal, else a circle (boundary vertices spaced by arc length).
+Domain domainOf(const std::vector<Point3>& pts, const Point3& meanFaceNormal) {
+  Domain d;
+  Point3 centroid(0, 0, 0);
+  for (const Point3& p : pts) centroid += p;
+  centroid /= double(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Point3& p : pts) {
+    const Eigen::Vector3d r(p[0] - centroid[0], p[1] - centroid[1], p[2] - centroid[2]);
+    cov += r * r.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(cov);
+  const Eigen::Vector3d e = eigen.eigenvectors().col(0);
+  if (projectOnPlane(pts, centroid, Point3(e[0], e[1], e[2]), d)) return d;
+  if (meanFaceNormal.Norm() > 0 && projectOnPlane(pts, centroid, meanFaceNormal, d)) return d;
+  d.planar = false;
+  d.uv.clear();
+  double perimeter = 0;
+  std::vector<double> at;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    at.push_back(perimeter);
+    perimeter += (pts[(i + 1) % pts.size()] - pts[i]).Norm();
+  }
+  const double radius = perimeter / (2 * M_PI);
+  for (double s : at) {
+    const double phi = 2 * M_PI * s / perimeter;
+    d.uv.push_back({radius * std::cos(phi), radius * std::sin(phi)});
+  }
+  return d;
+}
+
+// ---- Cotangent Laplacian rows --------------------------------------------------
+
+std::array<double, 3> cotangents(const Point3& a, const Point3& b, const Point3& c) {
+  auto cot = [](const Point3& u, const Point3& v) {
+    const double s = (u ^ v).Norm();
+    return s > 0 ? (u * v) / s : 0.0;
+  };
+  return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
+}
+
+// Edge weights below this are raised to it: obtuse triangles give negative
+// cotangent sums, which would make the systems indefinite.
+constexpr double kMinimumWeight = 0.05;
+
+// One vertex's Laplacian: neighbours (keys) with cotangent weights w_ij (Eq. 2-3).
+struct LaplacianRow {
+  std::vector<std::pair<int, double>> weights;  // key, omega (not normalised)
+  double total = 0;
+  double area = 0;  // a third of the area of the faces around the vertex
+
+  void add(int key, double omega) {
+    for (auto& [k, w] : weights)
+      if (k == key) {
+        w += omega;
+        return;
+      }
+    weights.push_back({key, omega});
+  }
+  void finish() {
+    total = 0;
+    for (auto& [k, w] : weights) total += (w = std::max(w, kMinimumWeight));
+  }
+};
+
+// Adds triangle (keys k[0..2], positions p[0..2]) to the row of corner `corner`.
+void addTriangleToRow(LaplacianRow& row, const std::array<int, 3>& k,
+                      const std::array<Point3, 3>& p, int corner) {
+  const std::array<double, 3> c = cotangents(p[0], p[1], p[2]);
+  const int j = (corner + 1) % 3, l = (corner + 2) % 3;
+  row.add(k[j], c[l]);
+  row.add(k[l], c[j]);
+  row.area += ((p[1] - p[0]) ^ (p[2] - p[0])).Norm() / 6;
+}
+
+// ---- LS-SVM regression (§2.2) ----------------------------------------------------
+
+// Least-squares SVM regression (Suykens) of a scalar over 3-D points with
+// Wendland's compactly supported C2 kernel (positive definite in 3-D, no
+// exponentials): solves [0 1^T; 1 Omega + I/gamma] [b; a] = [0; y] (Eq. 14)
+// and predicts f(x) = sum a_i K(x, x_i) + b (Eq. 15).
+class LsSvm {
+ public:
+  bool fit(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& y, double support,
+           double gamma) {
+    const std::size_t n = x.size();
+    if (n < 4) return false;
+    centres_ = x;
+    inverseSupport_ = 1 / support;
+    Eigen::MatrixXd K(n, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      K(i, i) = 1 + 1 / gamma;
+      for (std::size_t j = i + 1; j < n; ++j) K(i, j) = K(j, i) = kernel((x[i] - x[j]).norm());
+    }
+    const Eigen::LLT<Eigen::MatrixXd> llt(K);
+    if (llt.info() != Eigen::Success) return false;
+    const Eigen::VectorXd eta = llt.solve(Eigen::VectorXd::Ones(Eigen::Index(n)));
+    const Eigen::VectorXd nu =
+        llt.solve(Eigen::Map<const Eigen::VectorXd>(y.data(), Eigen::Index(n)));
+    const double s = eta.sum();
+    if (!(std::abs(s) > 0)) return false;
+    bias_ = nu.sum() / s;
+    alpha_ = nu - bias_ * eta;
+    return alpha_.allFinite() && std::isfinite(bias_);
+  }
+
+  double predict(const Eigen::Vector3d& p) const {
+    double f = bias_;
+    for (std::size_t i = 0; i < centres_.size(); ++i) {
+      const double d2 = (p - centres_[i]).squaredNorm() * inverseSupport_ * inverseSupport_;
+      if (d2 < 1) f += alpha_[Eigen::Index(i)] * wendland(std::sqrt(d2));
+    }
+    return f;
+  }
+
+ private:
+  static double wendland(double r) {
+    const double s = 1 - r;
+    const double s2 = s * s;
+    return s2 * s2 * (4 * r + 1);
+  }
+  double kernel(double d) const {
+    const double r = d * inverseSupport_;
+    return r < 1 ? wendland(r) : 0.0;
+  }
+  std::vector<Eigen::Vector3d> centres_;
+  Eigen::VectorXd alpha_;
+  double bias_ = 0, inverseSupport_ = 1;
+};
+
+Eigen::Vector3d toEigen(const Point3& p) {
+  return {p[0], p[1], p[2]};
+}
+
+// ---- The working surface ----------------------------------------------------------
+
+// Where a vertex added by a split lies on the input: the input face and the
+// barycentric coordinates in it.
+struct SplitOrigin {
+  int face = -1;
+  Point3 barycentric{0, 0, 0};
+};
+
+struct Surface {
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  std::size_t inputVertices = 0, inputFaces = 0;
+  std::unique_ptr<VertexFaces> adjacency;
+  std::unordered_map<std::uint64_t, int> borderOwner;  // directed border edge -> its face
+  std::unordered_map<int, SplitOrigin> splitOrigins;   // split vertex -> where it lies
+  std::vector<int> inputFaceOf;  // per face beyond the input: the input face it is part of, or -1
+  std::unordered_map<int, Triangle> inputCorners;  // input faces changed by splits: their corners
+  std::vector<int> patchFaces, splitFaces;         // faces added by patches / by splits
+  std::vector<Box> inputBoxes;
+  std::unique_ptr<BoxTree> inputTree;  // over the input faces' boxes (built on first use)
+
+  int inputFace(int f) const {
+    return std::size_t(f) < inputFaces ? f : inputFaceOf[std::size_t(f) - inputFaces];
+  }
+  Triangle originalCorners(int f0) const {
+    const auto it = inputCorners.find(f0);
+    return it == inputCorners.end() ? triangles[f0] : it->second;
+  }
+  Point3 barycentricIn(int v, int f0) const {
+    const Triangle t = originalCorners(f0);
+    for (int k = 0; k < 3; ++k)
+      if (t[k] == v) {
+        Point3 b(0, 0, 0);
+        b[k] = 1;
+        return b;
+      }
+    const auto it = splitOrigins.find(v);
+    if (it != splitOrigins.end() && it->second.face == f0) return it->second.barycentric;
+    return Point3(1.0 / 3, 1.0 / 3, 1.0 / 3);
+  }
+};
+
+// What to restore when a hole is given up.
+struct Checkpoint {
+  std::size_t points = 0, triangles = 0, splitFaces = 0;
+  std::vector<std::pair<int, Triangle>> changedFaces;   // in change order
+  std::vector<std::pair<std::uint64_t, int>> ownerLog;  // key, previous owner (-1: none)
+  std::vector<int> splitVertices;
+};
+
+void setOwner(Surface& s, Checkpoint& undo, std::uint64_t key, int face) {
+  const auto it = s.borderOwner.find(key);
+  undo.ownerLog.push_back({key, it == s.borderOwner.end() ? -1 : it->second});
+  if (face < 0)
+    s.borderOwner.erase(key);
+  else
+    s.borderOwner[key] = face;
+}
+
+void restore(Surface& s, Checkpoint& undo) {
+  for (auto it = undo.changedFaces.rbegin(); it != undo.changedFaces.rend(); ++it)
+    s.triangles[it->first] = it->second;
+  for (auto it = undo.ownerLog.rbegin(); it != undo.ownerLog.rend(); ++it) {
+    if (it->second < 0)
+      s.borderOwner.erase(it->first);
+    else
+      s.borderOwner[it->first] = it->second;
+  }
+  for (int v : undo.splitVertices) s.splitOrigins.erase(v);
+  s.points.resize(undo.points);
+  s.triangles.resize(undo.triangles);
+  s.inputFaceOf.resize(undo.triangles - s.inputFaces);
+  s.splitFaces.resize(undo.splitFaces);
+  s.adjacency->truncate(undo.points, undo.triangles);
+}
+
+// §3.1: halves the border edges longer than `factor` x the loop's mean edge
+// length (the mean taken again after each pass) together with the face each
+// borders, until none is. `loop` (mesh direction) gets the new vertices.
+std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Checkpoint& undo) {
+  if (factor <= 0) return 0;
+  std::size_t splits = 0;
+  for (int pass = 0; pass < 64; ++pass) {
+    double total = 0;
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      total += (s.points[loop[(i + 1) % loop.size()]] - s.points[loop[i]]).Norm();
+    const double limit = factor * total / double(loop.size());
+    std::vector<int> out;
+    bool any = false;
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const int a = loop[i], b = loop[(i + 1) % loop.size()];
+      out.push_back(a);
+      if (!((s.points[b] - s.points[a]).Norm() > limit)) continue;
+      const auto owner = s.borderOwner.find(directedKey(a, b));
+      if (owner == s.borderOwner.end()) continue;
+      const int f = owner->second;
+      Triangle t = s.triangles[f];
+      int k = 0;
+      while (k < 3 && !(t[k] == a && t[(k + 1) % 3] == b)) ++k;
+      if (k == 3) continue;
+      const int c = t[(k + 2) % 3];
+      const int m = int(s.points.size());
+      const int f0 = s.inputFace(f);
+      if (std::size_t(f) < s.inputFaces && !s.inputCorners.count(f)) s.inputCorners[f] = t;
+      s.points.push_back((s.points[a] + s.points[b]) / 2);
+      s.splitOrigins[m] = {f0, (s.barycentricIn(a, f0) + s.barycentricIn(b, f0)) / 2};
+      undo.splitVertices.push_back(m);
+      undo.changedFaces.push_back({f, t});
+      t[(k + 1) % 3] = m;  // f = (a, m, c)
+      s.triangles[f] = t;
+      const int g = int(s.triangles.size());
+      s.triangles.push_back({m, b, c});
+      s.inputFaceOf.push_back(f0);
+      s.splitFaces.push_back(g);
+      s.adjacency->add(m, f);
+      for (int v : {m, b, c}) s.adjacency->add(v, g);
+      setOwner(s, undo, directedKey(a, b), -1);
+      setOwner(s, undo, directedKey(a, m), f);
+      setOwner(s, undo, directedKey(m, b), g);
+      const auto bc = s.borderOwner.find(directedKey(b, c));
+      if (bc != s.borderOwner.end() && bc->second == f) setOwner(s, undo, directedKey(b, c), g);
+      out.push_back(m);
+      any = true;
+      ++splits;
+    }
+    loop = std::move(out);
+    if (!any) break;
+  }
+  return splits;
+}
+
+// ---- Exact check of a patch ----------------------------------------------------------
+
+// Counts the pairs of faces that intersect (the self-intersection rule,
+// vertex identity = index) between the patch and itself or the surface. The
+// patch's new vertices are numbered from s.points.size() on, at `added`.
+std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
+                               const std::vector<Point3>& added) {
+  const std::size_t base = s.points.size();
+  auto at = [&](int v) -> const Point3& {
+    return std::size_t(v) < base ? s.points[v] : added[std::size_t(v) - base];
+  };
+  auto pointsOf = [&](const Triangle& t) { return TrianglePoints{at(t[0]), at(t[1]), at(t[2])}; };
+  std::vector<Box> boxes;
+  boxes.reserve(patch.size());
+  Box bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  for (const Triangle& t : patch) {
+    if (collinear(at(t[0]), at(t[1]), at(t[2]))) return 1;  // a patch face must have an area
+    boxes.push_back(boxOf(at(t[0]), at(t[1]), at(t[2])));
+    for (int k = 0; k < 3; ++k) {
+      bounds.lo[k] = std::min(bounds.lo[k], boxes.back().lo[k]);
+      bounds.hi[k] = std::max(bounds.hi[k], boxes.back().hi[k]);
+    }
+  }
+  auto intersect = [&](const Triangle& a, const Triangle& b) {
+    const SharedCorners c = sharedCorners(a, b);
+    return intersectBeyondShared(pointsOf(a), pointsOf(b), c.count, c.ia, c.ib);
+  };
+  const BoxTree tree(boxes);
+  std::atomic<std::size_t> pairs{0};
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
+    if (intersect(patch[i], patch[j])) ++pairs;
+  });
+  if (!s.inputTree) {
+    s.inputBoxes.resize(s.inputFaces);
+    for (std::size_t f = 0; f < s.inputFaces; ++f) {
+      const Triangle t = s.originalCorners(int(f));
+      s.inputBoxes[f] = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
+    }
+    s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
+  }
+  // Input faces (their first boxes still hold the halves of split ones), then later faces.
+  auto against = [&](int face) {
+    const Triangle& t = s.triangles[face];
+    if (collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]])) return;
+    tree.query(boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]), 0,
+               [&](std::uint32_t i, unsigned) {
+                 if (intersect(patch[i], t)) ++pairs;
+               });
+  };
+  for (std::size_t i = 0; i < patch.size(); ++i)
+    s.inputTree->query(boxes[i], 0, [&](std::uint32_t f, unsigned) {
+      const Triangle& t = s.triangles[f];
+      if (collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]])) return;
+      if (intersect(patch[i], t)) ++pairs;
+    });
+  for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f) {
+    const Triangle& t = s.triangles[f];
+    if (overlap(boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]), bounds)) against(int(f));
+  }
+  return pairs;
+}
+
+// ---- One hole ----------------------------------------------------------------------
+
+struct PatchShape {
+  std::vector<Point3> positions;  // local: boundary (front order) then new vertices
+  HoleFairing fairing = HoleFairing::Flat;
+  double residual = 0;
+};
+
+class HoleFiller {
+ public:
+  HoleFiller(Surface& s, const HoleFillOptions& options, const std::unordered_set<int>& pinched)
+      : s_(s), options_(options), pinched_(pinched) {}
+
+  // Fills the hole bounded by `loop` (mesh direction, after splitting) in
+  // the working surface; false (with the reason) when it could not be.
+  bool fill(const std::vector<int>& loop, HoleReport& report) {
+    n_ = loop.size();
+    front_.assign(loop.rbegin(), loop.rend());
+    local_.clear();
+    for (std::size_t k = 0; k < n_; ++k) local_[front_[k]] = int(k);
+    std::vector<Point3> boundary;
+    meanEdge_ = 0;
+    Point3 faceNormals(0, 0, 0);
+    for (std::size_t k = 0; k < n_; ++k) {
+      boundary.push_back(s_.points[front_[k]]);
+      meanEdge_ += (s_.points[front_[(k + 1) % n_]] - s_.points[front_[k]]).Norm();
+      const auto owner = s_.borderOwner.find(directedKey(front_[(k + 1) % n_], front_[k]));
+      if (owner != s_.borderOwner.end())
+        faceNormals += faceNormal(s_.points, s_.triangles[owner->second]);
+    }
+    meanEdge_ /= double(n_);
+    if (!(meanEdge_ > 0)) {
+      report.reason = "the hole's border has zero length";
+      return false;
+    }
+
+    const Domain domain = domainOf(boundary, faceNormals);
+    report.planar_domain = domain.planar;
+    if (!triangulate(domain, report)) return false;
+
+    // Patch faces in mesh numbering; new vertices follow the surface's.
+    const std::size_t base = s_.points.size();
+    patchTriangles_.clear();
+    for (const Triangle& t : localTriangles_) {
+      Triangle g;
+      for (int k = 0; k < 3; ++k)
+        g[k] = std::size_t(t[k]) < n_ ? front_[t[k]] : int(base + std::size_t(t[k]) - n_);
+      patchTriangles_.push_back(g);
+    }
+
+    buildRows();
+    const std::vector<Point3> flat = flatPositions(domain);
+    std::vector<HoleFairing> modes;
+    for (HoleFairing m : {HoleFairing::LaplacianRegression, HoleFairing::Biharmonic,
+                          HoleFairing::Harmonic, HoleFairing::Flat})
+      if (int(m) <= int(options_.fairing)) modes.push_back(m);
+    std::string problems;
+    for (HoleFairing mode : modes) {
+      PatchShape shape;
+      shape.positions = flat;
+      shape.fairing = mode;
+      if (mode != HoleFairing::Flat && !fair(mode, shape, report)) {
+        problems += std::string(problems.empty() ? "" : "; ") + toString(mode) + ": solver failed";
+        continue;
+      }
+      if (options_.check_intersections) {
+        const std::vector<Point3> added(shape.positions.begin() + std::ptrdiff_t(n_),
+                                        shape.positions.end());
+        const std::size_t pairs = patchIntersections(s_, patchTriangles_, added);
+        if (pairs > 0) {
+          problems += std::string(problems.empty() ? "" : "; ") + toString(mode) +
+                      " patch would intersect the mesh (" + std::to_string(pairs) + " pairs)";
+          continue;
+        }
+      }
+      commit(shape, report);
+      if (mode != options_.fairing) report.reason = "fell back: " + problems;
+      return true;
+    }
+    report.reason = "no patch fits: " + problems;
+    return false;
+  }
+
+ private:
+  bool triangulate(const Domain& domain, HoleReport& report) {
+    std::vector<double> sizes(n_);
+    for (std::size_t k = 0; k < n_; ++k) {
+      const Vec2 here = domain.uv[k];
+      sizes[k] =
+          (norm(domain.uv[(k + 1) % n_] - here) + norm(domain.uv[(k + n_ - 1) % n_] - here)) / 2;
+    }
+    double meanDomainEdge = 0;
+    for (std::size_t k = 0; k < n_; ++k)
+      meanDomainEdge += norm(domain.uv[(k + 1) % n_] - domain.uv[k]);
+    meanDomainEdge /= double(n_);
+    // Mesh edges between boundary vertices (the border's own among them):
+    // the patch must not add any of them again.
+    std::vector<std::pair<int, int>> existing;
+    for (std::size_t k = 0; k < n_; ++k)
+      s_.adjacency->forEach(front_[k], [&](int f) {
+        for (int c : s_.triangles[f]) {
+          const auto it = local_.find(c);
+          if (it != local_.end() && it->second > int(k)) existing.push_back({int(k), it->second});
+        }
+      });
+    AdvancingFront::Settings settings;
+    settings.growth = options_.size_growth;
+    settings.maxSize = options_.max_size_factor * meanDomainEdge;
+    settings.merge = options_.merge_distance;
+    AdvancingFront front(domain.uv, sizes, existing, settings);
+    if (!front.run()) {
+      report.reason = "the advancing front could not cover the hole (its border is too tangled)";
+      return false;
+    }
+    uv_ = front.uv;
+    localTriangles_ = front.triangles;
+    height_.assign(uv_.size(), 0);
+    if (domain.planar) {
+      for (std::size_t k = 0; k < n_; ++k) height_[k] = domain.height[k];
+      for (std::size_t v = n_; v < uv_.size(); ++v) {
+        const auto [a, b] = front.parent[v - n_];
+        height_[v] = (height_[a] + height_[b]) / 2;
+      }
+    }
+    relaxInterior(uv_, height_, n_, localTriangles_, 3);
+    localAround_.assign(uv_.size(), {});
+    for (std::size_t t = 0; t < localTriangles_.size(); ++t)
+      for (int v : localTriangles_[t]) localAround_[v].push_back(int(t));
+    return true;
+  }
+
+  // Local index of a patch vertex, or -(global + 1) for a vertex outside the patch.
+  int keyOf(int global) const {
+    const auto it = local_.find(global);
+    return it == local_.end() ? -(global + 1) : it->second;
+  }
+
+  // Laplacian rows: every new vertex, and the boundary vertices whose faces
+  // form one fan (their outside part is fixed; the patch part is added per solve).
+  void buildRows() {
+    rowVertex_.clear();
+    outsideRows_.clear();
+    for (std::size_t v = n_; v < uv_.size(); ++v) rowVertex_.push_back(int(v));
+    for (std::size_t k = 0; k < n_; ++k) {
+      if (pinched_.count(front_[k])) continue;
+      LaplacianRow row;
+      s_.adjacency->forEach(front_[k], [&](int f) {
+        const Triangle& t = s_.triangles[f];
+        int corner = 0;
+        while (t[corner] != front_[k]) ++corner;
+        addTriangleToRow(row, {keyOf(t[0]), keyOf(t[1]), keyOf(t[2])},
+                         {s_.points[t[0]], s_.points[t[1]], s_.points[t[2]]}, corner);
+      });
+      if (row.weights.empty()) continue;
+      rowVertex_.push_back(int(k));
+      outsideRows_[int(k)] = row;
+    }
+  }
+
+  const Point3& fixedPosition(int key, const std::vector<Point3>& x) const {
+    return key >= 0 ? x[key] : s_.points[-key - 1];
+  }
+
+  // The row of local vertex v with the patch's triangles at positions x
+  // (or in the plane, `planar`).
+  LaplacianRow rowOf(int v, const std::vector<Point3>& x, bool planar) const {
+    LaplacianRow row;
+    const auto outside = outsideRows_.find(v);
+    if (outside != outsideRows_.end()) row = outside->second;
+    for (int t : localAround_[v]) {
+      const Triangle& tri = localTriangles_[t];
+      int corner = 0;
+      while (tri[corner] != v) ++corner;
+      std::array<Point3, 3> p;
+      for (int k = 0; k < 3; ++k)
+        p[k] = planar ? Point3(uv_[tri[k]].x, uv_[tri[k]].y, 0) : x[tri[k]];
+      addTriangleToRow(row, {tri[0], tri[1], tri[2]}, p, corner);
+    }
+    row.finish();
+    return row;
+  }
+
+  // Flat: the front's own placement (heights carried inward from the
+  // boundary) over the plane, or a uniform membrane over a disk domain.
+  std::vector<Point3> flatPositions(const Domain& domain) const {
+    std::vector<Point3> x(uv_.size());
+    for (std::size_t k = 0; k < n_; ++k) x[k] = s_.points[front_[k]];
+    if (domain.planar) {
+      for (std::size_t v = n_; v < uv_.size(); ++v)
+        x[v] = domain.origin + domain.U * uv_[v].x + domain.V * uv_[v].y + domain.N * height_[v];
+      return x;
+    }
+    const std::size_t unknowns = uv_.size() - n_;
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
+    for (std::size_t v = n_; v < uv_.size(); ++v) {
+      std::unordered_set<int> neighbours;
+      for (int t : localAround_[v])
+        for (int c : localTriangles_[t])
+          if (std::size_t(c) != v) neighbours.insert(c);
+      const Eigen::Index r = Eigen::Index(v - n_);
+      entries.push_back({int(r), int(r), double(neighbours.size())});
+      for (int c : neighbours) {
+        if (std::size_t(c) >= n_)
+          entries.push_back({int(r), int(std::size_t(c) - n_), -1.0});
+        else
+          for (int d = 0; d < 3; ++d) rhs(r, d) += x[c][d];
+      }
+    }
+    Eigen::SparseMatrix<double> M(static_cast<Eigen::Index>(unknowns),
+                                  static_cast<Eigen::Index>(unknowns));
+    M.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(M);
+    const Eigen::MatrixXd sol = solver.solve(rhs);
+    for (std::size_t v = n_; v < uv_.size(); ++v)
+      x[v] = Point3(sol(Eigen::Index(v - n_), 0), sol(Eigen::Index(v - n_), 1),
+                    sol(Eigen::Index(v - n_), 2));
+    return x;
+  }
+
+  // Normal (area weighted) and a third of the area of the faces around local vertex v.
+  std::pair<Point3, double> normalAndArea(int v, const std::vector<Point3>& x) const {
+    Point3 n(0, 0, 0);
+    for (int t : localAround_[v]) {
+      const Triangle& tri = localTriangles_[t];
+      n += (x[tri[1]] - x[tri[0]]) ^ (x[tri[2]] - x[tri[0]]);
+    }
+    if (std::size_t(v) < n_)
+      s_.adjacency->forEach(front_[v], [&](int f) { n += faceNormal(s_.points, s_.triangles[f]); });
+    const double twiceArea = n.Norm();  // faces around a vertex are nearly coplanar
+    double area = 0;
+    for (int t : localAround_[v]) {
+      const Triangle& tri = localTriangles_[t];
+      area += ((x[tri[1]] - x[tri[0]]) ^ (x[tri[2]] - x[tri[0]])).Norm() / 6;
+    }
+    if (std::size_t(v) < n_)
+      s_.adjacency->forEach(
+          front_[v], [&](int f) { area += faceNormal(s_.points, s_.triangles[f]).Norm() / 6; });
+    return {twiceArea > 0 ? n / twiceArea : n, area};
+  }
+
+  // Least squares over the rows: sum_r |(L x)_r - delta_r|^2 over the new
+  // vertices (unknowns), normal equations factorised once per weight set.
+  struct System {
+    Eigen::SparseMatrix<double> A;  // rows x unknowns (normalised Laplacian rows)
+    Eigen::MatrixXd fixedPart;      // rows x 3: the fixed vertices' contribution
+    std::vector<double> rowTotal;   // sum of omega per row
+    // Row r counts with weight sqrt(A_r) x (the cotangent Laplacian's
+    // 1 / (2 A_r) scale), so that the sum of squares discretises the
+    // integral of |Laplacian|^2 whatever the local triangle size.
+    Eigen::VectorXd rowWeight;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+    bool ok = false;
+  };
+
+  void assemble(System& sys, const std::vector<int>& rows, const std::vector<Point3>& x,
+                bool planarWeights) const {
+    const std::size_t unknowns = uv_.size() - n_;
+    std::vector<Eigen::Triplet<double>> entries;
+    sys.fixedPart = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), 3);
+    sys.rowTotal.assign(rows.size(), 0);
+    sys.rowWeight.resize(Eigen::Index(rows.size()));
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const int v = rows[r];
+      const LaplacianRow row = rowOf(v, x, planarWeights);
+      sys.rowTotal[r] = row.total;
+      const double weight = row.area > 0 ? row.total / (2 * std::sqrt(row.area)) : 1.0;
+      sys.rowWeight[Eigen::Index(r)] = weight;
+      auto put = [&](int key, double coefficient) {
+        coefficient *= weight;
+        if (key >= int(n_)) {
+          entries.push_back({int(r), key - int(n_), coefficient});
+        } else {
+          const Point3& p = fixedPosition(key, x);
+          for (int d = 0; d < 3; ++d) sys.fixedPart(Eigen::Index(r), d) += coefficient * p[d];
+        }
+      };
+      put(v, -1);
+      for (const auto& [key, w] : row.weights) put(key, w / row.total);
+    }
+    sys.A.resize(Eigen::Index(rows.size()), Eigen::Index(unknowns));
+    sys.A.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::SparseMatrix<double> normal =
+        Eigen::SparseMatrix<double>(sys.A.transpose()) * sys.A;
+    sys.solver.compute(normal);
+    sys.ok = sys.solver.info() == Eigen::Success;
+  }
+
+  // Solves for the new vertices given the target Laplacians delta (rows x 3);
+  // returns the RMS residual.
+  double solve(System& sys, const Eigen::MatrixXd& delta, std::vector<Point3>& x) const {
+    const Eigen::MatrixXd weighted = sys.rowWeight.asDiagonal() * delta;
+    const Eigen::MatrixXd rhs = Eigen::MatrixXd(sys.A.transpose() * (weighted - sys.fixedPart));
+    const Eigen::MatrixXd sol = sys.solver.solve(rhs);
+    if (sys.solver.info() != Eigen::Success || !sol.allFinite()) return -1;
+    for (std::size_t v = n_; v < uv_.size(); ++v)
+      for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
+    // Unweighted: the rows' own residuals (lengths).
+    const Eigen::MatrixXd residual = sys.rowWeight.cwiseInverse().asDiagonal() *
+                                     Eigen::MatrixXd(sys.A * sol + sys.fixedPart - weighted);
+    return std::sqrt(residual.squaredNorm() / double(std::max<Eigen::Index>(1, residual.rows())));
+  }
+
+  // Harmonic: L x = 0 over the new vertices (symmetric cotangent form).
+  bool harmonic(std::vector<Point3>& x, bool planarWeights, double& residual) const {
+    std::vector<int> rows(rowVertex_.begin(), rowVertex_.begin() + std::ptrdiff_t(uv_.size() - n_));
+    const std::size_t unknowns = rows.size();
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
+    for (std::size_t r = 0; r < unknowns; ++r) {
+      const LaplacianRow row = rowOf(rows[r], x, planarWeights);
+      entries.push_back({int(r), int(r), row.total});
+      for (const auto& [key, w] : row.weights) {
+        if (key >= int(n_))
+          entries.push_back({int(r), key - int(n_), -w});
+        else
+          for (int d = 0; d < 3; ++d) rhs(Eigen::Index(r), d) += w * fixedPosition(key, x)[d];
+      }
+    }
+    Eigen::SparseMatrix<double> M(static_cast<Eigen::Index>(unknowns),
+                                  static_cast<Eigen::Index>(unknowns));
+    M.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(M);
+    if (solver.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd sol = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !sol.allFinite()) return false;
+    for (std::size_t v = n_; v < uv_.size(); ++v)
+      for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
+    const Eigen::MatrixXd res = M * sol - rhs;
+    double scale = 0;
+    for (const auto& e : entries)
+      if (e.row() == e.col()) scale += e.value();
+    residual = std::sqrt(res.squaredNorm() / double(std::max<std::size_t>(1, unknowns))) /
+               std::max(1e-300, scale / double(std::max<std::size_t>(1, unknowns)));
+    return true;
+  }
+
+  // Mean curvature from the rings around the hole, learnt by LS-SVM (§3.3).
+  // The samples are H at each ring vertex, from its cotangent Laplacian:
+  // sum_j omega_ij (x_j - x_i) = -4 A_i H_i n_i (Meyer et al.).
+  bool learnCurvature(LsSvm& model, Eigen::Vector3d& centre, double& scale,
+                      HoleReport& report) const {
+    centre.setZero();
+    for (int g : front_) centre += toEigen(s_.points[g]);
+    centre /= double(n_);
+    scale = 0;
+    for (int g : front_) scale += (toEigen(s_.points[g]) - centre).squaredNorm();
+    scale = std::sqrt(scale / double(n_));
+    if (!(scale > 0)) return false;
+    std::unordered_set<int> seen(front_.begin(), front_.end());
+    std::vector<int> ring(front_.begin(), front_.end()), samples;
+    for (int level = 0; level < options_.regression_rings; ++level) {
+      std::vector<int> nextRing;
+      for (int v : ring)
+        s_.adjacency->forEach(v, [&](int f) {
+          for (int c : s_.triangles[f])
+            if (seen.insert(c).second) nextRing.push_back(c);
+        });
+      samples.insert(samples.end(), nextRing.begin(), nextRing.end());
+      ring = std::move(nextRing);
+    }
+    std::vector<Eigen::Vector3d> xs;
+    std::vector<double> ys;
+    const std::size_t stride = std::max<std::size_t>(
+        1, (samples.size() + std::size_t(options_.regression_max_samples) - 1) /
+               std::size_t(options_.regression_max_samples));
+    for (std::size_t i = 0; i < samples.size(); i += stride) {
+      const int v = samples[i];
+      // Only vertices inside the surface (a closed fan: each neighbour on two faces).
+      std::unordered_map<int, int> count;
+      LaplacianRow row;
+      Point3 n(0, 0, 0);
+      double area = 0;
+      s_.adjacency->forEach(v, [&](int f) {
+        const Triangle& t = s_.triangles[f];
+        int corner = 0;
+        while (t[corner] != v) ++corner;
+        for (int c : t)
+          if (c != v) ++count[c];
+        addTriangleToRow(row, {t[0], t[1], t[2]},
+                         {s_.points[t[0]], s_.points[t[1]], s_.points[t[2]]}, corner);
+        const Point3 fn = faceNormal(s_.points, t);
+        n += fn;
+        area += fn.Norm() / 6;
+      });
+      bool closedFan = !count.empty();
+      for (const auto& [c, k] : count) closedFan = closedFan && k == 2;
+      if (!closedFan || !(area > 0) || !(n.Norm() > 0)) continue;
+      row.finish();
+      Point3 sum(0, 0, 0);
+      for (const auto& [c, w] : row.weights) sum += (s_.points[c] - s_.points[v]) * w;
+      n.Normalize();
+      const double H = -(sum * n) / (4 * area);
+      if (!std::isfinite(H)) continue;
+      xs.push_back((toEigen(s_.points[v]) - centre) / scale);
+      ys.push_back(H * scale);
+    }
+    report.training_samples = xs.size();
+    return model.fit(xs, ys, 2.5, options_.regression_gamma);
+  }
+
+  bool fair(HoleFairing mode, PatchShape& shape, HoleReport& report) {
+    std::vector<Point3>& x = shape.positions;
+    if (uv_.size() == n_) return true;  // nothing to place
+    if (mode == HoleFairing::Harmonic) {
+      double residual = 0;
+      if (!harmonic(x, true, residual)) return false;
+      // Weights from the membrane's own shape, then solved again.
+      if (!harmonic(x, false, residual)) return false;
+      shape.residual = residual;
+      return true;
+    }
+    System sys;
+    assemble(sys, rowVertex_, x, true);
+    if (!sys.ok) return false;
+    Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(Eigen::Index(rowVertex_.size()), 3);
+    if (solve(sys, zero, x) < 0) return false;
+    assemble(sys, rowVertex_, x, false);
+    if (!sys.ok) return false;
+    double residual = solve(sys, zero, x);
+    if (residual < 0) return false;
+    if (mode == HoleFairing::LaplacianRegression) {
+      LsSvm model;
+      Eigen::Vector3d centre;
+      double scale = 1;
+      if (learnCurvature(model, centre, scale, report)) {
+        std::vector<double> curvature(rowVertex_.size());
+        for (std::size_t r = 0; r < rowVertex_.size(); ++r)
+          curvature[r] = model.predict((toEigen(x[rowVertex_[r]]) - centre) / scale) / scale;
+        Eigen::MatrixXd delta(Eigen::Index(rowVertex_.size()), 3);
+        for (int iteration = 0; iteration < 3; ++iteration) {
+          for (std::size_t r = 0; r < rowVertex_.size(); ++r) {
+            const auto [n, area] = normalAndArea(rowVertex_[r], x);
+            const Point3 d = n * (-4 * area * curvature[r] / sys.rowTotal[r]);
+            for (int k = 0; k < 3; ++k) delta(Eigen::Index(r), k) = d[k];
+          }
+          std::vector<Point3> trial = x;
+          const double res = solve(sys, delta, trial);
+          if (res < 0) break;
+          x = std::move(trial);
+          residual = res;
+        }
+      } else {
+        report.reason = "too few vertices around the hole to learn from; biharmonic shape";
+      }
+    }
+    shape.residual = residual / meanEdge_;
+    return true;
+  }
+
+  void commit(const PatchShape& shape, HoleReport& report) {
+    for (std::size_t v = n_; v < shape.positions.size(); ++v)
+      s_.points.push_back(shape.positions[v]);
+    for (const Triangle& t : patchTriangles_) {
+      const int f = int(s_.triangles.size());
+      s_.triangles.push_back(t);
+      s_.inputFaceOf.push_back(-1);
+      s_.patchFaces.push_back(f);
+      for (int v : t) s_.adjacency->add(v, f);
+    }
+    for (std::size_t k = 0; k < n_; ++k)
+      s_.borderOwner.erase(directedKey(front_[(k + 1) % n_], front_[k]));
+    report.faces_added = patchTriangles_.size();
+    report.vertices_added += shape.positions.size() - n_;
+    report.fairing = shape.fairing;
+    report.fairing_residual = shape.residual;
+  }
+
+  Surface& s_;
+  const HoleFillOptions& options_;
+  const std::unordered_set<int>& pinched_;
+  std::size_t n_ = 0;
+  double meanEdge_ = 0;
+  std::vector<int> front_;                     // boundary vertices (mesh indices), front order
+  std::unordered_map<int, int> local_;         // boundary vertex -> local index
+  std::vector<Vec2> uv_;                       // patch vertices in the domain
+  std::vector<double> height_;                 // over the plane (planar domains)
+  std::vector<Triangle> localTriangles_;       // patch faces, local indices
+  std::vector<Triangle> patchTriangles_;       // the same in mesh numbering
+  std::vector<std::vector<int>> localAround_;  // patch faces around each local vertex
+  std::vector<int> rowVertex_;                 // Laplacian rows: new vertices, then boundary ones
+  std::unordered_map<int, LaplacianRow> outsideRows_;  // boundary rows' mesh part
+};
+
+void validate(const Mesh& mesh, const HoleFillOptions& o) {
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+  if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
+    throw InvalidInputError(
+        "the mesh has deleted vertices or faces; compact it first (MeshLab does when saving, or "
+        "run \"Remove Unreferenced Vertices\")");
+  auto bad = [](const std::string& what) { throw InvalidInputError("fill holes: " + what); };
+  if (!(o.max_diameter >= 0)) bad("max_diameter must be 0 (no limit) or positive");
+  if (!(o.long_edge_factor == 0 || o.long_edge_factor > 1))
+    bad("long_edge_factor must be 0 (off) or greater than 1");
+  if (!(o.size_growth >= 1 && o.size_growth <= 4)) bad("size_growth must be between 1 and 4");
+  if (!(o.max_size_factor >= 1)) bad("max_size_factor must be at least 1");
+  if (!(o.merge_distance > 0 && o.merge_distance < 1)) bad("merge_distance must be in (0, 1)");
+  if (o.regression_rings < 1) bad("regression_rings must be at least 1");
+  if (!(o.regression_gamma > 0)) bad("regression_gamma must be positive");
+  if (o.regression_max_samples < 8) bad("regression_max_samples must be at least 8");
+  if (!o.selected_vertices.empty() && o.selected_vertices.size() != mesh.vert.size())
+    bad("selected_vertices has " + std::to_string(o.selected_vertices.size()) +
+        " flags but the mesh has " + std::to_string(mesh.vert.size()) + " vertices");
+  for (int v : o.selected_vertex_indices)
+    if (v < 0 || std::size_t(v) >= mesh.vert.size())
+      bad("selected vertex " + std::to_string(v) + " is not a vertex of the mesh");
+}
+
+// Exact count of the intersecting pairs that involve one of `faces`.
+std::size_t countPairsInvolving(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                                const std::vector<int>& faces) {
+  if (faces.empty()) return 0;
+  std::vector<Box> boxes;
+  std::vector<char> mine(T.size(), 0);
+  for (int f : faces) {
+    boxes.push_back(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]));
+    mine[f] = 1;
+  }
+  const BoxTree tree(boxes);
+  std::atomic<std::size_t> pairs{0};
+  auto pointsOf = [&](const Triangle& t) { return TrianglePoints{P[t[0]], P[t[1]], P[t[2]]}; };
+  auto degenerate = [&](const Triangle& t) { return collinear(P[t[0]], P[t[1]], P[t[2]]); };
+  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t g = begin; g < end; ++g) {
+      const Triangle& tg = T[g];
+      if (degenerate(tg)) continue;
+      tree.query(boxOf(P[tg[0]], P[tg[1]], P[tg[2]]), worker, [&](std::uint32_t i, unsigned) {
+        const int f = faces[i];
+        if (std::size_t(f) == g || (mine[g] && std::size_t(f) > g) || degenerate(T[f])) return;
+        const SharedCorners c = sharedCorners(T[f], tg);
+        if (intersectBeyondShared(pointsOf(T[f]), pointsOf(tg), c.count, c.ia, c.ib)) ++pairs;
+      });
+    }
+  });
+  return pairs;
+}
+
+}  // namespace
+
+HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
+  const auto start = Clock::now();
+  validate(mesh, options);
+  HoleFillResult result;
+  reportProgress(options.progress, 0, "Finding holes");
+
+  Surface s;
+  s.points = positionsOf(mesh);
+  s.triangles = trianglesOf(mesh);
+  s.inputVertices = s.points.size();
+  s.inputFaces = s.triangles.size();
+  s.adjacency = std::make_unique<VertexFaces>(s.triangles, s.points.size());
+  const BorderLoops found = findBorderLoops(s.points, s.triangles, *s.adjacency);
+  result.holes_found = found.loops.size();
+  if (found.loops.empty()) {
+    reportProgress(options.progress, 100, "Done");
+    result.verified = options.verify;
+    result.time_ms = msSince(start);
+    return result;
+  }
+  for (const BorderLoop& loop : found.loops) {
+    const std::size_t count = loop.vertices.size();
+    const std::size_t edges = loop.closed ? count : count - 1;
+    for (std::size_t i = 0; i < edges; ++i) {
+      const int a = loop.vertices[i], b = loop.vertices[(i + 1) % count];
+      s.adjacency->forEach(a, [&](int f) {
+        const Triangle& t = s.triangles[f];
+        for (int k = 0; k < 3; ++k)
+          if (t[k] == a && t[(k + 1) % 3] == b) s.borderOwner[directedKey(a, b)] = f;
+      });
+    }
+  }
+
+  // Which holes to fill.
+  Point3 lo = s.points[0], hi = s.points[0];
+  for (const Point3& p : s.points)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const double diagonal = (hi - lo).Norm();
+  std::vector<char> selected(s.points.size(), 0);
+  const bool bySelection =
+      !options.selected_vertices.empty() || !options.selected_vertex_indices.empty();
+  for (std::size_t v = 0; v < options.selected_vertices.size(); ++v)
+    if (options.selected_vertices[v]) selected[v] = 1;
+  for (int v : options.selected_vertex_indices) selected[v] = 1;
+
+  std::vector<std::vector<int>> loops;
+  std::vector<std::size_t> toFill;
+  for (const BorderLoop& loop : found.loops) {
+    HoleReport report;
+    report.boundary = loop.vertices;
+    report.boundary_edges = loop.closed ? loop.vertices.size() : loop.vertices.size() - 1;
+    report.diameter = loopDiameter(s.points, loop.vertices);
+    const std::size_t index = result.holes.size();
+    if (!loop.closed)
+      report.reason = "its border is not a closed loop: at vertex " +
+                      std::to_string(loop.brokenAt) +
+                      " the faces are non-manifold or inconsistently oriented (repair them first)";
+    else if (loop.vertices.size() < 3)
+      report.reason = "a border of two edges (a slit between two faces): weld or stitch it instead";
+    else if (options.max_boundary_edges > 0 && report.boundary_edges > options.max_boundary_edges)
+      report.reason = "larger than the limit: " + std::to_string(report.boundary_edges) + " > " +
+                      std::to_string(options.max_boundary_edges) + " boundary edges";
+    else if (options.max_diameter > 0 && report.diameter > options.max_diameter * diagonal)
+      report.reason = "wider than the limit: diameter " +
+                      std::to_string(report.diameter / diagonal) + " > " +
+                      std::to_string(options.max_diameter) + " of the bounding box diagonal";
+    else if (bySelection && std::none_of(loop.vertices.begin(), loop.vertices.end(),
+                                         [&](int v) { return selected[v]; }))
+      report.reason = "not selected (no selected vertex on its border)";
+    else
+      toFill.push_back(index);
+    result.holes.push_back(std::move(report));
+    loops.push_back(loop.vertices);
+  }
+
+  HoleFiller filler(s, options, found.pinched);
+  for (std::size_t i = 0; i < toFill.size(); ++i) {
+    reportProgress(options.progress, int(5 + 85 * i / toFill.size()), "Filling holes");
+    const auto holeStart = Clock::now();
+    HoleReport& report = result.holes[toFill[i]];
+    std::vector<int> loop = loops[toFill[i]];
+    Checkpoint undo;
+    undo.points = s.points.size();
+    undo.triangles = s.triangles.size();
+    undo.splitFaces = s.splitFaces.size();
+    report.edges_split = splitLongEdges(s, loop, options.long_edge_factor, undo);
+    report.vertices_added = report.edges_split;
+    if (filler.fill(loop, report)) {
+      report.filled = true;
+      if (report.fairing != options.fairing) ++result.fallbacks;
+    } else {
+      restore(s, undo);
+      report.edges_split = 0;
+      report.vertices_added = 0;
+      report.faces_added = 0;
+    }
+    report.time_ms = msSince(holeStart);
+  }
+
+  for (const HoleReport& r : result.holes) {
+    if (r.filled) {
+      ++result.holes_filled;
+      result.faces_added += r.faces_added;
+      result.vertices_added += r.vertices_added;
+      result.edges_split += r.edges_split;
+    } else {
+      ++result.holes_skipped;
+    }
+  }
+  if (options.verify) {
+    reportProgress(options.progress, 92, "Verifying");
+    std::vector<int> changed = s.patchFaces;
+    changed.insert(changed.end(), s.splitFaces.begin(), s.splitFaces.end());
+    for (const auto& [f, corners] : s.inputCorners) changed.push_back(f);
+    result.remaining_intersecting_pairs = countPairsInvolving(s.points, s.triangles, changed);
+    result.verified = true;
+  }
+
+  // Write back: split faces change corners, new vertices and faces are appended.
+  reportProgress(options.progress, 97, "Writing");
+  if (s.points.size() > s.inputVertices || s.triangles.size() > s.inputFaces) {
+    VertexOriginHandle vo = vertexOrigins(mesh);
+    FaceOriginHandle fo = faceOrigins(mesh);
+    const int layer = mesh.vert.empty() ? 0 : std::max(0, vo[0].layer);
+    std::vector<FaceOrigin> inputOrigins(s.inputFaces);
+    for (std::size_t f = 0; f < s.inputFaces; ++f) inputOrigins[f] = fo[f];
+    const std::size_t newVertices = s.points.size() - s.inputVertices;
+    const std::size_t newFaces = s.triangles.size() - s.inputFaces;
+    if (newVertices > 0) {
+      auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
+      for (std::size_t v = s.inputVertices; v < s.points.size(); ++v, ++vi) {
+        vi->P() = s.points[v];
+        const auto split = s.splitOrigins.find(int(v));
+        if (split != s.splitOrigins.end()) {
+          const FaceOrigin& of = inputOrigins[split->second.face];
+          vo[v] = VertexOrigin{of.layer, -1, of.face, split->second.barycentric};
+        } else {
+          vo[v] = VertexOrigin{layer, -1, -1, {0, 0, 0}};
+        }
+        result.new_vertices.push_back(int(v));
+      }
+    }
+    for (const auto& [f, corners] : s.inputCorners)
+      for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
+    if (newFaces > 0) {
+      auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, newFaces);
+      for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f, ++fi) {
+        for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[s.triangles[f][k]];
+        const int from = s.inputFaceOf[f - s.inputFaces];
+        fo[f] = from >= 0 ? inputOrigins[from] : FaceOrigin{layer, -1};
+      }
+    }
+    result.new_faces = s.patchFaces;
+  }
+  reportProgress(options.progress, 100, "Done");
+  result.time_ms = msSince(start);
+  return result;
+}
+
+JsonObject toJson(const HoleFillResult& r) {
+  std::vector<JsonObject> skipped, holes;
+  for (std::size_t i = 0; i < r.holes.size(); ++i) {
+    const HoleReport& h = r.holes[i];
+    JsonObject j;
+    j.set("hole", i)
+        .set("boundary_edges", h.boundary_edges)
+        .set("diameter", h.diameter)
+        .set("filled", h.filled);
+    if (h.filled)
+      j.set("edges_split", h.edges_split)
+          .set("faces_added", h.faces_added)
+          .set("vertices_added", h.vertices_added)
+          .set("fairing", toString(h.fairing))
+          .set("planar_domain", h.planar_domain)
+          .set("fairing_residual", h.fairing_residual)
+          .set("training_samples", h.training_samples);
+    if (!h.reason.empty()) j.set("reason", h.reason);
+    j.set("time_ms", h.time_ms);
+    holes.push_back(j);
+    if (!h.filled)
+      skipped.push_back(JsonObject()
+                            .set("hole", i)
+                            .set("boundary_edges", h.boundary_edges)
+                            .set("reason", h.reason));
+  }
+  JsonObject j;
+  j.set("holes_found", r.holes_found)
+      .set("holes_filled", r.holes_filled)
+      .set("holes_skipped", r.holes_skipped)
+      .set("skipped", skipped)
+      .set("faces_added", r.faces_added)
+      .set("vertices_added", r.vertices_added)
+      .set("edges_split", r.edges_split)
+      .set("fallbacks", r.fallbacks);
+  if (r.verified)
+    j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
+  else
+    j.setNull("remaining_intersecting_pairs");
+  j.set("time_ms", r.time_ms).set("holes", holes);
+  return j;
+}
+
+}  // namespace meshmend

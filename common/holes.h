@@ -1,0 +1,135 @@
+// Feature-preserving hole filling (Xu, Li, Tan: "Feature Based Hole Filling
+// Algorithm on Triangular Mesh", papers/004): border loops are found and their
+// long edges split (§3.1), each hole is covered by an advancing-front patch
+// whose triangles grade from the boundary edge lengths (§3.2), and the patch
+// vertices are placed by a Poisson solve whose right-hand side is the
+// Laplacian predicted by least-squares SVM regression from the rings of
+// vertices around the hole (§2.2, §3.3, §3.4). Simpler shapes (flat,
+// harmonic, biharmonic) are options. Every patch is checked exactly against
+// itself and the mesh around it; a patch that would intersect falls back to a
+// flatter shape, and is left out (the hole reported skipped) when none fits.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "common/json.h"
+#include "common/mesh.h"
+#include "common/progress.h"
+
+namespace meshmend {
+
+// How the patch vertices are placed once the patch is triangulated.
+enum class HoleFairing {
+  Flat,        // no fairing: where the advancing front put them (a height field over the
+               // hole's plane; a uniform membrane when the hole has no plane it projects to)
+  Harmonic,    // membrane: cotangent Laplacian L x = 0, boundary fixed
+  Biharmonic,  // minimal curvature: L^2 x = 0 with the boundary and the ring of vertices
+               // around it fixed (tangent continuity with the surface)
+  LaplacianRegression,  // the paper's: Laplacians predicted from the rings around the hole by
+                        // LS-SVM regression, then L x = delta with the boundary fixed
+};
+
+const char* toString(HoleFairing fairing);
+
+struct HoleFillOptions {
+  // ---- Which holes. A hole is filled when it passes every limit that is set.
+  std::size_t max_boundary_edges = 0;  // holes with more boundary edges are skipped; 0 = no limit
+  // Holes whose diameter (largest distance between two boundary vertices)
+  // exceeds this fraction of the mesh's bounding box diagonal are skipped; 0 = no limit.
+  double max_diameter = 0;
+  // When not empty (one flag per vertex): only holes with a selected boundary vertex are filled.
+  std::vector<bool> selected_vertices;
+  // The same selection as vertex indices (either form, or both, may be given).
+  std::vector<int> selected_vertex_indices;
+
+  // ---- Pre-treatment (§3.1): boundary edges longer than long_edge_factor x
+  // the hole's mean boundary edge length are halved (with the face they
+  // border) until none is; 0 turns it off.
+  double long_edge_factor = 1.5;
+
+  // ---- Patch (§3.2). Patch triangles start at the size of the boundary edges
+  // around them; each front layer may grow by size_growth (1 = uniform), up to
+  // max_size_factor x the mean boundary edge length. Growth keeps large holes
+  // cheap (a round hole of n boundary edges needs ~n^2/12 uniform triangles).
+  double size_growth = 1.1;
+  double max_size_factor = 3;
+  // A new front vertex closer than merge_distance x its target size to
+  // another front vertex is merged into it (step 4 of §3.2).
+  double merge_distance = 0.6;
+
+  // ---- Shape.
+  HoleFairing fairing = HoleFairing::LaplacianRegression;
+  // Rings of surface vertices around the hole whose Laplacians train the regression (§3.3).
+  int regression_rings = 3;
+  // LS-SVM regularisation gamma (Eq. 11): larger follows the samples more
+  // closely, smaller smooths the predicted curvature more.
+  double regression_gamma = 10;
+  // At most this many training samples (evenly picked): the LS-SVM system is dense.
+  int regression_max_samples = 250;
+
+  // ---- Checks. Exact test of every patch against itself and the surface
+  // around it; a patch that intersects is replaced by a flatter one
+  // (LaplacianRegression -> Biharmonic -> Harmonic -> Flat), or left out.
+  bool check_intersections = true;
+  // Count, exactly, the intersecting pairs that involve new or split faces
+  // in the result (remaining_intersecting_pairs).
+  bool verify = true;
+  Progress progress;  // called once per hole
+};
+
+// What happened to one border loop.
+struct HoleReport {
+  std::vector<int> boundary;       // its vertices in order (before splitting), mesh indices
+  std::size_t boundary_edges = 0;  // as found
+  double diameter = 0;             // largest distance between two boundary vertices
+  std::size_t edges_split = 0;     // long boundary edges split (§3.1)
+  std::size_t faces_added = 0;     // patch faces (split faces not counted)
+  std::size_t vertices_added = 0;  // patch and split vertices
+  bool filled = false;             //
+  std::string reason;              // why it was skipped, or why the shape fell back
+  HoleFairing fairing = HoleFairing::Flat;  // the shape the patch got (after fallbacks)
+  bool planar_domain = true;                // triangulated over its plane (false: over a disk)
+  // RMS residual of the fairing system, in units of the mean boundary edge
+  // length (0 for Flat): how far the solution is from the target Laplacians.
+  double fairing_residual = 0;
+  std::size_t training_samples = 0;  // LS-SVM samples (LaplacianRegression)
+  double time_ms = 0;
+};
+
+struct HoleFillResult {
+  std::size_t holes_found = 0;  // border loops (a loop through a non-manifold vertex counts
+                                // once per part it is split into)
+  std::size_t holes_filled = 0;
+  std::size_t holes_skipped = 0;  // not selected, too large, or not fillable: see holes[i].reason
+  std::size_t faces_added = 0;    // patch faces
+  std::size_t vertices_added = 0;
+  std::size_t edges_split = 0;  // boundary edges split by the pre-treatment
+  std::size_t fallbacks = 0;    // holes whose patch took a flatter shape than asked
+  bool verified = false;        // remaining_intersecting_pairs was counted
+  // Intersecting pairs (exact, the self-intersection rule) that involve a
+  // new or split face: 0 unless verification found a problem.
+  std::size_t remaining_intersecting_pairs = 0;
+  double time_ms = 0;
+  std::vector<HoleReport> holes;  // one per border loop, in the order found
+  std::vector<int> new_faces;     // indices of the patch faces in the filled mesh
+  std::vector<int> new_vertices;  // indices of the vertices added (patch and split)
+};
+
+// Fills the holes of `mesh` in place. New vertices and faces are appended
+// (existing indices stay; a face split by the pre-treatment keeps its index
+// for one half); provenance: split vertices lie on the face they split,
+// patch faces and vertices have no origin face.
+// Throws InvalidInputError for an empty mesh, a non-finite coordinate,
+// deleted elements or a bad option; the mesh is unchanged when it throws
+// (CancelledError included). A mesh without holes is returned unchanged with
+// holes_found = 0.
+HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options = {});
+
+// The report_file keys: holes_found, holes_filled, holes_skipped, skipped
+// (hole, boundary_edges, reason), faces_added, vertices_added, edges_split,
+// remaining_intersecting_pairs, time_ms, holes (per hole).
+JsonObject toJson(const HoleFillResult& result);
+
+}  // namespace meshmend
