@@ -524,10 +524,13 @@ class AdvancingFront {
     mean /= double(n);
     minSize_ = std::max(*std::min_element(size.begin(), size.end()), 1e-3 * mean);
     const double area = std::abs(signedArea(uv));
-    // Cells about one boundary edge long, at most a few per expected triangle.
-    const std::size_t expected = std::size_t(area / (0.43 * mean * mean)) + n;
-    points_ = std::make_unique<Grid>(lo, hi, mean, 2 * expected + 16);
-    edgeGrid_ = std::make_unique<Grid>(lo, hi, mean, 2 * expected + 16);
+    // Cells between the boundary edges' size and the largest triangles'
+    // (geometric mean): few elements per cell near the border, few cells per
+    // element inside.
+    const double cell = std::sqrt(mean * std::min(settings.maxSize, 16 * mean));
+    const std::size_t expected = std::size_t(area / (0.43 * cell * cell)) + n;
+    points_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
+    edgeGrid_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
     budget_ = 8 * (std::size_t(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000;
     for (const auto& [a, b] : existingEdges) edges_.insert(edgeKey(a, b));
     for (std::size_t i = 0; i < n; ++i)
@@ -678,7 +681,7 @@ class AdvancingFront {
     triangles.push_back({a, b, c});
     edges_.insert(edgeKey(b, c));
     edges_.insert(edgeKey(c, a));
-    std::vector<int> touched;
+    std::array<int, 5> touched{-1, -1, -1, -1, -1};
     int result = nc;
     if (nc < 0) {  // a -> c -> b
       const int nw = newNode(c);
@@ -688,7 +691,7 @@ class AdvancingFront {
       nodes_[nb].prev = nw;
       recordEdge(na);
       recordEdge(nw);
-      touched = {na, nw, nb};
+      touched = {na, nw, nb, -1, -1};
       result = nw;
     } else if (closesNext && closesPrev) {  // the last triangle of a loop
       kill(na);
@@ -700,13 +703,13 @@ class AdvancingFront {
       nodes_[na].next = nc;
       nodes_[nc].prev = na;
       recordEdge(na);
-      touched = {na, nc};
+      touched = {na, nc, -1, -1, -1};
     } else if (closesPrev) {  // c -> b
       kill(na);
       nodes_[nc].next = nb;
       nodes_[nb].prev = nc;
       recordEdge(nc);
-      touched = {nc, nb};
+      touched = {nc, nb, -1, -1, -1};
     } else {  // the front splits: a -> c' -> (after c) ...  and  c -> b -> ...
       const int copy = newNode(c);
       const int after = nodes_[nc].next;
@@ -723,12 +726,12 @@ class AdvancingFront {
     }
     // A loop of two edges encloses nothing: both sides are covered.
     for (int n : touched)
-      if (nodes_[n].alive && nodes_[nodes_[n].next].next == n) {
+      if (n >= 0 && nodes_[n].alive && nodes_[nodes_[n].next].next == n) {
         kill(nodes_[n].next);
         kill(n);
       }
     for (int n : touched)
-      if (nodes_[n].alive) push(n);
+      if (n >= 0 && nodes_[n].alive) push(n);
     return result;
   }
 
@@ -1027,14 +1030,28 @@ struct LaplacianRow {
   }
 };
 
-// Adds triangle (keys k[0..2], positions p[0..2]) to the row of corner `corner`.
+// Cotangents at the corners of a triangle, and a third of its area.
+struct TriangleWeights {
+  std::array<double, 3> cot;
+  double thirdArea;
+};
+
+TriangleWeights triangleWeights(const Point3& a, const Point3& b, const Point3& c) {
+  return {cotangents(a, b, c), ((b - a) ^ (c - a)).Norm() / 6};
+}
+
+// Adds a triangle (keys k[0..2]) to the row of its corner `corner`.
+void addTriangleToRow(LaplacianRow& row, const std::array<int, 3>& k, const TriangleWeights& w,
+                      int corner) {
+  const int j = (corner + 1) % 3, l = (corner + 2) % 3;
+  row.add(k[j], w.cot[l]);
+  row.add(k[l], w.cot[j]);
+  row.area += w.thirdArea;
+}
+
 void addTriangleToRow(LaplacianRow& row, const std::array<int, 3>& k,
                       const std::array<Point3, 3>& p, int corner) {
-  const std::array<double, 3> c = cotangents(p[0], p[1], p[2]);
-  const int j = (corner + 1) % 3, l = (corner + 2) % 3;
-  row.add(k[j], c[l]);
-  row.add(k[l], c[j]);
-  row.area += ((p[1] - p[0]) ^ (p[2] - p[0])).Norm() / 6;
+  addTriangleToRow(row, k, triangleWeights(p[0], p[1], p[2]), corner);
 }
 
 // ---- LS-SVM regression (§2.2) ----------------------------------------------------
@@ -1230,21 +1247,64 @@ std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Ch
 
 // ---- Exact check of a patch ----------------------------------------------------------
 
+// The self-intersection rule for two faces of one mesh (vertex identity =
+// index; see triangle_intersection.h), with cheap exact plane-side tests
+// first: they settle almost every pair of neighbours.
+bool facesIntersect(const Triangle& a, const TrianglePoints& pa, const Triangle& b,
+                    const TrianglePoints& pb) {
+  const SharedCorners c = sharedCorners(a, b);
+  auto side = [](const TrianglePoints& t, const Point3& p) {
+    return orient3d(t[0], t[1], t[2], p);
+  };
+  auto beside = [&](const TrianglePoints& t, const TrianglePoints& u) {
+    const int s0 = side(t, u[0]);
+    return s0 != 0 && side(t, u[1]) == s0 && side(t, u[2]) == s0;
+  };
+  auto edgeMayMeet = [&](const TrianglePoints& t, int corner, const TrianglePoints& u) {
+    return side(u, t[(corner + 1) % 3]) * side(u, t[(corner + 2) % 3]) <= 0;
+  };
+  switch (c.count) {
+    case 0:
+      if (beside(pa, pb) || beside(pb, pa)) return false;
+      break;
+    case 1:  // the edge opposite the shared corner, in either face, must meet the other
+      if (!edgeMayMeet(pa, c.ia, pb) && !edgeMayMeet(pb, c.ib, pa)) return false;
+      break;
+    case 2:  // only coplanar faces folded onto each other meet beyond their edge
+      if (side(pa, pb[c.ib]) != 0) return false;
+      break;
+    default:
+      return true;
+  }
+  return intersectBeyondShared(pa, pb, c.count, c.ia, c.ib);
+}
+
 // Counts the pairs of faces that intersect (the self-intersection rule,
-// vertex identity = index) between the patch and itself or the surface. The
-// patch's new vertices are numbered from s.points.size() on, at `added`.
+// vertex identity = index) that involve the patch or `own` (the faces the
+// hole's pre-treatment split, already in the surface), among themselves or
+// with the rest of the surface. The patch's new vertices are numbered from
+// s.points.size() on, at `added`. A patch face without area counts as a pair.
 std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
-                               const std::vector<Point3>& added) {
+                               const std::vector<Point3>& added, const std::vector<int>& own) {
   const std::size_t base = s.points.size();
   auto at = [&](int v) -> const Point3& {
     return std::size_t(v) < base ? s.points[v] : added[std::size_t(v) - base];
   };
   auto pointsOf = [&](const Triangle& t) { return TrianglePoints{at(t[0]), at(t[1]), at(t[2])}; };
-  std::vector<Box> boxes;
-  boxes.reserve(patch.size());
-  Box bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  auto degenerate = [&](const Triangle& t) { return collinear(at(t[0]), at(t[1]), at(t[2])); };
+  std::vector<Triangle> checked;
+  checked.reserve(patch.size() + own.size());
   for (const Triangle& t : patch) {
-    if (collinear(at(t[0]), at(t[1]), at(t[2]))) return 1;  // a patch face must have an area
+    if (degenerate(t)) return 1;
+    checked.push_back(t);
+  }
+  std::unordered_set<int> ownSet;
+  for (int f : own)
+    if (ownSet.insert(f).second && !degenerate(s.triangles[f])) checked.push_back(s.triangles[f]);
+  std::vector<Box> boxes;
+  boxes.reserve(checked.size());
+  Box bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  for (const Triangle& t : checked) {
     boxes.push_back(boxOf(at(t[0]), at(t[1]), at(t[2])));
     for (int k = 0; k < 3; ++k) {
       bounds.lo[k] = std::min(bounds.lo[k], boxes.back().lo[k]);
@@ -1252,13 +1312,12 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
     }
   }
   auto intersect = [&](const Triangle& a, const Triangle& b) {
-    const SharedCorners c = sharedCorners(a, b);
-    return intersectBeyondShared(pointsOf(a), pointsOf(b), c.count, c.ia, c.ib);
+    return facesIntersect(a, pointsOf(a), b, pointsOf(b));
   };
   const BoxTree tree(boxes);
   std::atomic<std::size_t> pairs{0};
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
-    if (intersect(patch[i], patch[j])) ++pairs;
+    if (intersect(checked[i], checked[j])) ++pairs;
   });
   if (!s.inputTree) {
     s.inputBoxes.resize(s.inputFaces);
@@ -1268,24 +1327,23 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
     }
     s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
   }
-  // Input faces (their first boxes still hold the halves of split ones), then later faces.
-  auto against = [&](int face) {
-    const Triangle& t = s.triangles[face];
-    if (collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]])) return;
-    tree.query(boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]), 0,
-               [&](std::uint32_t i, unsigned) {
-                 if (intersect(patch[i], t)) ++pairs;
-               });
+  auto other = [&](int f) {  // a face of the rest of the surface, or -1
+    if (ownSet.count(f)) return false;
+    const Triangle& t = s.triangles[f];
+    return !collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
   };
-  for (std::size_t i = 0; i < patch.size(); ++i)
+  // Input faces (their first boxes still hold the halves of split ones), then later faces.
+  for (std::size_t i = 0; i < checked.size(); ++i)
     s.inputTree->query(boxes[i], 0, [&](std::uint32_t f, unsigned) {
-      const Triangle& t = s.triangles[f];
-      if (collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]])) return;
-      if (intersect(patch[i], t)) ++pairs;
+      if (other(int(f)) && intersect(checked[i], s.triangles[f])) ++pairs;
     });
   for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f) {
     const Triangle& t = s.triangles[f];
-    if (overlap(boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]), bounds)) against(int(f));
+    const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
+    if (!overlap(box, bounds) || !other(int(f))) continue;
+    tree.query(box, 0, [&](std::uint32_t i, unsigned) {
+      if (intersect(checked[i], t)) ++pairs;
+    });
   }
   return pairs;
 }
@@ -1300,12 +1358,13 @@ struct PatchShape {
 
 class HoleFiller {
  public:
-  HoleFiller(Surface& s, const HoleFillOptions& options, const std::unordered_set<int>& pinched)
-      : s_(s), options_(options), pinched_(pinched) {}
+  HoleFiller(Surface& s, const HoleFillOptions& options, const std::unordered_set<int>& pinched,
+             HoleFillResult::StageTimes& times)
+      : s_(s), options_(options), pinched_(pinched), times_(times) {}
 
   // Fills the hole bounded by `loop` (mesh direction, after splitting) in
   // the working surface; false (with the reason) when it could not be.
-  bool fill(const std::vector<int>& loop, HoleReport& report) {
+  bool fill(const std::vector<int>& loop, const std::vector<int>& splitFaces, HoleReport& report) {
     n_ = loop.size();
     front_.assign(loop.rbegin(), loop.rend());
     local_.clear();
@@ -1328,7 +1387,10 @@ class HoleFiller {
 
     const Domain domain = domainOf(boundary, faceNormals);
     report.planar_domain = domain.planar;
-    if (!triangulate(domain, report)) return false;
+    auto clock = Clock::now();
+    const bool covered = triangulate(domain, report);
+    times_.triangulate += msSince(clock);
+    if (!covered) return false;
 
     // Patch faces in mesh numbering; new vertices follow the surface's.
     const std::size_t base = s_.points.size();
@@ -1351,14 +1413,19 @@ class HoleFiller {
       PatchShape shape;
       shape.positions = flat;
       shape.fairing = mode;
-      if (mode != HoleFairing::Flat && !fair(mode, shape, report)) {
+      clock = Clock::now();
+      const bool faired = mode == HoleFairing::Flat || fair(mode, shape, report);
+      times_.fair += msSince(clock);
+      if (!faired) {
         problems += std::string(problems.empty() ? "" : "; ") + toString(mode) + ": solver failed";
         continue;
       }
       if (options_.check_intersections) {
         const std::vector<Point3> added(shape.positions.begin() + std::ptrdiff_t(n_),
                                         shape.positions.end());
-        const std::size_t pairs = patchIntersections(s_, patchTriangles_, added);
+        clock = Clock::now();
+        const std::size_t pairs = patchIntersections(s_, patchTriangles_, added, splitFaces);
+        times_.check += msSince(clock);
         if (pairs > 0) {
           problems += std::string(problems.empty() ? "" : "; ") + toString(mode) +
                       " patch would intersect the mesh (" + std::to_string(pairs) + " pairs)";
@@ -1396,8 +1463,15 @@ class HoleFiller {
         }
       });
     AdvancingFront::Settings settings;
-    settings.growth = options_.size_growth;
-    settings.maxSize = options_.max_size_factor * meanDomainEdge;
+    const double uniformFaces =
+        std::abs(signedArea(domain.uv)) / (0.433 * meanDomainEdge * meanDomainEdge);
+    if (uniformFaces > double(options_.uniform_face_limit)) {
+      settings.growth = options_.size_growth;
+      settings.maxSize = options_.max_size_factor * meanDomainEdge;
+    } else {
+      settings.growth = 1;
+      settings.maxSize = meanDomainEdge * 4;
+    }
     settings.merge = options_.merge_distance;
     AdvancingFront front(domain.uv, sizes, existing, settings);
     if (!front.run()) {
@@ -1431,7 +1505,8 @@ class HoleFiller {
   // form one fan (their outside part is fixed; the patch part is added per solve).
   void buildRows() {
     rowVertex_.clear();
-    outsideRows_.clear();
+    outsideRows_.assign(n_, {});
+    hasOutsideRow_.assign(n_, 0);
     for (std::size_t v = n_; v < uv_.size(); ++v) rowVertex_.push_back(int(v));
     for (std::size_t k = 0; k < n_; ++k) {
       if (pinched_.count(front_[k])) continue;
@@ -1445,7 +1520,8 @@ class HoleFiller {
       });
       if (row.weights.empty()) continue;
       rowVertex_.push_back(int(k));
-      outsideRows_[int(k)] = row;
+      outsideRows_[k] = row;
+      hasOutsideRow_[k] = 1;
     }
   }
 
@@ -1453,23 +1529,37 @@ class HoleFiller {
     return key >= 0 ? x[key] : s_.points[-key - 1];
   }
 
-  // The row of local vertex v with the patch's triangles at positions x
-  // (or in the plane, `planar`).
-  LaplacianRow rowOf(int v, const std::vector<Point3>& x, bool planar) const {
-    LaplacianRow row;
-    const auto outside = outsideRows_.find(v);
-    if (outside != outsideRows_.end()) row = outside->second;
+  // Cotangent weights of the patch's triangles at positions x, or in the plane (`planar`).
+  std::vector<TriangleWeights> patchWeights(const std::vector<Point3>& x, bool planar) const {
+    std::vector<TriangleWeights> w(localTriangles_.size());
+    for (std::size_t t = 0; t < localTriangles_.size(); ++t) {
+      const Triangle& tri = localTriangles_[t];
+      if (planar) {
+        auto at = [&](int k) { return Point3(uv_[tri[k]].x, uv_[tri[k]].y, 0); };
+        w[t] = triangleWeights(at(0), at(1), at(2));
+      } else {
+        w[t] = triangleWeights(x[tri[0]], x[tri[1]], x[tri[2]]);
+      }
+    }
+    return w;
+  }
+
+  // The Laplacian row of local vertex v (into `row`, reusing its storage).
+  void rowOf(int v, const std::vector<TriangleWeights>& weights, LaplacianRow& row) const {
+    row.weights.clear();
+    row.area = 0;
+    if (std::size_t(v) < n_ && hasOutsideRow_[v]) {
+      const LaplacianRow& outside = outsideRows_[v];
+      row.weights.assign(outside.weights.begin(), outside.weights.end());
+      row.area = outside.area;
+    }
     for (int t : localAround_[v]) {
       const Triangle& tri = localTriangles_[t];
       int corner = 0;
       while (tri[corner] != v) ++corner;
-      std::array<Point3, 3> p;
-      for (int k = 0; k < 3; ++k)
-        p[k] = planar ? Point3(uv_[tri[k]].x, uv_[tri[k]].y, 0) : x[tri[k]];
-      addTriangleToRow(row, {tri[0], tri[1], tri[2]}, p, corner);
+      addTriangleToRow(row, {tri[0], tri[1], tri[2]}, weights[t], corner);
     }
     row.finish();
-    return row;
   }
 
   // Flat: the front's own placement (heights carried inward from the
@@ -1542,7 +1632,7 @@ class HoleFiller {
     // integral of |Laplacian|^2 whatever the local triangle size.
     Eigen::VectorXd rowWeight;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
-    bool ok = false;
+    bool analysed = false, ok = false;
   };
 
   void assemble(System& sys, const std::vector<int>& rows, const std::vector<Point3>& x,
@@ -1552,9 +1642,11 @@ class HoleFiller {
     sys.fixedPart = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), 3);
     sys.rowTotal.assign(rows.size(), 0);
     sys.rowWeight.resize(Eigen::Index(rows.size()));
+    const std::vector<TriangleWeights> weights = patchWeights(x, planarWeights);
+    LaplacianRow row;
     for (std::size_t r = 0; r < rows.size(); ++r) {
       const int v = rows[r];
-      const LaplacianRow row = rowOf(v, x, planarWeights);
+      rowOf(v, weights, row);
       sys.rowTotal[r] = row.total;
       const double weight = row.area > 0 ? row.total / (2 * std::sqrt(row.area)) : 1.0;
       sys.rowWeight[Eigen::Index(r)] = weight;
@@ -1574,7 +1666,12 @@ class HoleFiller {
     sys.A.setFromTriplets(entries.begin(), entries.end());
     const Eigen::SparseMatrix<double> normal =
         Eigen::SparseMatrix<double>(sys.A.transpose()) * sys.A;
-    sys.solver.compute(normal);
+    // Both weight sets give the same pattern: it is ordered once.
+    if (!sys.analysed) {
+      sys.solver.analyzePattern(normal);
+      sys.analysed = true;
+    }
+    sys.solver.factorize(normal);
     sys.ok = sys.solver.info() == Eigen::Success;
   }
 
@@ -1599,8 +1696,10 @@ class HoleFiller {
     const std::size_t unknowns = rows.size();
     std::vector<Eigen::Triplet<double>> entries;
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
+    const std::vector<TriangleWeights> weights = patchWeights(x, planarWeights);
+    LaplacianRow row;
     for (std::size_t r = 0; r < unknowns; ++r) {
-      const LaplacianRow row = rowOf(rows[r], x, planarWeights);
+      rowOf(rows[r], weights, row);
       entries.push_back({int(r), int(r), row.total});
       for (const auto& [key, w] : row.weights) {
         if (key >= int(n_))
@@ -1761,6 +1860,7 @@ class HoleFiller {
   Surface& s_;
   const HoleFillOptions& options_;
   const std::unordered_set<int>& pinched_;
+  HoleFillResult::StageTimes& times_;
   std::size_t n_ = 0;
   double meanEdge_ = 0;
   std::vector<int> front_;                     // boundary vertices (mesh indices), front order
@@ -1771,7 +1871,8 @@ class HoleFiller {
   std::vector<Triangle> patchTriangles_;       // the same in mesh numbering
   std::vector<std::vector<int>> localAround_;  // patch faces around each local vertex
   std::vector<int> rowVertex_;                 // Laplacian rows: new vertices, then boundary ones
-  std::unordered_map<int, LaplacianRow> outsideRows_;  // boundary rows' mesh part
+  std::vector<LaplacianRow> outsideRows_;      // boundary rows' mesh part
+  std::vector<char> hasOutsideRow_;
 };
 
 void validate(const Mesh& mesh, const HoleFillOptions& o) {
@@ -1819,8 +1920,7 @@ std::size_t countPairsInvolving(const std::vector<Point3>& P, const std::vector<
       tree.query(boxOf(P[tg[0]], P[tg[1]], P[tg[2]]), worker, [&](std::uint32_t i, unsigned) {
         const int f = faces[i];
         if (std::size_t(f) == g || (mine[g] && std::size_t(f) > g) || degenerate(T[f])) return;
-        const SharedCorners c = sharedCorners(T[f], tg);
-        if (intersectBeyondShared(pointsOf(T[f]), pointsOf(tg), c.count, c.ia, c.ib)) ++pairs;
+        if (facesIntersect(T[f], pointsOf(T[f]), tg, pointsOf(tg))) ++pairs;
       });
     }
   });
@@ -1845,7 +1945,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   result.holes_found = found.loops.size();
   if (found.loops.empty()) {
     reportProgress(options.progress, 100, "Done");
-    result.verified = options.verify;
+    result.verified = options.check_intersections || options.verify;
     result.time_ms = msSince(start);
     return result;
   }
@@ -1904,7 +2004,8 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     loops.push_back(loop.vertices);
   }
 
-  HoleFiller filler(s, options, found.pinched);
+  result.stage_ms.find = msSince(start);
+  HoleFiller filler(s, options, found.pinched, result.stage_ms);
   for (std::size_t i = 0; i < toFill.size(); ++i) {
     reportProgress(options.progress, int(5 + 85 * i / toFill.size()), "Filling holes");
     const auto holeStart = Clock::now();
@@ -1914,9 +2015,14 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     undo.points = s.points.size();
     undo.triangles = s.triangles.size();
     undo.splitFaces = s.splitFaces.size();
+    const auto splitStart = Clock::now();
     report.edges_split = splitLongEdges(s, loop, options.long_edge_factor, undo);
+    result.stage_ms.split += msSince(splitStart);
     report.vertices_added = report.edges_split;
-    if (filler.fill(loop, report)) {
+    std::vector<int> splitFaces(s.splitFaces.begin() + std::ptrdiff_t(undo.splitFaces),
+                                s.splitFaces.end());
+    for (const auto& [f, corners] : undo.changedFaces) splitFaces.push_back(f);
+    if (filler.fill(loop, splitFaces, report)) {
       report.filled = true;
       if (report.fairing != options.fairing) ++result.fallbacks;
     } else {
@@ -1938,17 +2044,22 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       ++result.holes_skipped;
     }
   }
+  // Every patch kept passed its exact check (none when the check is off).
+  result.verified = options.check_intersections;
   if (options.verify) {
     reportProgress(options.progress, 92, "Verifying");
     std::vector<int> changed = s.patchFaces;
     changed.insert(changed.end(), s.splitFaces.begin(), s.splitFaces.end());
     for (const auto& [f, corners] : s.inputCorners) changed.push_back(f);
+    const auto verifyStart = Clock::now();
     result.remaining_intersecting_pairs = countPairsInvolving(s.points, s.triangles, changed);
+    result.stage_ms.verify = msSince(verifyStart);
     result.verified = true;
   }
 
   // Write back: split faces change corners, new vertices and faces are appended.
   reportProgress(options.progress, 97, "Writing");
+  const auto writeStart = Clock::now();
   if (s.points.size() > s.inputVertices || s.triangles.size() > s.inputFaces) {
     VertexOriginHandle vo = vertexOrigins(mesh);
     FaceOriginHandle fo = faceOrigins(mesh);
@@ -1983,6 +2094,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     }
     result.new_faces = s.patchFaces;
   }
+  result.stage_ms.write = msSince(writeStart);
   reportProgress(options.progress, 100, "Done");
   result.time_ms = msSince(start);
   return result;
@@ -2027,7 +2139,17 @@ JsonObject toJson(const HoleFillResult& r) {
     j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
   else
     j.setNull("remaining_intersecting_pairs");
-  j.set("time_ms", r.time_ms).set("holes", holes);
+  const auto& t = r.stage_ms;
+  j.set("time_ms", r.time_ms)
+      .set("stage_ms", JsonObject()
+                           .set("find", t.find)
+                           .set("split", t.split)
+                           .set("triangulate", t.triangulate)
+                           .set("fair", t.fair)
+                           .set("check", t.check)
+                           .set("verify", t.verify)
+                           .set("write", t.write))
+      .set("holes", holes);
   return j;
 }
 

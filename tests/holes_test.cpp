@@ -365,6 +365,7 @@ TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
   Mesh m = appended(sphere, plate);
   HoleFillOptions o;
   o.max_boundary_edges = 100;
+  o.verify = true;
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_found, 2u);
   ASSERT_EQ(r.holes_filled, 1u);
@@ -374,6 +375,24 @@ TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
   EXPECT_NE(hole.reason.find("intersect"), std::string::npos) << hole.reason;
   EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
   EXPECT_EQ(selfIntersectingPairs(m), 0u);
+}
+
+TEST(HoleChecks, VerificationCountsWhatAnUncheckedPatchCrosses) {
+  // The same plate through the opening, with the check off: the hole is
+  // filled through the plate and the independent recount sees it.
+  const Mesh sphere = sphereWithCap();
+  const Mesh plate = makeMesh({{0, -0.3, 0.5}, {0, 0.3, 0.5}, {0, 0.3, 1.5}, {0, -0.3, 1.5}},
+                              {{0, 1, 2}, {0, 2, 3}});
+  Mesh m = appended(sphere, plate);
+  HoleFillOptions o;
+  o.max_boundary_edges = 100;
+  o.check_intersections = false;
+  o.verify = true;
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_filled, 2u);  // the plate's border too, by a copy of the plate
+  EXPECT_TRUE(r.verified);
+  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
 }
 
 TEST(HoleChecks, HoleWhoseFillMustCrossAnotherPartIsSkipped) {
@@ -552,6 +571,7 @@ TEST(HoleLarge, ThousandBorderVertexHoleIsFilled) {
   Mesh m = sphereBand(1000, 0.6, 6);
   ASSERT_GT(volumeOf(withHole(m, [](const Point3&) { return false; })), -1);
   HoleFillOptions o;
+  o.verify = true;
   std::vector<bool> top(std::size_t(m.vn), false);
   for (int j = 0; j < 1000; ++j) top[j] = true;
   o.selected_vertices = top;
