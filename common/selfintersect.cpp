@@ -76,6 +76,7 @@ struct Edges {
 
 struct TopologyCounts {
   std::size_t border_edges = 0, non_manifold_edges = 0;
+  std::size_t fin_edges = 0;  // used more than once, unequally in the two directions
   int components = 0;
   int genus = -1;
 };
@@ -89,6 +90,10 @@ TopologyCounts topologyOf(const std::vector<Triangle>& T, std::size_t vertexCoun
     const int n = edges.size(int(e));
     if (n == 1) ++c.border_edges;
     if (n > 2) ++c.non_manifold_edges;
+    if (n > 1) {
+      const auto [forward, backward] = edges.directions(int(e), T);
+      c.fin_edges += forward != backward;
+    }
     for (int k = edges.first[e] + 1; k < edges.first[e + 1]; ++k)
       parent[find(parent, edges.uses[k].face)] = find(parent, edges.uses[edges.first[e]].face);
   }
@@ -977,6 +982,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
     r.genus_before = before.genus;
     r.border_edges_before = before.border_edges;
     r.non_manifold_edges_before = before.non_manifold_edges;
+    r.fin_edges_before = before.fin_edges;
     r.input_closed = before.border_edges == 0;
   }
 
@@ -1159,6 +1165,7 @@ JsonObject toJson(const SelfIntersectionResult& r) {
       .set("border_edges_before", r.border_edges_before)
       .set("border_edges_after", r.border_edges_after)
       .set("non_manifold_edges_before", r.non_manifold_edges_before)
+      .set("fin_edges_before", r.fin_edges_before)
       .set("non_manifold_edges_after", r.non_manifold_edges_after)
       .set("degenerate_faces_before", r.degenerate_faces_before)
       .set("collapses", r.collapses)

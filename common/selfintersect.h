@@ -71,6 +71,12 @@ struct SelfIntersectionResult {
   bool input_closed = false, output_closed = false;
   std::size_t border_edges_before = 0, border_edges_after = 0;
   std::size_t non_manifold_edges_before = 0, non_manifold_edges_after = 0;
+  // Edges of the cleaned input (welded, opposite duplicate faces cancelled)
+  // used more than once but unequally in the two directions: fins, where
+  // the surface has no inside. A face that cannot be continued there leaves
+  // a border (counted in side_conflicts), so a closed input with fins may
+  // come out with small holes at them.
+  std::size_t fin_edges_before = 0;
   int components_before = 0, components_after = 0;
   // Genus of a closed, edge-manifold mesh (summed over components), else -1.
   int genus_before = -1, genus_after = -1;
