@@ -316,13 +316,14 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
 
 double loopDiameter(const std::vector<Point3>& P, const std::vector<int>& loop) {
   double best = 0;
-  if (loop.size() <= 3000) {
+  if (loop.size() <= 512) {
     for (std::size_t i = 0; i < loop.size(); ++i)
       for (std::size_t j = i + 1; j < loop.size(); ++j)
         best = std::max(best, (P[loop[i]] - P[loop[j]]).SquaredNorm());
     return std::sqrt(best);
   }
-  // Large loops: repeated farthest-point sweeps (a lower bound within a few percent).
+  // Large loops: repeated farthest-point sweeps (a lower bound, within a
+  // few percent for the round and long shapes of holes).
   int from = loop[0];
   for (int sweep = 0; sweep < 4; ++sweep) {
     int far = from;

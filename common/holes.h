@@ -56,7 +56,7 @@ struct HoleFillOptions {
   // length: a round hole of n boundary edges needs ~n^2/12 uniform
   // triangles, a graded patch a few times n.
   std::size_t uniform_face_limit = 4000;
-  double size_growth = 1.3;
+  double size_growth = 1.4;
   double max_size_factor = 16;
   // A new front vertex closer than merge_distance x its target size to
   // another front vertex is merged into it (step 4 of §3.2).
@@ -88,12 +88,14 @@ struct HoleFillOptions {
 struct HoleReport {
   std::vector<int> boundary;       // its vertices in order (before splitting), mesh indices
   std::size_t boundary_edges = 0;  // as found
-  double diameter = 0;             // largest distance between two boundary vertices
-  std::size_t edges_split = 0;     // long boundary edges split (§3.1)
-  std::size_t faces_added = 0;     // patch faces (split faces not counted)
-  std::size_t vertices_added = 0;  // patch and split vertices
-  bool filled = false;             //
-  std::string reason;              // why it was skipped, or why the shape fell back
+  // Largest distance between two boundary vertices (within a few percent
+  // above 512 of them).
+  double diameter = 0;
+  std::size_t edges_split = 0;              // long boundary edges split (§3.1)
+  std::size_t faces_added = 0;              // patch faces (split faces not counted)
+  std::size_t vertices_added = 0;           // patch and split vertices
+  bool filled = false;                      //
+  std::string reason;                       // why it was skipped, or why the shape fell back
   HoleFairing fairing = HoleFairing::Flat;  // the shape the patch got (after fallbacks)
   bool planar_domain = true;                // triangulated over its plane (false: over a disk)
   // RMS residual of the fairing system, in units of the mean boundary edge

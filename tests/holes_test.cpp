@@ -185,9 +185,11 @@ TEST(HoleLoops, OpenBorderIsReportedNotFilled) {
 
 // ---- Pre-treatment (§3.1) ------------------------------------------------------------
 
-TEST(HolePretreatment, SplitsLongBorderEdgesAndTheirFaces) {
-  // A 6 x 6 plane with the squares inside [1,5]^2 removed, except that the
-  // hole's top side is one edge of length 4 (its row of faces is a fan).
+namespace {
+
+// A 6 x 6 plane with the squares inside [1,5]^2 removed, except that the
+// hole's top side is one edge of length 4 (its row of faces is a fan).
+Mesh longEdgeHole() {
   std::vector<Point3> p;
   for (int j = 0; j <= 6; ++j)
     for (int i = 0; i <= 6; ++i) p.emplace_back(i, j, 0);
@@ -207,7 +209,13 @@ TEST(HolePretreatment, SplitsLongBorderEdgesAndTheirFaces) {
   t.push_back({at(1, 5), at(2, 6), at(1, 6)});
   t.push_back({at(5, 5), at(4, 6), at(3, 6)});
   t.push_back({at(5, 5), at(5, 6), at(4, 6)});
-  Mesh m = makeMesh(p, t);
+  return makeMesh(p, t);
+}
+
+}  // namespace
+
+TEST(HolePretreatment, SplitsLongBorderEdgesAndTheirFaces) {
+  Mesh m = longEdgeHole();
   const std::size_t facesBefore = std::size_t(m.fn);
   ASSERT_EQ(edgeStats(m).border, 24u + 13u);
 
@@ -247,6 +255,17 @@ TEST(HolePretreatment, SplitsLongBorderEdgesAndTheirFaces) {
   for (int v : r.new_vertices)
     if (vo[v].face >= 0) ++onFaces;
   EXPECT_EQ(onFaces, 3);
+}
+
+TEST(HolePretreatment, FactorZeroLeavesTheBorderAlone) {
+  Mesh m = longEdgeHole();
+  HoleFillOptions o = withFairing(HoleFairing::Flat);
+  o.long_edge_factor = 0;
+  o.max_boundary_edges = 13;
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_filled, 1u);
+  EXPECT_EQ(r.edges_split, 0u);
+  expectSound(m, 24);
 }
 
 // ---- Advancing front (§3.2) -----------------------------------------------------------
@@ -325,6 +344,57 @@ TEST(HoleFront, SaddleHoleInEveryMode) {
     }
     std::cout << toString(mode) << ": saddle max deviation " << worst << "\n";
   }
+}
+
+TEST(HoleFront, HoleAcrossASharpCornerInEveryMode) {
+  // The border runs over three sides of a cube: far from planar.
+  for (HoleFairing mode : {HoleFairing::Flat, HoleFairing::Harmonic, HoleFairing::Biharmonic,
+                           HoleFairing::LaplacianRegression}) {
+    SCOPED_TRACE(toString(mode));
+    Mesh m =
+        withHole(gridCube(12), [](const Point3& c) { return (c - Point3(1, 1, 1)).Norm() < 0.35; });
+    ASSERT_GT(volumeOf(m), 0.9);
+    const HoleFillResult r = fillHoles(m, withFairing(mode));
+    ASSERT_EQ(r.holes_filled, 1u) << r.holes[0].reason;
+    EXPECT_EQ(r.holes[0].fairing, mode) << r.holes[0].reason;
+    expectSound(m, 0);
+    // Flat and membrane patches cut the corner off; the others round it.
+    EXPECT_GT(volumeOf(m), 0.98);
+    EXPECT_LT(volumeOf(m), 1.01);
+  }
+}
+
+TEST(HoleFront, HoleWrappingATubeIsTriangulatedOverADisk) {
+  // A hole three quarters around an open tube: its border projects onto no
+  // plane as a simple polygon, so the front runs over a disk.
+  Mesh m = withHole(openTube(48, 24, 1, 3), [](const Point3& c) {
+    return std::abs(std::atan2(c[1], c[0])) < 2.3 && c[2] > 1 && c[2] < 2;
+  });
+  const std::size_t ends = 2 * 48;
+  HoleFillOptions o;
+  o.selected_vertex_indices = {8 * 48};  // on the side hole's lower border (z = 1, angle 0)
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_found, 3u);
+  ASSERT_EQ(r.holes_filled, 1u);
+  const HoleReport& side =
+      *std::find_if(r.holes.begin(), r.holes.end(), [](const HoleReport& h) { return h.filled; });
+  EXPECT_FALSE(side.planar_domain);
+  expectSound(m, ends);
+}
+
+TEST(HoleFront, TriangularHoleGetsOneFace) {
+  const Mesh closed = icosphere(2);
+  std::vector<Triangle> t = trianglesOf(closed);
+  const Triangle removed = t[7];
+  t.erase(t.begin() + 7);
+  Mesh m = makeMesh(positionsOf(closed), t);
+  const HoleFillResult r = fillHoles(m);
+  ASSERT_EQ(r.holes_filled, 1u);
+  EXPECT_EQ(r.faces_added, 1u);
+  EXPECT_EQ(r.vertices_added, 0u);
+  expectSound(m, 0);
+  const Triangle added = trianglesOf(m).back();
+  EXPECT_TRUE(std::is_permutation(added.begin(), added.end(), removed.begin()));
 }
 
 // ---- Shape (§3.3, §3.4) -------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // Small meshes built in code for the unit tests.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <vector>
@@ -117,6 +118,67 @@ Mesh heightGrid(int nx, int ny, double cell, Height&& height, Keep&& keep) {
       if (!keep((i + 0.5) * cell, (j + 0.5) * cell)) continue;
       t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
       t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return makeMesh(p, t);
+}
+
+// The cube [0,s]^3 with each side an n x n grid of squares cut into two
+// triangles; closed, welded, outward normals.
+inline Mesh gridCube(int n, double s = 1) {
+  std::vector<Point3> p;
+  std::vector<Triangle> t;
+  std::map<std::array<long, 3>, int> index;  // grid coordinates -> vertex
+  auto vertex = [&](const std::array<int, 3>& g) {
+    const std::array<long, 3> key{g[0], g[1], g[2]};
+    const auto it = index.find(key);
+    if (it != index.end()) return it->second;
+    p.emplace_back(s * g[0] / n, s * g[1] / n, s * g[2] / n);
+    return index[key] = int(p.size()) - 1;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          auto at = [&](int a, int b) {
+            std::array<int, 3> g{};
+            g[axis] = side * n;
+            g[(axis + 1) % 3] = a;
+            g[(axis + 2) % 3] = b;
+            return vertex(g);
+          };
+          const int v00 = at(i, j), v10 = at(i + 1, j), v11 = at(i + 1, j + 1), v01 = at(i, j + 1);
+          if (side == 1) {
+            t.push_back({v00, v10, v11});
+            t.push_back({v00, v11, v01});
+          } else {
+            t.push_back({v00, v11, v10});
+            t.push_back({v00, v01, v11});
+          }
+        }
+  return makeMesh(p, t);
+}
+
+// An open tube (no caps) of radius r around the z axis from z = 0 to h:
+// `around` vertices per ring (alternate rings turned by half a step),
+// `along` bands; outward normals.
+inline Mesh openTube(int around, int along, double r, double h) {
+  std::vector<Point3> p;
+  for (int j = 0; j <= along; ++j)
+    for (int i = 0; i < around; ++i) {
+      const double a = 2 * M_PI * (i + 0.5 * (j % 2)) / around;
+      p.emplace_back(r * std::cos(a), r * std::sin(a), h * j / along);
+    }
+  auto at = [&](int i, int j) { return j * around + (i % around); };
+  std::vector<Triangle> t;
+  for (int j = 0; j < along; ++j)
+    for (int i = 0; i < around; ++i) {
+      if (j % 2 == 0) {
+        t.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+        t.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      } else {
+        t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      }
     }
   return makeMesh(p, t);
 }
