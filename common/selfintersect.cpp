@@ -174,7 +174,7 @@ class Pretreatment {
       for (int v : T_[f]) around_[v].push_back(int(f));
       boxes[f] = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
     }
-    tree_ = std::make_unique<BoxTree>(std::move(boxes));
+    tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
     changed_.clear();
   }
 
@@ -452,7 +452,7 @@ class ValidRegionGrowing {
       : P_(P), T_(T), newFace_(newFace), births_(std::move(births)), edges_(T) {
     std::vector<Box> boxes(T.size());
     for (std::size_t f = 0; f < T.size(); ++f) boxes[f] = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
-    tree_ = std::make_unique<BoxTree>(std::move(boxes));
+    tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
     bounds_ = tree_->bounds();
     // Regions the growing crosses freely (through manifold edges): a region
     // is kept or removed as a whole, so a seed test that proves one face of
@@ -565,21 +565,20 @@ class ValidRegionGrowing {
 
   // Edges (of the cut mesh) that come out with more than two faces.
   std::vector<int> overloadedEdges(const std::vector<char>& valid, const Stitched& s) const {
-    std::vector<std::tuple<int, int, int>> uses;  // output edge, cut-mesh edge
+    std::vector<int> faces;
+    std::vector<Triangle> stitched;
     for (std::size_t f = 0; f < T_.size(); ++f)
-      if (valid[f])
-        for (int i = 0; i < 3; ++i) {
-          const int a = s.vertex_of_corner[3 * f + i], b = s.vertex_of_corner[3 * f + (i + 1) % 3];
-          uses.emplace_back(std::min(a, b), std::max(a, b), edges_.edge_of_use[3 * f + i]);
-        }
-    std::sort(uses.begin(), uses.end());
+      if (valid[f]) {
+        faces.push_back(int(f));
+        stitched.push_back({s.vertex_of_corner[3 * f], s.vertex_of_corner[3 * f + 1],
+                            s.vertex_of_corner[3 * f + 2]});
+      }
+    const std::vector<EdgeUse> uses = edgeUses(stitched);
     std::vector<int> out;
     for (std::size_t i = 0; i < uses.size();) {
       std::size_t j = i + 1;
-      while (j < uses.size() && std::get<0>(uses[j]) == std::get<0>(uses[i]) &&
-             std::get<1>(uses[j]) == std::get<1>(uses[i]))
-        ++j;
-      if (j - i > 2) out.push_back(std::get<2>(uses[i]));
+      while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+      if (j - i > 2) out.push_back(edges_.edge_of_use[3 * faces[uses[i].face] + uses[i].corner]);
       i = j;
     }
     return out;

@@ -430,7 +430,7 @@ class CurveSnapper {
     std::vector<Box> boxes(T_.size());
     for (std::size_t f = 0; f < T_.size(); ++f)
       boxes[f] = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
-    tree_ = std::make_unique<BoxTree>(std::move(boxes));
+    tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
   }
 
   // Merges new vertices into nearby input vertices; returns how many.
