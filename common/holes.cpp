@@ -1134,7 +1134,9 @@ struct Surface {
   std::unordered_map<int, Triangle> inputCorners;  // input faces changed by splits: their corners
   std::vector<int> patchFaces, splitFaces;         // faces added by patches / by splits
   std::vector<Box> inputBoxes;
-  std::unique_ptr<BoxTree> inputTree;  // over the input faces' boxes (built on first use)
+  std::unique_ptr<BoxTree>
+      inputTree;           // over the input faces' boxes (built once there are many holes)
+  std::size_t checks = 0;  // patches checked so far
 
   int inputFace(int f) const {
     return std::size_t(f) < inputFaces ? f : inputFaceOf[std::size_t(f) - inputFaces];
@@ -1320,24 +1322,35 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
     if (intersect(checked[i], checked[j])) ++pairs;
   });
-  if (!s.inputTree) {
+  if (s.inputBoxes.size() != s.inputFaces) {
     s.inputBoxes.resize(s.inputFaces);
     for (std::size_t f = 0; f < s.inputFaces; ++f) {
       const Triangle t = s.originalCorners(int(f));
       s.inputBoxes[f] = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
     }
-    s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
   }
-  auto other = [&](int f) {  // a face of the rest of the surface, or -1
+  // A few holes scan the input faces' boxes; many pay for a hierarchy once.
+  if (!s.inputTree && ++s.checks > 8) s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
+  auto other = [&](int f) {  // a non-degenerate face of the rest of the surface
     if (ownSet.count(f)) return false;
     const Triangle& t = s.triangles[f];
     return !collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
   };
-  // Input faces (their first boxes still hold the halves of split ones), then later faces.
-  for (std::size_t i = 0; i < checked.size(); ++i)
-    s.inputTree->query(boxes[i], 0, [&](std::uint32_t f, unsigned) {
-      if (other(int(f)) && intersect(checked[i], s.triangles[f])) ++pairs;
-    });
+  // Input faces (the boxes of split ones still hold their halves), then later faces.
+  if (s.inputTree) {
+    for (std::size_t i = 0; i < checked.size(); ++i)
+      s.inputTree->query(boxes[i], 0, [&](std::uint32_t f, unsigned) {
+        if (other(int(f)) && intersect(checked[i], s.triangles[f])) ++pairs;
+      });
+  } else {
+    for (std::size_t f = 0; f < s.inputFaces; ++f) {
+      if (!overlap(s.inputBoxes[f], bounds) || !other(int(f))) continue;
+      const Triangle& t = s.triangles[f];
+      tree.query(s.inputBoxes[f], 0, [&](std::uint32_t i, unsigned) {
+        if (intersect(checked[i], t)) ++pairs;
+      });
+    }
+  }
   for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f) {
     const Triangle& t = s.triangles[f];
     const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
@@ -1429,12 +1442,16 @@ class HoleFiller {
         times_.check += msSince(clock);
         if (pairs > 0) {
           problems += std::string(problems.empty() ? "" : "; ") + toString(mode) +
-                      " patch would intersect the mesh (" + std::to_string(pairs) + " pairs)";
+                      " patch would intersect itself or the mesh (" + std::to_string(pairs) +
+                      " pairs)";
           continue;
         }
       }
       commit(shape, report);
-      if (mode != options_.fairing) report.reason = "fell back: " + problems;
+      if (mode != options_.fairing)
+        report.reason = "fell back: " + problems;
+      else if (shape.fairing != mode)
+        report.reason = "fell back to biharmonic: " + report.reason;
       return true;
     }
     report.reason = "no patch fits: " + problems;
@@ -1833,7 +1850,8 @@ class HoleFiller {
           residual = res;
         }
       } else {
-        report.reason = "too few vertices around the hole to learn from; biharmonic shape";
+        report.reason = "too few surface vertices around the hole to learn its curvature from";
+        shape.fairing = HoleFairing::Biharmonic;
       }
     }
     shape.residual = residual / meanEdge_;
@@ -2107,6 +2125,7 @@ JsonObject toJson(const HoleFillResult& r) {
     const HoleReport& h = r.holes[i];
     JsonObject j;
     j.set("hole", i)
+        .set("boundary_vertices", h.boundary.size())
         .set("boundary_edges", h.boundary_edges)
         .set("diameter", h.diameter)
         .set("filled", h.filled);

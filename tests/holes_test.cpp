@@ -606,6 +606,25 @@ TEST(HoleSelection, SizeLimitsAndSelectionChooseTheHoles) {
   }
 }
 
+TEST(HoleSelection, ManySmallHolesAreAllFilled) {
+  // 16 holes of 2 x 2 squares: past the first few, the checks use a box
+  // hierarchy of the input faces instead of scanning them.
+  Mesh m = heightGrid(
+      40, 40, 1, [](double x, double y) { return 0.05 * std::sin(x) * std::cos(y); },
+      [](double x, double y) {
+        const int i = int(x), j = int(y);
+        return !(i % 10 >= 4 && i % 10 < 6 && j % 10 >= 4 && j % 10 < 6);
+      });
+  HoleFillOptions o;
+  o.max_boundary_edges = 10;
+  o.verify = true;
+  const HoleFillResult r = fillHoles(m, o);
+  EXPECT_EQ(r.holes_found, 17u);
+  EXPECT_EQ(r.holes_filled, 16u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectSound(m, 160);
+}
+
 // ---- Large holes -------------------------------------------------------------------------
 
 // A band of the unit sphere below the circle at polar angle `cap`, with
