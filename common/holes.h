@@ -20,15 +20,24 @@
 
 namespace meshmend {
 
-// How the patch vertices are placed once the patch is triangulated.
+// How the patch vertices are placed once the patch is triangulated. The
+// smooth shapes minimise the squared cotangent Laplacians (Eq. 1-3) of the
+// new vertices and of the boundary vertices, whose outer neighbours stay
+// fixed: that is what joins the patch to the surface with a continuous
+// tangent plane.
 enum class HoleFairing {
   Flat,        // no fairing: where the advancing front put them (a height field over the
                // hole's plane; a uniform membrane when the hole has no plane it projects to)
-  Harmonic,    // membrane: cotangent Laplacian L x = 0, boundary fixed
-  Biharmonic,  // minimal curvature: L^2 x = 0 with the boundary and the ring of vertices
-               // around it fixed (tangent continuity with the surface)
-  LaplacianRegression,  // the paper's: Laplacians predicted from the rings around the hole by
-                        // LS-SVM regression, then L x = delta with the boundary fixed
+  Harmonic,    // membrane: L x = 0 with the boundary fixed (no tangent continuity)
+  Biharmonic,  // minimal curvature: target Laplacians 0 (L^2 x = 0 in the least-squares sense)
+  // The paper's (§3.3-3.4): the mean curvature H of the vertices in the
+  // rings around the hole, from their own Laplacians, is learnt by LS-SVM
+  // regression over 3-D position; the Laplacian it implies at each patch
+  // vertex (-4 A H n / sum of weights) is the Poisson target. (The paper
+  // regresses each coordinate of the Laplacian from the same coordinate of
+  // the position; the normal part scaled by the local area carries the shape
+  // without depending on how the surface around was triangulated.)
+  LaplacianRegression,
 };
 
 const char* toString(HoleFairing fairing);
@@ -91,10 +100,10 @@ struct HoleReport {
   // Largest distance between two boundary vertices (within a few percent
   // above 512 of them).
   double diameter = 0;
-  std::size_t edges_split = 0;              // long boundary edges split (§3.1)
-  std::size_t faces_added = 0;              // patch faces (split faces not counted)
-  std::size_t vertices_added = 0;           // patch and split vertices
-  bool filled = false;                      //
+  std::size_t edges_split = 0;     // long boundary edges split (§3.1)
+  std::size_t faces_added = 0;     // patch faces (split faces not counted)
+  std::size_t vertices_added = 0;  // patch and split vertices
+  bool filled = false;
   std::string reason;                       // why it was skipped, or why the shape fell back
   HoleFairing fairing = HoleFairing::Flat;  // the shape the patch got (after fallbacks)
   bool planar_domain = true;                // triangulated over its plane (false: over a disk)
