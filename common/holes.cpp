@@ -1250,12 +1250,46 @@ std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Ch
 
 // ---- Exact check of a patch ----------------------------------------------------------
 
+// Exact, sufficient for "the faces meet at most in corners they share":
+// in the projection dropping `axis`, a line through an edge of one face
+// (which projects one-to-one) has the other face strictly on its far side,
+// but for shared corners on the line. Coplanar neighbours, where the
+// plane-side tests below cannot decide, are settled here with 2-D tests.
+bool separatedInProjection(const Triangle& a, const TrianglePoints& pa, const Triangle& b,
+                           const TrianglePoints& pb, int axis) {
+  for (int pass = 0; pass < 2; ++pass) {
+    const Triangle& t = pass == 0 ? a : b;
+    const TrianglePoints& p = pass == 0 ? pa : pb;
+    const Triangle& other = pass == 0 ? b : a;
+    const TrianglePoints& q = pass == 0 ? pb : pa;
+    if (orient2dDropping(p[0], p[1], p[2], axis) == 0) continue;
+    for (int e = 0; e < 3; ++e) {
+      const int u = e, w = (e + 1) % 3, o = (e + 2) % 3;
+      const int inside = orient2dDropping(p[u], p[w], p[o], axis);
+      bool separated = true;
+      for (int k = 0; k < 3 && separated; ++k) {
+        if (other[k] == t[u] || other[k] == t[w]) continue;
+        separated = orient2dDropping(p[u], p[w], q[k], axis) == -inside;
+      }
+      if (separated) return true;
+    }
+  }
+  return false;
+}
+
 // The self-intersection rule for two faces of one mesh (vertex identity =
 // index; see triangle_intersection.h), with cheap exact plane-side tests
 // first: they settle almost every pair of neighbours.
 bool facesIntersect(const Triangle& a, const TrianglePoints& pa, const Triangle& b,
                     const TrianglePoints& pb) {
   const SharedCorners c = sharedCorners(a, b);
+  if (c.count < 3) {
+    const Point3 n = (pa[1] - pa[0]) ^ (pa[2] - pa[0]);
+    const int axis = std::abs(n[0]) >= std::abs(n[1]) && std::abs(n[0]) >= std::abs(n[2]) ? 0
+                     : std::abs(n[1]) >= std::abs(n[2])                                   ? 1
+                                                                                          : 2;
+    if (separatedInProjection(a, pa, b, pb, axis)) return false;
+  }
   auto side = [](const TrianglePoints& t, const Point3& p) {
     return orient3d(t[0], t[1], t[2], p);
   };
