@@ -1,0 +1,316 @@
+// bench_holes [--repeat N] [--limit S] [--methods a,b,...] [--out-dir DIR] FILE:
+// hole filling, ours against CGAL 5.5 and MeshLab's own "Close Holes" on the
+// same holes in the same run. Fills every hole of FILE. Prints one JSON object.
+//
+// Methods:
+//   meshmend_regression   ours, fillHoles with the default options (the
+//                         paper's LS-SVM Laplacian regression)
+//   meshmend_biharmonic, meshmend_harmonic, meshmend_flat
+//                         ours with the other patch shapes
+//   cgal_refine_fair      PMP::triangulate_refine_and_fair_hole on each border
+//                         cycle (defaults: Delaunay search space, fairing
+//                         continuity 1), on a Surface_mesh copy; only the calls
+//                         are timed (the cycles are found beforehand)
+//   meshlab_close_holes   the work of MeshLab 2020.09's filter "Close Holes"
+//                         (meshfilter.cpp, FP_CLOSE_HOLES with its default
+//                         "prevent self-intersections"): face-face adjacency,
+//                         the non-manifold edge check, then vcglib's
+//                         Hole::EarCuttingIntersectionFill with
+//                         SelfIntersectionEar, on a float mesh like CMeshO,
+//                         compiled here from the same vcglib headers
+//
+// Each method runs in child processes (benchmarks/harness.h). A first child
+// fills one copy, timing the call by hand, and writes the filled mesh
+// (DIR/<method>.off) and a report (DIR/<method>.json: faces added, ours' full
+// HoleFillResult, the first run's time) outside the clock; the harness then
+// times N runs on copies made beforehand, so that copying the input is never
+// timed. A method whose first run takes over 10 s is not repeated. Without
+// --out-dir nothing is written and only the times are printed.
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <vcg/complex/algorithms/clean.h>
+#include <vcg/complex/algorithms/hole.h>
+#include <vcg/complex/append.h>
+#include <vcg/complex/complex.h>
+
+#include "benchmarks/cgal_mesh.h"
+#include "benchmarks/harness.h"
+#include "common/holes.h"
+#include "common/mesh_io.h"
+
+using namespace meshmend;
+using namespace meshmend::bench;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+namespace {
+
+constexpr double kSlowMs = 10000;  // a method slower than this runs once
+
+// The components of MeshLab's CMeshO that vcglib's hole filling touches:
+// float coordinates, normals, flags, marks and face-face adjacency.
+class MlVertex;
+class MlFace;
+struct MlTypes
+    : public vcg::UsedTypes<vcg::Use<MlVertex>::AsVertexType, vcg::Use<MlFace>::AsFaceType> {};
+class MlVertex : public vcg::Vertex<MlTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
+                                    vcg::vertex::BitFlags, vcg::vertex::Mark> {};
+class MlFace : public vcg::Face<MlTypes, vcg::face::VertexRef, vcg::face::FFAdj,
+                                vcg::face::Normal3f, vcg::face::BitFlags, vcg::face::Mark> {};
+class MlMesh : public vcg::tri::TriMesh<std::vector<MlVertex>, std::vector<MlFace>> {};
+
+void toMlMesh(const Mesh& in, MlMesh& out) {
+  const std::vector<Point3> points = positionsOf(in);
+  const std::vector<Triangle> triangles = trianglesOf(in);
+  auto v = vcg::tri::Allocator<MlMesh>::AddVertices(out, points.size());
+  for (const Point3& p : points) (v++)->P() = vcg::Point3f(float(p[0]), float(p[1]), float(p[2]));
+  auto f = vcg::tri::Allocator<MlMesh>::AddFaces(out, triangles.size());
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) f->V(k) = &out.vert[std::size_t(t[k])];
+    ++f;
+  }
+}
+
+// MeshLab's filter: adjacency, refusal of non-manifold edges, ear cutting
+// of every hole below MaxHoleSize (the benchmark's holes are all below the
+// limit given). Returns the faces added.
+long closeHolesLikeMeshLab(MlMesh& m) {
+  const std::size_t before = std::size_t(m.fn);
+  vcg::tri::UpdateTopology<MlMesh>::FaceFace(m);
+  if (vcg::tri::Clean<MlMesh>::CountNonManifoldEdgeFF(m) > 0)
+    throw std::runtime_error("non-manifold edges: MeshLab's filter refuses the mesh");
+  vcg::tri::Hole<MlMesh>::EarCuttingIntersectionFill<vcg::tri::SelfIntersectionEar<MlMesh>>(
+      m, 1 << 30, false);
+  return long(std::size_t(m.fn) - before);
+}
+
+void writeOff(const std::string& path, MlMesh& m) {
+  vcg::tri::Allocator<MlMesh>::CompactEveryVector(m);
+  std::ofstream out(path);
+  out.precision(17);  // a float widened to double, written exactly
+  out << "OFF\n" << m.vn << ' ' << m.fn << " 0\n";
+  for (const MlVertex& v : m.vert)
+    out << double(v.cP()[0]) << ' ' << double(v.cP()[1]) << ' ' << double(v.cP()[2]) << '\n';
+  for (const MlFace& f : m.face)
+    out << "3 " << vcg::tri::Index(m, f.cV(0)) << ' ' << vcg::tri::Index(m, f.cV(1)) << ' '
+        << vcg::tri::Index(m, f.cV(2)) << '\n';
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// How one method fills a copy of the input: `load` builds the input once
+// (untimed), `fill` fills one copy, `write` saves a filled copy and its report.
+template <class M>
+struct Filler {
+  std::function<M()> load;
+  std::function<long(M&)> fill;
+  std::function<void(M&, long faces, double ms, const std::string& stem)> write;
+};
+
+// The two harness passes of one method (see the file comment). `stem` is
+// DIR/<method>, empty when nothing is written. The first pass returns its
+// run's time in microseconds as its result, which is how the parent learns it.
+template <class M>
+std::pair<Method, Method> passes(const std::string& name, const std::string& role,
+                                 const Filler<M>& f, const std::string& stem, int repeat) {
+  Method first{name, role, [=] {
+                 auto input = std::make_shared<M>(f.load());
+                 return std::function<long()>([=] {
+                   M copy = *input;
+                   const auto t0 = std::chrono::steady_clock::now();
+                   const long faces = f.fill(copy);
+                   const double ms = msSince(t0);
+                   if (!stem.empty()) f.write(copy, faces, ms, stem);
+                   return long(ms * 1000);
+                 });
+               }};
+  Method timed{name, role, [=] {
+                 auto input = std::make_shared<M>(f.load());
+                 auto copies = std::make_shared<std::vector<M>>(std::size_t(repeat), *input);
+                 auto next = std::make_shared<std::size_t>(0);
+                 return std::function<long()>([=] { return f.fill((*copies)[(*next)++]); });
+               }};
+  return {first, timed};
+}
+
+// Ours keeps the result of its fill for the report.
+struct OursInput {
+  Mesh mesh;
+  HoleFillResult result;
+};
+
+Filler<OursInput> ours(const std::string& file, HoleFairing fairing) {
+  Filler<OursInput> f;
+  f.load = [file] { return OursInput{readMesh(file), {}}; };
+  f.fill = [fairing](OursInput& in) {
+    HoleFillOptions o;
+    o.fairing = fairing;
+    in.result = fillHoles(in.mesh, o);
+    return long(in.result.faces_added);
+  };
+  f.write = [](OursInput& in, long, double ms, const std::string& stem) {
+    writeMesh(stem + ".off", in.mesh);
+    JsonObject j = toJson(in.result);
+    j.set("first_run_ms", ms);
+    writeJsonFile(stem + ".json", j);
+  };
+  return f;
+}
+
+struct CgalInput {
+  SurfaceMesh mesh;
+  std::vector<SurfaceMesh::Halfedge_index> cycles;  // one border halfedge per hole
+};
+
+Filler<CgalInput> cgal(const std::string& file) {
+  Filler<CgalInput> f;
+  f.load = [file] {
+    CgalInput in;
+    in.mesh = toSurfaceMesh(readMesh(file));
+    PMP::extract_boundary_cycles(in.mesh, std::back_inserter(in.cycles));
+    return in;
+  };
+  f.fill = [](CgalInput& in) {
+    long faces = 0;
+    for (SurfaceMesh::Halfedge_index h : in.cycles) {
+      std::vector<SurfaceMesh::Face_index> added;
+      std::vector<SurfaceMesh::Vertex_index> vertices;
+      PMP::triangulate_refine_and_fair_hole(in.mesh, h, std::back_inserter(added),
+                                            std::back_inserter(vertices));
+      faces += long(added.size());
+    }
+    return faces;
+  };
+  f.write = [](CgalInput& in, long faces, double ms, const std::string& stem) {
+    in.mesh.collect_garbage();
+    if (!CGAL::IO::write_polygon_mesh(stem + ".off", in.mesh,
+                                      CGAL::parameters::stream_precision(17)))
+      throw std::runtime_error("cannot write " + stem + ".off");
+    JsonObject j;
+    j.set("faces_added", faces).set("holes", long(in.cycles.size())).set("first_run_ms", ms);
+    writeJsonFile(stem + ".json", j);
+  };
+  return f;
+}
+
+// MlMesh is not copyable (vcglib); the pool holds copies made with Append.
+struct MlInput {
+  std::shared_ptr<MlMesh> mesh = std::make_shared<MlMesh>();
+  MlInput() = default;
+  MlInput(const MlInput& other) { vcg::tri::Append<MlMesh, MlMesh>::MeshCopy(*mesh, *other.mesh); }
+  MlInput& operator=(const MlInput& other) {
+    if (this != &other) {
+      mesh = std::make_shared<MlMesh>();
+      vcg::tri::Append<MlMesh, MlMesh>::MeshCopy(*mesh, *other.mesh);
+    }
+    return *this;
+  }
+};
+
+Filler<MlInput> meshlab(const std::string& file) {
+  Filler<MlInput> f;
+  f.load = [file] {
+    MlInput in;
+    toMlMesh(readMesh(file), *in.mesh);
+    return in;
+  };
+  f.fill = [](MlInput& in) { return closeHolesLikeMeshLab(*in.mesh); };
+  f.write = [](MlInput& in, long faces, double ms, const std::string& stem) {
+    writeOff(stem + ".off", *in.mesh);
+    JsonObject j;
+    j.set("faces_added", faces).set("first_run_ms", ms);
+    writeJsonFile(stem + ".json", j);
+  };
+  return f;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeat = 5, limit = 600;
+  std::string outDir, file;
+  bool bad = false;
+  std::vector<std::string> names = {"meshmend_regression", "meshmend_biharmonic",
+                                    "meshmend_harmonic",   "meshmend_flat",
+                                    "cgal_refine_fair",    "meshlab_close_holes"};
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
+      limit = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--methods") && i + 1 < argc)
+      names = splitList(argv[++i]);
+    else if (!std::strcmp(argv[i], "--out-dir") && i + 1 < argc)
+      outDir = argv[++i];
+    else if (file.empty() && argv[i][0] != '-')
+      file = argv[i];
+    else
+      bad = true;
+  }
+  if (bad || file.empty()) {
+    std::fprintf(stderr,
+                 "usage: bench_holes [--repeat N] [--limit SECONDS] [--methods a,b,...] "
+                 "[--out-dir DIR] FILE\n");
+    return 1;
+  }
+  std::vector<JsonObject> results;
+  for (const std::string& name : names) {
+    const std::string stem = outDir.empty() ? "" : outDir + "/" + name;
+    std::pair<Method, Method> p;
+    if (name == "meshmend_regression")
+      p = passes(name, "ours", ours(file, HoleFairing::LaplacianRegression), stem, repeat);
+    else if (name == "meshmend_biharmonic")
+      p = passes(name, "alternative", ours(file, HoleFairing::Biharmonic), stem, repeat);
+    else if (name == "meshmend_harmonic")
+      p = passes(name, "alternative", ours(file, HoleFairing::Harmonic), stem, repeat);
+    else if (name == "meshmend_flat")
+      p = passes(name, "alternative", ours(file, HoleFairing::Flat), stem, repeat);
+    else if (name == "cgal_refine_fair")
+      p = passes(name, "peer", cgal(file), stem, repeat);
+    else if (name == "meshlab_close_holes")
+      p = passes(name, "peer", meshlab(file), stem, repeat);
+    else {
+      std::fprintf(stderr, "unknown method %s\n", name.c_str());
+      return 1;
+    }
+    const Measurement first = measure(p.first, 1, limit);
+    Measurement m = first;
+    if (first.ok) {
+      const double firstMs = double(first.result) / 1000;
+      if (firstMs <= kSlowMs && repeat > 1) {
+        m = measure(p.second, repeat, limit);
+      } else {          // too slow to repeat: the first run's own clock
+        m.result = -1;  // faces added: in the report
+        m.times_ms = {firstMs};
+        m.median_ms = m.min_ms = firstMs;
+      }
+    }
+    JsonObject j = toJson(m);
+    if (first.ok) j.set("first_run_ms", double(first.result) / 1000);
+    if (!stem.empty() && first.ok) j.set("output", stem + ".off").set("report", stem + ".json");
+    results.push_back(j);
+    std::fprintf(stderr, "  %-22s %s\n", name.c_str(), j.str().c_str());
+  }
+  JsonObject out;
+  out.set("file", file).set("repeat", repeat).set("methods", results);
+  std::printf("%s\n", out.str(true).c_str());
+}
