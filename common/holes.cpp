@@ -1125,6 +1125,11 @@ struct SplitOrigin {
 
 struct Surface {
   std::vector<Point3> points;
+  bool roundToFloat = false;  // new vertices take float coordinates (HoleFillOptions)
+  // Where a new vertex at p is stored.
+  Point3 stored(const Point3& p) const {
+    return roundToFloat ? Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))) : p;
+  }
   std::vector<Triangle> triangles;
   std::size_t inputVertices = 0, inputFaces = 0;
   std::unique_ptr<VertexFaces> adjacency;
@@ -1221,7 +1226,7 @@ std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Ch
       const int m = int(s.points.size());
       const int f0 = s.inputFace(f);
       if (std::size_t(f) < s.inputFaces && !s.inputCorners.count(f)) s.inputCorners[f] = t;
-      s.points.push_back((s.points[a] + s.points[b]) / 2);
+      s.points.push_back(s.stored((s.points[a] + s.points[b]) / 2));
       s.splitOrigins[m] = {f0, (s.barycentricIn(a, f0) + s.barycentricIn(b, f0)) / 2};
       undo.splitVertices.push_back(m);
       undo.changedFaces.push_back({f, t});
@@ -1468,6 +1473,8 @@ class HoleFiller {
         problems += std::string(problems.empty() ? "" : "; ") + toString(mode) + ": solver failed";
         continue;
       }
+      for (std::size_t v = n_; v < shape.positions.size(); ++v)
+        shape.positions[v] = s_.stored(shape.positions[v]);
       if (options_.check_intersections) {
         const std::vector<Point3> added(shape.positions.begin() + std::ptrdiff_t(n_),
                                         shape.positions.end());
@@ -1989,6 +1996,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   reportProgress(options.progress, 0, "Finding holes");
 
   Surface s;
+  s.roundToFloat = options.round_to_float;
   s.points = positionsOf(mesh);
   s.triangles = trianglesOf(mesh);
   s.inputVertices = s.points.size();

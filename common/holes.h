@@ -90,6 +90,9 @@ struct HoleFillOptions {
   // Recount, independently and exactly, the intersecting pairs that involve
   // new or split faces in the finished mesh (costs about as much as the checks).
   bool verify = false;
+  // New vertices take float coordinates (as MeshLab stores them) before the
+  // checks, so that what is checked is what is stored.
+  bool round_to_float = false;
   Progress progress;  // called once per hole
 };
 

@@ -110,6 +110,7 @@ bool HolesPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterLis
     options.long_edge_factor = parameters.getFloat("long_edge_factor");
     options.check_intersections = parameters.getBool("check_intersections");
     options.verify = parameters.getBool("verify");
+    options.round_to_float = true;  // MeshLab stores float: check what it will store
     options.progress = progressFrom(cb);
 
     reportProgress(options.progress, 0, "MeshMend: reading the layer");
