@@ -1,0 +1,1694 @@
+#include "common/stitch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <numeric>
+#include <queue>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/errors.h"
+#include "common/intersections.h"
+#include "common/predicates.h"
+
+namespace meshmend {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+std::uint64_t edgeKey(int a, int b) {
+  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+}
+std::uint64_t undirectedKey(int a, int b) {
+  return edgeKey(std::min(a, b), std::max(a, b));
+}
+
+// "vertex 123 (0.5, 1, -2)": where a user can find it in MeshLab.
+std::string describeVertex(const Mesh& mesh, int v) {
+  std::ostringstream s;
+  s.precision(6);
+  const Point3& p = mesh.vert[v].cP();
+  s << "vertex " << v << " (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+  return s.str();
+}
+
+void requireCompact(const Mesh& mesh) {
+  if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
+    throw InvalidInputError(
+        "the mesh has deleted vertices or faces: compact it first (vcg::tri::Allocator::Compact)");
+}
+
+void requireVertex(const Mesh& mesh, int v, const std::string& what) {
+  if (v < 0 || std::size_t(v) >= mesh.vert.size())
+    throw InvalidInputError(what + " refers to vertex " + std::to_string(v) +
+                            ", but the mesh has only " + std::to_string(mesh.vert.size()) +
+                            " vertices");
+}
+
+// Edges used by exactly one face, from the sorted edge uses.
+std::size_t borderEdgesOf(const std::vector<Triangle>& triangles) {
+  const std::vector<EdgeUse> uses = edgeUses(triangles);
+  std::size_t border = 0;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 1) ++border;
+    i = j;
+  }
+  return border;
+}
+
+// Vertex adjacency (each undirected edge once per end), sorted per vertex.
+struct Adjacency {
+  std::vector<int> start, next;
+  const int* begin(int v) const { return next.data() + start[v]; }
+  const int* end(int v) const { return next.data() + start[v + 1]; }
+  int degree(int v) const { return start[v + 1] - start[v]; }
+  bool joined(int a, int b) const { return std::binary_search(begin(a), end(a), b); }
+};
+
+Adjacency adjacencyOf(const std::vector<EdgeUse>& uses, int vertexCount) {
+  Adjacency adj;
+  adj.start.assign(std::size_t(vertexCount) + 1, 0);
+  for (std::size_t i = 0; i < uses.size(); ++i)
+    if (i == 0 || uses[i].u != uses[i - 1].u || uses[i].v != uses[i - 1].v) {
+      ++adj.start[uses[i].u + 1];
+      ++adj.start[uses[i].v + 1];
+    }
+  for (int v = 0; v < vertexCount; ++v) adj.start[v + 1] += adj.start[v];
+  adj.next.resize(adj.start.back());
+  std::vector<int> fill(adj.start.begin(), adj.start.end() - 1);
+  for (std::size_t i = 0; i < uses.size(); ++i)
+    if (i == 0 || uses[i].u != uses[i - 1].u || uses[i].v != uses[i - 1].v) {
+      adj.next[fill[uses[i].u]++] = uses[i].v;
+      adj.next[fill[uses[i].v]++] = uses[i].u;
+    }
+  for (int v = 0; v < vertexCount; ++v)
+    std::sort(adj.next.begin() + adj.start[v], adj.next.begin() + adj.start[v + 1]);
+  return adj;
+}
+
+// Copies provenance of the kept elements into a rebuilt mesh.
+void rebuildWithOrigins(Mesh& out, const std::vector<Point3>& points,
+                        const std::vector<Triangle>& triangles,
+                        const std::vector<VertexOrigin>& vertexOrigin,
+                        const std::vector<FaceOrigin>& faceOrigin) {
+  buildMesh(out, points, triangles);
+  VertexOriginHandle vo = vertexOrigins(out);
+  FaceOriginHandle fo = faceOrigins(out);
+  for (std::size_t v = 0; v < vertexOrigin.size(); ++v) vo[v] = vertexOrigin[v];
+  for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
+}
+
+// ================================================================ trimming
+
+// The loop through selected vertices. A sharp turn of the path makes a
+// triangle of three selected vertices; its third edge (the short cut) is
+// dropped when the middle vertex has no other selected neighbour, so that
+// such a turn is not mistaken for a branch.
+std::vector<int> loopFromSelection(const Mesh& mesh, const Adjacency& adj,
+                                   const std::vector<bool>& selected) {
+  const int n = int(mesh.vert.size());
+  if (selected.size() != std::size_t(n))
+    throw InvalidInputError("selected_vertices has " + std::to_string(selected.size()) +
+                            " flags for " + std::to_string(n) + " vertices");
+  std::vector<int> chosen;
+  for (int v = 0; v < n; ++v)
+    if (selected[v]) chosen.push_back(v);
+  if (chosen.empty()) throw InvalidInputError("no vertex is selected: select a closed loop");
+  std::unordered_map<int, std::vector<int>> nb;
+  for (int v : chosen) {
+    std::vector<int>& list = nb[v];
+    for (const int* w = adj.begin(v); w != adj.end(v); ++w)
+      if (selected[*w]) list.push_back(*w);
+  }
+  auto drop = [&](int a, int b) {
+    std::vector<int>& la = nb[a];
+    la.erase(std::find(la.begin(), la.end(), b));
+    std::vector<int>& lb = nb[b];
+    lb.erase(std::find(lb.begin(), lb.end(), a));
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int v : chosen) {
+      const std::vector<int>& lv = nb[v];
+      if (lv.size() != 2) continue;
+      const int a = lv[0], b = lv[1];
+      if (nb[a].size() > 2 && nb[b].size() > 2 &&
+          std::find(nb[a].begin(), nb[a].end(), b) != nb[a].end()) {
+        drop(a, b);
+        changed = true;
+      }
+    }
+  }
+  for (int v : chosen) {
+    const std::size_t d = nb[v].size();
+    if (d == 0)
+      throw InvalidInputError("the selection is not a closed loop: " + describeVertex(mesh, v) +
+                              " is selected but no selected vertex shares an edge with it");
+    if (d == 1)
+      throw InvalidInputError("the selection is not a closed loop: the path ends at " +
+                              describeVertex(mesh, v) +
+                              " (one selected neighbour along edges); select the vertices that "
+                              "close it");
+    if (d > 2)
+      throw InvalidInputError("the selection is not a single loop: " + describeVertex(mesh, v) +
+                              " has " + std::to_string(d) +
+                              " selected neighbours along edges (the path branches there)");
+  }
+  std::vector<int> loop{chosen.front()};
+  int prev = -1, cur = chosen.front();
+  while (true) {
+    const std::vector<int>& l = nb[cur];
+    const int next = l[0] != prev ? l[0] : l[1];
+    if (next == chosen.front()) break;
+    loop.push_back(next);
+    prev = cur;
+    cur = next;
+  }
+  if (loop.size() != chosen.size()) {
+    std::unordered_set<int> on(loop.begin(), loop.end());
+    for (int v : chosen)
+      if (!on.count(v))
+        throw InvalidInputError(
+            "the selection forms more than one loop: " + describeVertex(mesh, v) +
+            " is not on the loop through " + describeVertex(mesh, loop.front()));
+  }
+  if (loop.size() < 3) throw InvalidInputError("the selected loop has fewer than three vertices");
+  return loop;
+}
+
+// Picked vertices joined by shortest edge paths; each leg avoids the
+// vertices of the loop so far and the other picks, so the loop is simple.
+std::vector<int> loopFromPicks(const Mesh& mesh, const Adjacency& adj,
+                               const std::vector<int>& picks) {
+  const int n = int(mesh.vert.size());
+  for (int v : picks) requireVertex(mesh, v, "picked_vertices");
+  if (picks.size() < 3)
+    throw InvalidInputError("pick at least three vertices: two picks do not define a loop");
+  std::vector<char> used(n, 0);
+  for (int v : picks) {
+    if (used[v]) throw InvalidInputError(describeVertex(mesh, v) + " is picked twice");
+    used[v] = 1;
+  }
+  std::vector<double> dist(n, INFINITY);
+  std::vector<int> from(n, -1);
+  std::vector<int> touched;
+  std::vector<int> loop;
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const int s = picks[k], t = picks[(k + 1) % picks.size()];
+    for (int v : touched) dist[v] = INFINITY, from[v] = -1;
+    touched.clear();
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[s] = 0;
+    touched.push_back(s);
+    queue.push({0, s});
+    while (!queue.empty()) {
+      const auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (v == t) break;
+      for (const int* w = adj.begin(v); w != adj.end(v); ++w) {
+        if (used[*w] && *w != t) continue;
+        const double nd = d + (mesh.vert[*w].cP() - mesh.vert[v].cP()).Norm();
+        if (nd < dist[*w]) {
+          if (std::isinf(dist[*w])) touched.push_back(*w);
+          dist[*w] = nd;
+          from[*w] = v;
+          queue.push({nd, *w});
+        }
+      }
+    }
+    if (std::isinf(dist[t]))
+      throw InvalidInputError("no edge path from picked " + describeVertex(mesh, s) + " to " +
+                              describeVertex(mesh, t) +
+                              " avoids the rest of the loop: pick vertices on one connected "
+                              "part, or more of them");
+    std::vector<int> leg;
+    for (int v = from[t]; v != s; v = from[v]) leg.push_back(v);
+    loop.push_back(s);
+    for (auto it = leg.rbegin(); it != leg.rend(); ++it) {
+      loop.push_back(*it);
+      used[*it] = 1;
+    }
+  }
+  return loop;
+}
+
+}  // namespace
+
+TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
+  const auto start = Clock::now();
+  TrimResult result;
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+  requireCompact(mesh);
+  reportProgress(options.progress, 0, "Finding the loop");
+  const std::vector<Point3> P = positionsOf(mesh);
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const int n = int(P.size());
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  const Adjacency adj = adjacencyOf(uses, n);
+
+  std::vector<int> loop;
+  bool directed = true;
+  if (!options.loop.empty()) {
+    loop = options.loop;
+    if (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
+    for (int v : loop) requireVertex(mesh, v, "the loop");
+    if (loop.size() < 3) throw InvalidInputError("the loop needs at least three vertices");
+    std::vector<char> seen(n, 0);
+    for (int v : loop) {
+      if (seen[v])
+        throw InvalidInputError("the loop passes " + describeVertex(mesh, v) +
+                                " twice: a trim loop must be simple");
+      seen[v] = 1;
+    }
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const int a = loop[k], b = loop[(k + 1) % loop.size()];
+      if (!adj.joined(a, b))
+        throw InvalidInputError("the loop is broken between " + describeVertex(mesh, a) + " and " +
+                                describeVertex(mesh, b) + ": they share no edge");
+    }
+  } else if (!options.selected_vertices.empty()) {
+    loop = loopFromSelection(mesh, adj, options.selected_vertices);
+    directed = false;
+  } else if (!options.picked_vertices.empty()) {
+    loop = loopFromPicks(mesh, adj, options.picked_vertices);
+  } else {
+    throw InvalidInputError("no trim loop given: select a closed loop of vertices, or give it");
+  }
+  if (options.keep_face >= int(T.size()))
+    throw InvalidInputError("keep_face " + std::to_string(options.keep_face) +
+                            " is out of range (the mesh has " + std::to_string(T.size()) +
+                            " faces)");
+  if (options.keep_face < 0 && !directed)
+    throw InvalidInputError(
+        "a loop recovered from a selection has no direction: select a face on the side to keep");
+  result.loop = loop;
+  reportProgress(options.progress, 30, "Classifying faces");
+
+  // Loop edges, keyed undirected, with the loop's direction.
+  std::unordered_map<std::uint64_t, std::pair<int, int>> loopEdges;
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const int a = loop[k], b = loop[(k + 1) % loop.size()];
+    loopEdges[undirectedKey(a, b)] = {a, b};
+  }
+  // Faces joined across every edge that is not on the loop.
+  std::vector<int> parent(T.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::function<int(int)> root = [&](int f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  };
+  struct LoopUse {
+    int face;
+    bool along;  // runs the loop edge in the loop's direction
+    int a, b;
+  };
+  std::vector<LoopUse> loopUses;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    const auto it = loopEdges.find(undirectedKey(uses[i].u, uses[i].v));
+    if (it == loopEdges.end()) {
+      for (std::size_t k = i + 1; k < j; ++k) parent[root(uses[k].face)] = root(uses[i].face);
+    } else {
+      for (std::size_t k = i; k < j; ++k)
+        loopUses.push_back({uses[k].face, T[uses[k].face][uses[k].corner] == it->second.first,
+                            it->second.first, it->second.second});
+    }
+    i = j;
+  }
+  // 0 unknown, 1 keep, 2 remove, per face-component root.
+  std::vector<char> side(T.size(), 0);
+  auto notSeparating = [&](int a, int b) {
+    return TopologyError(
+        "the loop does not separate the mesh: the faces on both sides of its "
+        "edge from " +
+        describeVertex(mesh, a) + " to " + describeVertex(mesh, b) +
+        " are connected without crossing the loop (e.g. a loop around a handle "
+        "or across a strip)");
+  };
+  // The same component on both sides of one loop edge: nothing separates.
+  {
+    std::unordered_map<std::uint64_t, std::pair<int, int>> sides;  // edge -> (along, against) root
+    for (const LoopUse& u : loopUses) {
+      auto& s = sides.try_emplace(undirectedKey(u.a, u.b), -1, -1).first->second;
+      (u.along ? s.first : s.second) = root(u.face);
+      if (s.first >= 0 && s.first == s.second) throw notSeparating(u.a, u.b);
+    }
+  }
+  if (options.keep_face < 0) {
+    for (const LoopUse& u : loopUses) {
+      const int r = root(u.face);
+      const char want = u.along ? 1 : 2;
+      if (side[r] != 0 && side[r] != want)
+        throw TopologyError(
+            "the side to keep cannot be decided by the loop's direction near " +
+            describeVertex(mesh, u.a) +
+            ": the faces along the loop are inconsistently oriented, or the loop does not "
+            "separate the mesh; select a face on the side to keep");
+      side[r] = want;
+    }
+  } else {
+    // Two-colour the components: across a loop edge the sides differ.
+    std::unordered_map<int, std::vector<std::pair<int, bool>>> across;  // root -> (root, along)
+    std::unordered_map<std::uint64_t, std::vector<std::pair<int, bool>>> byEdge;
+    for (const LoopUse& u : loopUses)
+      byEdge[undirectedKey(u.a, u.b)].push_back({root(u.face), u.along});
+    for (const auto& [key, list] : byEdge)
+      for (const auto& x : list)
+        for (const auto& y : list)
+          if (x.second != y.second) across[x.first].push_back({y.first, true});
+    const int keepRoot = root(options.keep_face);
+    if (!across.count(keepRoot) && std::none_of(loopUses.begin(), loopUses.end(),
+                                                [&](auto& u) { return root(u.face) == keepRoot; }))
+      throw InvalidInputError("face " + std::to_string(options.keep_face) +
+                              " is not next to the loop on either side (it lies on a part of the "
+                              "mesh the loop does not touch)");
+    side[keepRoot] = 1;
+    std::vector<int> stack{keepRoot};
+    while (!stack.empty()) {
+      const int r = stack.back();
+      stack.pop_back();
+      for (const auto& [other, unused] : across[r]) {
+        (void)unused;
+        const char want = side[r] == 1 ? 2 : 1;
+        if (side[other] == 0) {
+          side[other] = want;
+          stack.push_back(other);
+        } else if (side[other] != want) {
+          for (const LoopUse& u : loopUses)
+            if (root(u.face) == other) throw notSeparating(u.a, u.b);
+        }
+      }
+    }
+    // Components on the loop that no loop edge ties to the kept side (a
+    // loop edge on a border has one face): the loop's direction relative to
+    // the kept side decides.
+    int keepAlong = 0;
+    for (const LoopUse& u : loopUses)
+      if (side[root(u.face)] != 0) keepAlong += (side[root(u.face)] == 1) == u.along ? 1 : -1;
+    for (const LoopUse& u : loopUses) {
+      const int r = root(u.face);
+      if (side[r] == 0) side[r] = (u.along == (keepAlong >= 0)) ? 1 : 2;
+    }
+  }
+
+  // Split the faces; provenance follows every element.
+  reportProgress(options.progress, 70, "Writing");
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  FaceOriginHandle fo = faceOrigins(mesh);
+  std::vector<char> onLoop(n, 0);
+  for (int v : loop) onLoop[v] = 1;
+  std::vector<char> usedByKept(n, 0), usedByRemoved(n, 0), usedAtAll(n, 0);
+  std::vector<char> removeFace(T.size(), 0);
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    removeFace[f] = side[root(int(f))] == 2;
+    for (int v : T[f]) (removeFace[f] ? usedByRemoved : usedByKept)[v] = 1;
+    for (int v : T[f]) usedAtAll[v] = 1;
+    if (onLoop[T[f][0]] && onLoop[T[f][1]] && onLoop[T[f][2]]) ++result.faces_on_loop;
+  }
+  auto part = [&](bool removed, std::vector<int>& index) {
+    std::vector<Point3> points;
+    std::vector<VertexOrigin> vorig;
+    index.assign(n, -1);
+    for (int v = 0; v < n; ++v) {
+      const bool keep =
+          removed ? usedByRemoved[v]
+                  : (usedByKept[v] || !usedAtAll[v] || !options.remove_unreferenced_vertices);
+      if (!keep) continue;
+      index[v] = int(points.size());
+      points.push_back(P[v]);
+      vorig.push_back(vo[v]);
+    }
+    std::vector<Triangle> tris;
+    std::vector<FaceOrigin> forig;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (bool(removeFace[f]) == removed) {
+        tris.push_back({index[T[f][0]], index[T[f][1]], index[T[f][2]]});
+        forig.push_back(fo[f]);
+      }
+    return std::make_tuple(points, tris, vorig, forig);
+  };
+  std::vector<int> removedIndex;
+  {
+    const auto [points, tris, vorig, forig] = part(true, removedIndex);
+    rebuildWithOrigins(result.removed, points, tris, vorig, forig);
+  }
+  result.border_edges_before = borderEdgesOf(T);
+  {
+    const auto [points, tris, vorig, forig] = part(false, result.vertex_index);
+    result.faces_kept = tris.size();
+    result.faces_removed = T.size() - tris.size();
+    result.border_edges_after = borderEdgesOf(tris);
+    rebuildWithOrigins(mesh, points, tris, vorig, forig);
+  }
+  reportProgress(options.progress, 100, "Done");
+  result.time_ms = msSince(start);
+  return result;
+}
+
+// ================================================================ stitching
+
+namespace {
+
+// For a few vertices of a mesh, every neighbour along an edge with the
+// number of faces that run the edge each way: enough to tell border edges,
+// their direction, and what a new face on an edge would do to it, in one
+// pass over the faces and without sorting the whole mesh's edges.
+class LocalEdges {
+ public:
+  struct Neighbour {
+    int v;
+    int out;  // faces running (this -> v)
+    int in;   // faces running (v -> this)
+  };
+
+  LocalEdges(const Mesh& mesh, const std::vector<int>& vertices) : slot_(mesh.vert.size(), -1) {
+    int slots = 0;
+    for (int v : vertices)
+      if (slot_[v] < 0) slot_[v] = slots++;
+    start_.assign(std::size_t(slots) + 1, 0);
+    const Vertex* base = mesh.vert.data();
+    auto forEachUse = [&](auto&& visit) {
+      for (const Face& f : mesh.face) {
+        const int c[3] = {int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
+        if (slot_[c[0]] < 0 && slot_[c[1]] < 0 && slot_[c[2]] < 0) continue;
+        for (int k = 0; k < 3; ++k) {
+          const int a = c[k], b = c[(k + 1) % 3];
+          if (slot_[a] >= 0) visit(slot_[a], b, true);
+          if (slot_[b] >= 0) visit(slot_[b], a, false);
+        }
+      }
+    };
+    forEachUse([&](int s, int, bool) { ++start_[s + 1]; });
+    for (int s = 0; s < slots; ++s) start_[s + 1] += start_[s];
+    entries_.resize(start_.back());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    forEachUse([&](int s, int w, bool out) {
+      entries_[fill[s]++] = Neighbour{w, out ? 1 : 0, out ? 0 : 1};
+    });
+    // Merge the uses of one edge (a vertex has few).
+    std::vector<int> newStart(start_.size(), 0);
+    std::size_t write = 0;
+    for (int s = 0; s < slots; ++s) {
+      auto b = entries_.begin() + start_[s], e = entries_.begin() + start_[s + 1];
+      std::sort(b, e, [](const Neighbour& x, const Neighbour& y) { return x.v < y.v; });
+      newStart[s] = int(write);
+      for (auto it = b; it != e; ++it) {
+        if (write > std::size_t(newStart[s]) && entries_[write - 1].v == it->v) {
+          entries_[write - 1].out += it->out;
+          entries_[write - 1].in += it->in;
+        } else {
+          entries_[write++] = *it;
+        }
+      }
+    }
+    newStart[slots] = int(write);
+    start_ = std::move(newStart);
+    entries_.resize(write);
+  }
+
+  // The entry for b among a's neighbours (a must be one of the vertices).
+  const Neighbour* find(int a, int b) const {
+    const int s = slot_[a];
+    for (int i = start_[s]; i < start_[s + 1]; ++i)
+      if (entries_[i].v == b) return &entries_[i];
+    return nullptr;
+  }
+  int uses(int a, int b) const {
+    const Neighbour* e = find(a, b);
+    return e ? e->out + e->in : 0;
+  }
+  bool onBorder(int a) const {
+    const int s = slot_[a];
+    for (int i = start_[s]; i < start_[s + 1]; ++i)
+      if (entries_[i].out + entries_[i].in == 1) return true;
+    return false;
+  }
+
+ private:
+  std::vector<int> slot_, start_;
+  std::vector<Neighbour> entries_;
+};
+
+// What a stitch will add, decided before the mesh changes.
+struct StitchPlan {
+  std::vector<Point3> newPoints;  // vertex n + k is newPoints[k]
+  std::vector<Triangle> faces;
+  std::array<int, 2> firstRung{-1, -1}, lastRung{-1, -1};
+  bool closed = false, reversedB = false;
+  std::size_t conflicts = 0;
+  long borderDelta = 0;  // border edges after minus before
+  double maxAspect = 0;
+};
+
+// Longest edge over shortest altitude (infinite for a degenerate triangle).
+double aspectRatio(const Point3& a, const Point3& b, const Point3& c) {
+  const double l = std::max({(b - a).SquaredNorm(), (c - b).SquaredNorm(), (a - c).SquaredNorm()});
+  const double area2 = ((b - a) ^ (c - a)).Norm();
+  return area2 > 0 ? l / area2 : INFINITY;
+}
+
+// Arc-length parametrised polyline, for comparing how two paths run.
+class Polyline {
+ public:
+  explicit Polyline(std::vector<Point3> points) : p_(std::move(points)), s_(p_.size(), 0) {
+    for (std::size_t i = 1; i < p_.size(); ++i) s_[i] = s_[i - 1] + (p_[i] - p_[i - 1]).Norm();
+  }
+  double length() const { return s_.back(); }
+  const std::vector<Point3>& points() const { return p_; }
+  // The point at arc length s (clamped), and the fractional vertex index.
+  Point3 at(double s, double* index = nullptr) const {
+    if (p_.size() == 1 || s <= 0) {
+      if (index) *index = 0;
+      return p_.front();
+    }
+    if (s >= s_.back()) {
+      if (index) *index = double(p_.size() - 1);
+      return p_.back();
+    }
+    const std::size_t i = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin() - 1;
+    const double span = s_[i + 1] - s_[i];
+    const double t = span > 0 ? (s - s_[i]) / span : 0;
+    if (index) *index = double(i) + t;
+    return p_[i] * (1 - t) + p_[i + 1] * t;
+  }
+
+ private:
+  std::vector<Point3> p_;
+  std::vector<double> s_;
+};
+
+// Sum of distances between points at the same arc-length fraction: small
+// when the two paths run side by side in the same direction.
+double correspondenceCost(const Polyline& a, const Polyline& b) {
+  constexpr int kSamples = 32;
+  double cost = 0;
+  for (int k = 0; k <= kSamples; ++k) {
+    const double t = double(k) / kSamples;
+    cost += (a.at(t * a.length()) - b.at(t * b.length())).Norm();
+  }
+  return cost;
+}
+
+std::vector<Point3> pointsOf(const Mesh& mesh, const std::vector<int>& path) {
+  std::vector<Point3> out;
+  out.reserve(path.size());
+  for (int v : path) out.push_back(mesh.vert[v].cP());
+  return out;
+}
+
+// The merge-like triangulation (§2.2) of the strip between lists a and b
+// (indices into `points`), from rung (a[0], b[0]) to (a.back(), b.back()):
+// each step advances along the list whose next diagonal is shorter, any
+// number of steps along one list. A step that would make a triangle with
+// exactly collinear corners takes the other list when it can. Faces are
+// `forward` = (a[i], a[i+1], b[j]) and (b[j], a[i], b[j+1]), else reversed.
+// Returns, per step, whether it advanced along a.
+template <class PointOf>
+std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, PointOf&& point,
+                         bool forward, std::vector<Triangle>& faces) {
+  std::vector<char> steps;
+  steps.reserve(a.size() + b.size());
+  std::size_t i = 0, j = 0;
+  while (i + 1 < a.size() || j + 1 < b.size()) {
+    bool alongA;
+    if (i + 1 == a.size()) {
+      alongA = false;
+    } else if (j + 1 == b.size()) {
+      alongA = true;
+    } else {
+      const Point3 &ai = point(a[i]), &ai1 = point(a[i + 1]), &bj = point(b[j]),
+                   &bj1 = point(b[j + 1]);
+      alongA = (ai1 - bj).SquaredNorm() <= (ai - bj1).SquaredNorm();
+      const bool flat = alongA ? collinear(ai, ai1, bj) : collinear(bj, ai, bj1);
+      if (flat && !(alongA ? collinear(bj, ai, bj1) : collinear(ai, ai1, bj))) alongA = !alongA;
+    }
+    if (alongA) {
+      faces.push_back(forward ? Triangle{a[i], a[i + 1], b[j]} : Triangle{a[i + 1], a[i], b[j]});
+      ++i;
+    } else {
+      faces.push_back(forward ? Triangle{b[j], a[i], b[j + 1]} : Triangle{a[i], b[j], b[j + 1]});
+      ++j;
+    }
+    steps.push_back(alongA);
+  }
+  return steps;
+}
+
+struct PreparedPath {
+  std::vector<int> v;
+  bool closed = false;
+  int sign = 0;  // +1: the path runs along its border edges' direction, -1 against, 0 unknown
+  std::size_t against = 0;  // border edges against the majority
+};
+
+PreparedPath preparePath(const Mesh& mesh, const BorderPath& path, const char* name) {
+  PreparedPath p;
+  p.v = path.vertices;
+  const std::string what = std::string("path ") + name;
+  for (int v : p.v) requireVertex(mesh, v, what);
+  bool repeated = false;
+  if (p.v.size() > 2 && p.v.front() == p.v.back()) {
+    p.v.pop_back();
+    repeated = true;
+  }
+  if (p.v.size() < 2 && !(p.v.size() == 1 && path.shape != BorderPath::Shape::Closed))
+    throw InvalidInputError(what + " has fewer than two vertices");
+  p.closed = path.shape == BorderPath::Shape::Closed ||
+             (path.shape == BorderPath::Shape::Auto && repeated);
+  if (path.shape == BorderPath::Shape::Closed && p.v.size() < 3)
+    throw InvalidInputError(what + " is a closed loop of fewer than three vertices");
+  return p;
+}
+
+void checkDistinct(const Mesh& mesh, const PreparedPath& p, std::vector<char>& seen,
+                   const char* name) {
+  for (int v : p.v) {
+    if (seen[v])
+      throw InvalidInputError(describeVertex(mesh, v) + " appears twice in path " + name);
+    seen[v] = 1;
+  }
+}
+
+// Direction of a path relative to its border edges, by majority.
+void orientPath(PreparedPath& p, const LocalEdges& edges) {
+  long along = 0, against = 0;
+  const std::size_t count = p.closed ? p.v.size() : p.v.size() - 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    const LocalEdges::Neighbour* e = edges.find(p.v[k], p.v[(k + 1) % p.v.size()]);
+    if (!e || e->out + e->in != 1) continue;
+    (e->out ? along : against)++;
+  }
+  p.sign = along > against ? 1 : against > along ? -1 : 0;
+  p.against = std::size_t(std::min(along, against));
+}
+
+template <class T>
+void rotate(std::vector<T>& v, std::size_t first) {
+  std::rotate(v.begin(), v.begin() + first, v.end());
+}
+
+StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
+  StitchPlan plan;
+  PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
+  {
+    std::vector<char> seen(mesh.vert.size(), 0);
+    checkDistinct(mesh, A, seen, "a");
+    std::vector<char> seenB(mesh.vert.size(), 0);
+    checkDistinct(mesh, B, seenB, "b");
+  }
+  std::vector<int> all = A.v;
+  all.insert(all.end(), B.v.begin(), B.v.end());
+  const LocalEdges edges(mesh, all);
+  for (const auto* p : {&A, &B})
+    for (int v : p->v)
+      if (!edges.onBorder(v))
+        throw InvalidInputError(describeVertex(mesh, v) + " of path " + (p == &A ? "a" : "b") +
+                                " is not on a border edge: stitch paths must follow borders");
+  // Auto shape: a path whose ends share a border edge goes all around.
+  for (auto [p, path] : {std::make_pair(&A, &o.a), std::make_pair(&B, &o.b)})
+    if (path->shape == BorderPath::Shape::Auto && !p->closed && p->v.size() >= 3 &&
+        edges.uses(p->v.front(), p->v.back()) == 1)
+      p->closed = true;
+  if (A.closed != B.closed)
+    throw InvalidInputError(
+        "one path is a closed loop and the other is open: stitch a loop to a loop, or give two "
+        "open paths");
+  plan.closed = A.closed;
+  // Shared vertices: only the ends of open paths (a crack closing at a point).
+  {
+    std::unordered_set<int> inA(A.v.begin(), A.v.end());
+    for (std::size_t k = 0; k < B.v.size(); ++k)
+      if (inA.count(B.v[k])) {
+        const bool endOfB = k == 0 || k + 1 == B.v.size();
+        const bool endOfA = B.v[k] == A.v.front() || B.v[k] == A.v.back();
+        if (A.closed || !endOfA || !endOfB)
+          throw InvalidInputError(describeVertex(mesh, B.v[k]) +
+                                  " is on both paths (only open paths may share an end)");
+      }
+  }
+  orientPath(A, edges);
+  orientPath(B, edges);
+
+  // Closed loops start at their nearest pair of vertices (nearest to a
+  // sample of a's vertices: linear, and good enough to start the zipper).
+  if (A.closed) {
+    const std::size_t samples = std::min<std::size_t>(A.v.size(), 32);
+    double best = INFINITY;
+    std::size_t bi = 0, bj = 0;
+    for (std::size_t s = 0; s < samples; ++s) {
+      const std::size_t i = s * A.v.size() / samples;
+      const Point3& p = mesh.vert[A.v[i]].cP();
+      for (std::size_t j = 0; j < B.v.size(); ++j) {
+        const double d = (mesh.vert[B.v[j]].cP() - p).SquaredNorm();
+        if (d < best) best = d, bi = i, bj = j;
+      }
+    }
+    rotate(A.v, bi);
+    rotate(B.v, bj);
+  }
+  // Which way b runs beside a: by geometry, and by orientation (a side
+  // that runs along its border must meet one that runs against it).
+  auto traversal = [&](const PreparedPath& p, bool reversed) {
+    std::vector<int> v = p.v;
+    if (reversed) std::reverse(v.begin() + (p.closed ? 1 : 0), v.end());
+    if (p.closed) v.push_back(v.front());
+    return v;
+  };
+  const Polyline polyA(pointsOf(mesh, traversal(A, false)));
+  const double costSame = correspondenceCost(polyA, Polyline(pointsOf(mesh, traversal(B, false))));
+  const double costReversed =
+      correspondenceCost(polyA, Polyline(pointsOf(mesh, traversal(B, true))));
+  const bool geometrySame = costSame <= costReversed;
+  bool same = geometrySame;
+  if (A.sign != 0 && B.sign != 0) {
+    const bool orientationSame = A.sign == -B.sign;
+    const double chosen = orientationSame ? costSame : costReversed;
+    const double other = orientationSame ? costReversed : costSame;
+    if (orientationSame != geometrySame && chosen > 2 * other) {
+      if (!o.allow_orientation_conflict)
+        throw TopologyError(
+            "the two sides are oppositely oriented: following the borders' directions would "
+            "twist the stitch across the gap (path a runs " +
+            std::string(A.sign > 0 ? "along" : "against") + " its border, path b " +
+            (B.sign > 0 ? "along" : "against") +
+            " its own, side by side); invert the faces of one side first");
+      plan.conflicts += B.v.size();
+    } else {
+      same = orientationSame;
+    }
+  }
+  plan.reversedB = !same;
+  if (!same) {
+    std::reverse(B.v.begin() + (B.closed ? 1 : 0), B.v.end());
+    B.sign = -B.sign;
+  }
+  // forward faces run a against a[i] -> a[i+1] and b along b[j+1] -> b[j]:
+  // right when a runs against its border and b along its own.
+  const bool forward = A.sign != 0 ? A.sign < 0 : B.sign != 0 ? B.sign > 0 : true;
+  plan.conflicts += A.against + B.against;
+
+  std::vector<int> a = A.v, b = B.v;
+  if (A.closed) {
+    a.push_back(a.front());
+    b.push_back(b.front());
+  } else {
+    if (b.front() == a.front()) b.erase(b.begin());
+    if (!b.empty() && b.back() == a.back()) b.pop_back();
+    if (b.empty()) throw InvalidInputError("path b has no vertex that path a does not share");
+  }
+
+  // Every edge of a path gets one new face: it must be a border edge run
+  // the other way, or no edge yet.
+  auto checkPathEdges = [&](const std::vector<int>& p, bool newFaceRunsForward, const char* name) {
+    for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+      const LocalEdges::Neighbour* e = edges.find(p[k], p[k + 1]);
+      const int used = e ? e->out + e->in : 0;
+      if (used == 0) {
+        ++plan.borderDelta;
+      } else if (used == 1) {
+        const bool existingForward = e->out == 1;
+        if (existingForward == newFaceRunsForward && !o.allow_orientation_conflict)
+          throw TopologyError("the border along path " + std::string(name) +
+                              " changes direction between " + describeVertex(mesh, p[k]) + " and " +
+                              describeVertex(mesh, p[k + 1]) +
+                              ": the faces there are inconsistently oriented");
+        --plan.borderDelta;
+      } else {
+        throw TopologyError("the edge from " + describeVertex(mesh, p[k]) + " to " +
+                            describeVertex(mesh, p[k + 1]) + " on path " + name +
+                            " already has two faces: the path leaves the border there");
+      }
+    }
+  };
+  checkPathEdges(a, forward, "a");
+  checkPathEdges(b, !forward, "b");
+
+  const int n = int(mesh.vert.size());
+  auto existingPoint = [&](int v) -> Point3 { return mesh.vert[v].cP(); };
+  std::vector<char> steps = zipper(a, b, existingPoint, forward, plan.faces);
+
+  // Rungs: an end rung may close an existing border edge; an inner rung
+  // gets two new faces, so it must not exist yet.
+  {
+    std::size_t i = 0, j = 0;
+    for (std::size_t s = 0; s <= steps.size(); ++s) {
+      const bool end = !A.closed && (s == 0 || s == steps.size());
+      const LocalEdges::Neighbour* e = a[i] != b[j] ? edges.find(a[i], b[j]) : nullptr;
+      const int used = e ? e->out + e->in : 0;
+      if (end) {
+        // The first face runs b[0] -> a[0] (forward), the last a -> b.
+        const bool newRunsAToB = (s == 0) != forward;
+        if (used == 0) {
+          ++plan.borderDelta;
+        } else if (used == 1 && (e->out == 1) != newRunsAToB) {
+          --plan.borderDelta;
+        } else {
+          throw TopologyError("the stitch would add a face to the edge from " +
+                              describeVertex(mesh, a[i]) + " to " + describeVertex(mesh, b[j]) +
+                              ", which " +
+                              (used == 1 ? "runs the same way" : "already has two faces"));
+        }
+      } else if (used > 0) {
+        throw TopologyError("the stitch would add two faces to the existing edge from " +
+                            describeVertex(mesh, a[i]) + " to " + describeVertex(mesh, b[j]) +
+                            ": the paths touch there; stitch shorter paths");
+      }
+      if (s < steps.size()) (steps[s] ? i : j)++;
+    }
+  }
+  if (!A.closed) {
+    plan.firstRung = {a.front(), b.front()};
+    plan.lastRung = {a.back(), b.back()};
+  }
+
+  // Subdivision: rows of new vertices across a wide strip.
+  if (o.max_aspect_ratio > 0) {
+    auto meanEdge = [&](const std::vector<int>& p) {
+      double sum = 0;
+      for (std::size_t k = 0; k + 1 < p.size(); ++k)
+        sum += (existingPoint(p[k + 1]) - existingPoint(p[k])).Norm();
+      return p.size() > 1 ? sum / double(p.size() - 1) : 0.0;
+    };
+    const double ha = meanEdge(a), hb = meanEdge(b.size() > 1 ? b : a);
+    const double h = 0.5 * (ha + hb);
+    std::vector<std::array<int, 2>> rungs{{a[0], b[0]}};
+    {
+      std::size_t i = 0, j = 0;
+      for (char s : steps) {
+        (s ? i : j)++;
+        rungs.push_back({a[i], b[j]});
+      }
+    }
+    double longest = 0;
+    for (const auto& r : rungs)
+      longest = std::max(longest, (existingPoint(r[0]) - existingPoint(r[1])).Norm());
+    const int strips =
+        h > 0 ? std::min(o.max_rows + 1, int(std::ceil(longest / (o.max_aspect_ratio * h)))) : 1;
+    if (strips > 1) {
+      plan.faces.clear();
+      std::vector<std::vector<int>> rows{a};
+      for (int k = 1; k < strips; ++k) {
+        const double t = double(k) / strips;
+        std::vector<Point3> curve;
+        for (const auto& r : rungs)
+          curve.push_back(existingPoint(r[0]) * (1 - t) + existingPoint(r[1]) * t);
+        const Polyline line(curve);
+        const double spacing = (1 - t) * ha + t * hb;
+        const int segments =
+            std::max(1, int(std::lround(line.length() / std::max(spacing, 1e-300))));
+        std::vector<int> row;
+        for (int s = 0; s <= segments; ++s) {
+          if (A.closed && s == segments) {
+            row.push_back(row.front());
+            break;
+          }
+          row.push_back(n + int(plan.newPoints.size()));
+          plan.newPoints.push_back(line.at(line.length() * s / segments));
+        }
+        rows.push_back(row);
+      }
+      rows.push_back(b);
+      auto anyPoint = [&](int v) -> Point3 {
+        return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
+      };
+      for (std::size_t k = 0; k + 1 < rows.size(); ++k)
+        zipper(rows[k], rows[k + 1], anyPoint, forward, plan.faces);
+      // End rungs are now chains of strips edges (new border edges).
+      if (!A.closed) {
+        const bool closesFirst = edges.uses(a.front(), b.front()) == 1;
+        const bool closesLast = edges.uses(a.back(), b.back()) == 1;
+        if (closesFirst || closesLast)
+          throw TopologyError(
+              "a wide stitch cannot be subdivided where its end rung is an existing edge");
+        plan.borderDelta += 2 * (strips - 1);
+      }
+    }
+  }
+  auto anyPoint = [&](int v) -> Point3 {
+    return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
+  };
+  for (const Triangle& t : plan.faces)
+    plan.maxAspect =
+        std::max(plan.maxAspect, aspectRatio(anyPoint(t[0]), anyPoint(t[1]), anyPoint(t[2])));
+  return plan;
+}
+
+// Exact count of the intersecting pairs that involve a planned face.
+std::size_t newIntersections(const Mesh& mesh, const StitchPlan& plan,
+                             std::vector<char>* badFaces = nullptr) {
+  std::vector<Point3> P = positionsOf(mesh);
+  P.insert(P.end(), plan.newPoints.begin(), plan.newPoints.end());
+  std::vector<Triangle> T = trianglesOf(mesh);
+  const std::size_t first = T.size();
+  T.insert(T.end(), plan.faces.begin(), plan.faces.end());
+  std::vector<char> changed(T.size(), 0);
+  std::fill(changed.begin() + first, changed.end(), 1);
+  const auto pairs = intersectingOf(P, T, pairsWithChangedFaces(P, T, changed));
+  if (badFaces) {
+    badFaces->assign(plan.faces.size(), 0);
+    for (const auto& p : pairs)
+      for (std::uint32_t f : p)
+        if (f >= first) (*badFaces)[f - first] = 1;
+  }
+  return pairs.size();
+}
+
+void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  FaceOriginHandle fo = faceOrigins(mesh);
+  const int layer = mesh.vert.empty() ? 0 : std::max(0, vo[0].layer);
+  const std::size_t n = mesh.vert.size(), m = mesh.face.size();
+  if (!plan.newPoints.empty()) {
+    auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, plan.newPoints.size());
+    for (std::size_t k = 0; k < plan.newPoints.size(); ++k, ++vi) {
+      vi->P() = plan.newPoints[k];
+      vo[n + k] = VertexOrigin{layer, -1, -1, {0, 0, 0}};
+      r.new_vertices.push_back(int(n + k));
+    }
+  }
+  if (!plan.faces.empty()) {
+    auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, plan.faces.size());
+    for (std::size_t k = 0; k < plan.faces.size(); ++k, ++fi) {
+      for (int c = 0; c < 3; ++c) fi->V(c) = &mesh.vert[plan.faces[k][c]];
+      fo[m + k] = FaceOrigin{layer, -1};
+      r.new_faces.push_back(int(m + k));
+    }
+  }
+  r.faces_added = plan.faces.size();
+  r.vertices_added = plan.newPoints.size();
+  r.closed = plan.closed;
+  r.reversed_b = plan.reversedB;
+  r.orientation_conflicts = plan.conflicts;
+  r.first_rung = plan.firstRung;
+  r.last_rung = plan.lastRung;
+  r.max_aspect_ratio = plan.maxAspect;
+}
+
+}  // namespace
+
+std::size_t countBorderEdges(const Mesh& mesh) {
+  return borderEdgesOf(trianglesOf(mesh));
+}
+
+StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
+  const auto start = Clock::now();
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+  requireCompact(mesh);
+  if (options.max_aspect_ratio < 0 || options.max_rows < 0)
+    throw InvalidInputError("max_aspect_ratio and max_rows must not be negative");
+  reportProgress(options.progress, 0, "Planning the stitch");
+  StitchResult r;
+  const StitchPlan plan = planStitch(mesh, options);
+  if (options.check_intersections) {
+    reportProgress(options.progress, 50, "Checking intersections");
+    r.remaining_intersecting_pairs = newIntersections(mesh, plan);
+    r.checked = true;
+  }
+  reportProgress(options.progress, 90, "Writing");
+  r.border_edges_before = countBorderEdges(mesh);
+  applyPlan(mesh, plan, r);
+  r.border_edges_after = std::size_t(long(r.border_edges_before) + plan.borderDelta);
+  reportProgress(options.progress, 100, "Done");
+  r.time_ms = msSince(start);
+  return r;
+}
+
+namespace {
+
+// Path p oriented to end at vertex x (an end of p, or one border edge
+// beyond it): the path, or empty when p does not reach x.
+std::vector<int> endingAt(const std::vector<int>& p, int x, const LocalEdges& edges) {
+  std::vector<int> v = p;
+  if (v.back() == x) return v;
+  if (v.front() == x) {
+    std::reverse(v.begin(), v.end());
+    return v;
+  }
+  if (edges.uses(x, v.back()) == 1) {
+    v.push_back(x);
+    return v;
+  }
+  if (edges.uses(x, v.front()) == 1) {
+    std::reverse(v.begin(), v.end());
+    v.push_back(x);
+    return v;
+  }
+  return {};
+}
+
+}  // namespace
+
+StitchSequenceResult stitchPathsSequence(Mesh& mesh, const StitchSequenceOptions& options) {
+  const auto start = Clock::now();
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+  requireCompact(mesh);
+  StitchSequenceResult result;
+  const int count = int(options.paths.size());
+  // Working copy: the mesh is unchanged when a step throws.
+  Mesh work = mesh;
+  std::vector<std::vector<int>> paths;
+  std::vector<BorderPath::Shape> shapes;
+  for (const BorderPath& p : options.paths) {
+    paths.push_back(p.vertices);
+    shapes.push_back(p.shape);
+  }
+  std::vector<int> owner(count);  // original index -> current path (union-find)
+  std::iota(owner.begin(), owner.end(), 0);
+  auto current = [&](int i) {
+    while (owner[i] != i) i = owner[i] = owner[owner[i]];
+    return i;
+  };
+  std::vector<char> used(count, 0);
+  result.border_edges_before = countBorderEdges(work);
+  for (std::size_t step = 0; step < options.pairs.size(); ++step) {
+    const std::string where = "step " + std::to_string(step + 1) + ": ";
+    const auto [ia, ib] = options.pairs[step];
+    if (ia < 0 || ib < 0 || ia >= count || ib >= count)
+      throw InvalidInputError(where + "path index out of range");
+    const int ca = current(ia), cb = current(ib);
+    if (ca == cb)
+      throw InvalidInputError(where + "paths " + std::to_string(ia) + " and " + std::to_string(ib) +
+                              " were concatenated into one path");
+    if (used[ca] || used[cb])
+      throw InvalidInputError(where + "a path was already stitched in an earlier step");
+    StitchOptions so = options.stitch;
+    so.a = BorderPath{paths[ca], shapes[ca]};
+    so.b = BorderPath{paths[cb], shapes[cb]};
+    so.progress = nullptr;
+    reportProgress(options.stitch.progress, int(100 * step / options.pairs.size()), "Stitching");
+    StitchResult r;
+    try {
+      r = stitchPaths(work, so);
+    } catch (const TopologyError& e) {
+      throw TopologyError(where + e.what());
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError(where + e.what());
+    }
+    used[ca] = used[cb] = 1;
+    result.concatenated.emplace_back();
+    if (options.concatenate && !r.closed) {
+      // A remaining path ending at one end of the stitch on a's side and
+      // another at the same end on b's side are joined through the rung.
+      for (const auto& rung : {r.first_rung, r.last_rung}) {
+        std::vector<int> candidates;
+        for (int i = 0; i < count; ++i)
+          if (current(i) == i && !used[i]) candidates.push_back(i);
+        std::vector<int> probe;
+        for (int i : candidates) probe.insert(probe.end(), paths[i].begin(), paths[i].end());
+        probe.push_back(rung[0]);
+        probe.push_back(rung[1]);
+        const LocalEdges edges(work, probe);
+        int u = -1, v = -1;
+        std::vector<int> pu, pv;
+        for (int i : candidates) {
+          if (u < 0) {
+            pu = endingAt(paths[i], rung[0], edges);
+            if (!pu.empty()) {
+              u = i;
+              continue;
+            }
+          }
+          if (v < 0) {
+            pv = endingAt(paths[i], rung[1], edges);
+            if (!pv.empty()) v = i;
+          }
+        }
+        if (u < 0 || v < 0) continue;
+        std::reverse(pv.begin(), pv.end());  // now starts at rung[1]
+        pu.insert(pu.end(), pv.begin(), pv.end());
+        paths[u] = pu;
+        shapes[u] = BorderPath::Shape::Open;
+        owner[v] = u;
+        result.concatenated.back().push_back({u, v});
+      }
+    }
+    result.faces_added += r.faces_added;
+    result.vertices_added += r.vertices_added;
+    result.remaining_intersecting_pairs += r.remaining_intersecting_pairs;
+    result.steps.push_back(r);
+  }
+  result.border_edges_after = countBorderEdges(work);
+  mesh = work;
+  result.time_ms = msSince(start);
+  return result;
+}
+
+std::vector<BorderPath> borderPathsFromSelection(const Mesh& mesh,
+                                                 const std::vector<bool>& selected) {
+  if (selected.size() != mesh.vert.size())
+    throw InvalidInputError("the selection has " + std::to_string(selected.size()) + " flags for " +
+                            std::to_string(mesh.vert.size()) + " vertices");
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  // Directed border edges between selected vertices: next / previous.
+  std::unordered_map<int, int> next, prev;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 1 && selected[uses[i].u] && selected[uses[i].v]) {
+      const int a = T[uses[i].face][uses[i].corner], b = T[uses[i].face][(uses[i].corner + 1) % 3];
+      // At a bow-tie vertex keep the first border edge out and in.
+      if (!next.count(a) && !prev.count(b)) {
+        next[a] = b;
+        prev[b] = a;
+      }
+    }
+    i = j;
+  }
+  std::vector<BorderPath> out;
+  std::unordered_set<int> done;
+  std::vector<int> starts;
+  for (const auto& [a, b] : next) starts.push_back(a);
+  std::sort(starts.begin(), starts.end());
+  // Open runs start where no border edge comes in; then the loops.
+  for (int pass = 0; pass < 2; ++pass)
+    for (int s : starts) {
+      if (done.count(s) || (pass == 0 && prev.count(s))) continue;
+      BorderPath p;
+      int v = s;
+      while (true) {
+        p.vertices.push_back(v);
+        done.insert(v);
+        const auto it = next.find(v);
+        if (it == next.end()) break;
+        v = it->second;
+        if (v == s) {
+          p.shape = BorderPath::Shape::Closed;
+          break;
+        }
+        if (done.count(v)) {
+          p.vertices.push_back(v);
+          break;
+        }
+      }
+      if (p.shape != BorderPath::Shape::Closed) p.shape = BorderPath::Shape::Open;
+      out.push_back(p);
+    }
+  return out;
+}
+
+// ================================================================ gap closing
+
+namespace {
+
+// Points within a distance of a query: a uniform grid (cell = the
+// distance), or exact coordinate buckets for distance 0.
+class NearPoints {
+ public:
+  NearPoints(const std::vector<Point3>& points, const std::vector<int>& ids, double radius)
+      : points_(points), radius_(radius) {
+    for (int id : ids) cells_[keyOf(points[id])].push_back(id);
+  }
+  template <class Visit>
+  void near(const Point3& q, Visit&& visit) const {
+    if (radius_ <= 0) {
+      const auto it = cells_.find(keyOf(q));
+      if (it != cells_.end())
+        for (int id : it->second)
+          if (points_[id] == q) visit(id);
+      return;
+    }
+    const auto c = cellOf(q);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(hash({c[0] + dx, c[1] + dy, c[2] + dz}));
+          if (it == cells_.end()) continue;
+          for (int id : it->second)
+            if ((points_[id] - q).SquaredNorm() <= radius_ * radius_) visit(id);
+        }
+  }
+
+ private:
+  std::array<long, 3> cellOf(const Point3& p) const {
+    return {long(std::floor(p[0] / radius_)), long(std::floor(p[1] / radius_)),
+            long(std::floor(p[2] / radius_))};
+  }
+  static std::uint64_t hash(const std::array<long, 3>& c) {
+    std::uint64_t h = 0;
+    for (long x : c) h = (h ^ std::uint64_t(x)) * 0x9E3779B97F4A7C15ull, h ^= h >> 29;
+    return h;
+  }
+  std::uint64_t keyOf(const Point3& p) const {
+    if (radius_ > 0) return hash(cellOf(p));
+    std::uint64_t h = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = p[k] == 0 ? 0.0 : p[k];
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h = (h ^ bits) * 0x9E3779B97F4A7C15ull;
+      h ^= h >> 32;
+    }
+    return h;
+  }
+  const std::vector<Point3>& points_;
+  double radius_;
+  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
+};
+
+struct BorderEdge {
+  int from, to;
+};
+
+std::vector<BorderEdge> borderEdgesDirected(const std::vector<Triangle>& T) {
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  std::vector<BorderEdge> out;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 1)
+      out.push_back({T[uses[i].face][uses[i].corner], T[uses[i].face][(uses[i].corner + 1) % 3]});
+    i = j;
+  }
+  return out;
+}
+
+// Step 1: border edges that coincide (within the tolerance) and run
+// opposite ways become one edge, merge by merge, each kept only if it
+// leaves every edge it touches with at most two faces running it opposite
+// ways and no face with a repeated corner.
+void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
+                            std::vector<int>& target, double tolerance, CloseGapsResult& r) {
+  const int n = int(P.size());
+  target.resize(n);
+  std::iota(target.begin(), target.end(), 0);
+  const std::vector<BorderEdge> border = borderEdgesDirected(T);
+  std::vector<int> borderVertices;
+  {
+    std::vector<char> on(n, 0);
+    for (const BorderEdge& e : border) on[e.from] = on[e.to] = 1;
+    for (int v = 0; v < n; ++v)
+      if (on[v]) borderVertices.push_back(v);
+  }
+  std::unordered_map<int, std::vector<int>> outEdges;  // vertex -> border edges leaving it
+  for (std::size_t k = 0; k < border.size(); ++k) outEdges[border[k].from].push_back(int(k));
+  const NearPoints near(P, borderVertices, tolerance);
+  // Candidates of edge e = (a -> b): edges (c -> d) with c at b and d at a.
+  auto candidates = [&](int e) {
+    std::vector<int> out;
+    const BorderEdge& be = border[e];
+    near.near(P[be.to], [&](int c) {
+      const auto it = outEdges.find(c);
+      if (it == outEdges.end()) return;
+      for (int f : it->second) {
+        if (f == e) continue;
+        const int d = border[f].to;
+        const double t2 = tolerance * tolerance;
+        if (tolerance > 0 ? (P[d] - P[be.from]).SquaredNorm() <= t2 : P[d] == P[be.from])
+          out.push_back(f);
+      }
+    });
+    return out;
+  };
+  std::vector<std::array<int, 2>> matches;
+  for (std::size_t e = 0; e < border.size(); ++e) {
+    const std::vector<int> c = candidates(int(e));
+    if (c.size() != 1 || c[0] < int(e)) continue;
+    const std::vector<int> back = candidates(c[0]);
+    if (back.size() == 1 && back[0] == int(e)) matches.push_back({int(e), c[0]});
+  }
+  if (matches.empty()) return;
+
+  // Faces per vertex and directed edge counts, updated merge by merge.
+  std::vector<std::vector<int>> facesOf(n);
+  for (std::size_t f = 0; f < T.size(); ++f)
+    for (int v : T[f]) facesOf[v].push_back(int(f));
+  std::unordered_map<std::uint64_t, int> directed;
+  for (const Triangle& t : T)
+    for (int k = 0; k < 3; ++k) ++directed[edgeKey(t[k], t[(k + 1) % 3])];
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& [e1, e2] : matches) {
+    // e1 = a -> b, e2 = c -> d: d joins a, c joins b.
+    const int a = root(border[e1].from), b = root(border[e1].to);
+    const int c = root(border[e2].from), d = root(border[e2].to);
+    std::unordered_map<int, int> into;
+    if (d != a) into[d] = a;
+    if (c != b) into[c] = b;
+    if (into.empty()) continue;
+    auto mapped = [&](int v) {
+      const auto it = into.find(v);
+      return it == into.end() ? v : it->second;
+    };
+    std::vector<int> affected;
+    for (const auto& [from, to] : into) {
+      (void)to;
+      affected.insert(affected.end(), facesOf[from].begin(), facesOf[from].end());
+    }
+    std::sort(affected.begin(), affected.end());
+    affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
+    bool ok = true;
+    std::vector<Triangle> changed;
+    for (int f : affected) {
+      const Triangle t{mapped(T[f][0]), mapped(T[f][1]), mapped(T[f][2])};
+      if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) ok = false;
+      changed.push_back(t);
+    }
+    std::vector<std::uint64_t> touched;
+    if (ok) {
+      for (std::size_t k = 0; k < affected.size(); ++k)
+        for (int i = 0; i < 3; ++i) {
+          const Triangle& t = T[affected[k]];
+          --directed[edgeKey(t[i], t[(i + 1) % 3])];
+        }
+      for (const Triangle& t : changed)
+        for (int i = 0; i < 3; ++i) {
+          ++directed[edgeKey(t[i], t[(i + 1) % 3])];
+          touched.push_back(edgeKey(t[i], t[(i + 1) % 3]));
+        }
+      for (std::uint64_t key : touched) {
+        const int u = int(key >> 32), v = int(key & 0xffffffffu);
+        const auto fwd = directed.find(edgeKey(u, v));
+        const auto bwd = directed.find(edgeKey(v, u));
+        const int nf = fwd == directed.end() ? 0 : fwd->second;
+        const int nb = bwd == directed.end() ? 0 : bwd->second;
+        if (nf > 1 || nf + nb > 2) ok = false;
+      }
+      if (!ok) {  // undo
+        for (const Triangle& t : changed)
+          for (int i = 0; i < 3; ++i) --directed[edgeKey(t[i], t[(i + 1) % 3])];
+        for (std::size_t k = 0; k < affected.size(); ++k)
+          for (int i = 0; i < 3; ++i) {
+            const Triangle& t = T[affected[k]];
+            ++directed[edgeKey(t[i], t[(i + 1) % 3])];
+          }
+      }
+    }
+    if (!ok) {
+      ++r.merges_skipped;
+      continue;
+    }
+    for (std::size_t k = 0; k < affected.size(); ++k) T[affected[k]] = changed[k];
+    for (const auto& [from, to] : into) {
+      parent[from] = to;
+      facesOf[to].insert(facesOf[to].end(), facesOf[from].begin(), facesOf[from].end());
+      facesOf[from].clear();
+      ++r.vertices_merged;
+    }
+    ++r.edges_merged;
+  }
+  for (int v = 0; v < n; ++v) target[v] = root(v);
+}
+
+// Border loops as vertex cycles, following border edges (at a vertex with
+// several, the first unused one).
+std::vector<std::vector<int>> borderLoops(const std::vector<Triangle>& T) {
+  const std::vector<BorderEdge> border = borderEdgesDirected(T);
+  std::unordered_map<int, std::vector<int>> out;
+  for (std::size_t k = 0; k < border.size(); ++k) out[border[k].from].push_back(int(k));
+  std::vector<char> done(border.size(), 0);
+  std::vector<std::vector<int>> loops;
+  for (std::size_t k = 0; k < border.size(); ++k) {
+    if (done[k]) continue;
+    std::vector<int> loop;
+    int e = int(k);
+    while (e >= 0 && !done[e]) {
+      done[e] = 1;
+      loop.push_back(border[e].from);
+      int nextEdge = -1;
+      for (int f : out[border[e].to])
+        if (!done[f]) {
+          nextEdge = f;
+          break;
+        }
+      if (border[e].to == loop.front()) break;
+      e = nextEdge;
+    }
+    if (loop.size() >= 2) loops.push_back(loop);
+  }
+  return loops;
+}
+
+}  // namespace
+
+CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
+  const auto start = Clock::now();
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+  requireCompact(mesh);
+  if (options.merge_tolerance < 0 || options.max_gap < 0 || options.max_aspect_ratio < 0)
+    throw InvalidInputError("merge_tolerance, max_gap and max_aspect_ratio must not be negative");
+  CloseGapsResult r;
+  std::vector<Point3> P = positionsOf(mesh);
+  std::vector<Triangle> T = trianglesOf(mesh);
+  r.border_edges_before = borderEdgesOf(T);
+
+  // ---- Step 1: merge coincident borders.
+  reportProgress(options.progress, 0, "Merging coincident borders");
+  std::vector<int> target;
+  mergeCoincidentBorders(P, T, target, options.merge_tolerance, r);
+  const int n = int(P.size());
+  r.vertex_index.assign(n, -1);
+  if (r.vertices_merged > 0) {
+    VertexOriginHandle vo = vertexOrigins(mesh);
+    FaceOriginHandle fo = faceOrigins(mesh);
+    std::vector<Point3> points;
+    std::vector<VertexOrigin> vorig;
+    for (int v = 0; v < n; ++v)
+      if (target[v] == v) {
+        r.vertex_index[v] = int(points.size());
+        points.push_back(P[v]);
+        vorig.push_back(vo[v]);
+      }
+    for (int v = 0; v < n; ++v) r.vertex_index[v] = r.vertex_index[target[v]];
+    std::vector<FaceOrigin> forig;
+    for (std::size_t f = 0; f < T.size(); ++f) {
+      for (int& v : T[f]) v = r.vertex_index[v];
+      forig.push_back(fo[f]);
+    }
+    rebuildWithOrigins(mesh, points, T, vorig, forig);
+    P = points;
+  } else {
+    std::iota(r.vertex_index.begin(), r.vertex_index.end(), 0);
+  }
+  r.border_edges_after_merge = borderEdgesOf(T);
+  r.border_edges_after = r.border_edges_after_merge;
+
+  // ---- Step 2: facing borders.
+  if (options.max_gap > 0) {
+    reportProgress(options.progress, 30, "Finding facing borders");
+    double bound = options.max_gap;
+    if (!options.gap_absolute) {
+      vcg::Box3d box;
+      for (const Point3& p : P) box.Add(p);
+      bound *= box.Diag();
+    }
+    const std::vector<std::vector<int>> loops = borderLoops(T);
+    std::vector<int> loopOf(P.size(), -1);
+    std::vector<int> ids;
+    for (std::size_t l = 0; l < loops.size(); ++l)
+      for (int v : loops[l]) {
+        loopOf[v] = int(l);
+        ids.push_back(v);
+      }
+    const NearPoints near(P, ids, bound);
+    // Each border vertex's nearest border vertex on another loop.
+    std::vector<int> partnerOf(P.size(), -1);
+    for (std::size_t l = 0; l < loops.size(); ++l)
+      for (int v : loops[l]) {
+        double bestD = INFINITY;
+        near.near(P[v], [&](int w) {
+          if (loopOf[w] == int(l)) return;
+          const double d = (P[w] - P[v]).SquaredNorm();
+          if (d < bestD) bestD = d, partnerOf[v] = w;
+        });
+      }
+    // Cyclic runs of a loop's vertices whose partners are on loop `other`.
+    auto runsOf = [&](int l, int other) {
+      std::vector<std::vector<int>> runs;
+      const std::vector<int>& loop = loops[l];
+      const std::size_t m = loop.size();
+      auto facing = [&](std::size_t k) {
+        const int w = partnerOf[loop[k % m]];
+        return w >= 0 && loopOf[w] == other;
+      };
+      std::size_t first = 0;
+      while (first < m && facing(first)) ++first;
+      if (first == m) return std::vector<std::vector<int>>{loop};  // the whole loop
+      for (std::size_t k = first + 1; k <= first + m; ++k) {
+        if (!facing(k)) continue;
+        std::vector<int> run;
+        while (k <= first + m && facing(k)) run.push_back(loop[k++ % m]);
+        if (int(run.size()) >= options.min_path_vertices) runs.push_back(run);
+      }
+      return runs;
+    };
+    std::vector<std::array<int, 2>> loopPairs;
+    {
+      std::set<std::array<int, 2>> seen;
+      for (std::size_t l = 0; l < loops.size(); ++l)
+        for (int v : loops[l])
+          if (const int w = partnerOf[v]; w >= 0) {
+            const std::array<int, 2> key{std::min(int(l), loopOf[w]), std::max(int(l), loopOf[w])};
+            if (seen.insert(key).second) loopPairs.push_back(key);
+          }
+    }
+    for (const auto& [l1, l2] : loopPairs) {
+      const auto runs1 = runsOf(l1, l2), runs2 = runsOf(l2, l1);
+      const bool whole1 = runs1.size() == 1 && runs1[0].size() == loops[l1].size();
+      const bool whole2 = runs2.size() == 1 && runs2[0].size() == loops[l2].size();
+      std::vector<char> taken(runs2.size(), 0);
+      for (const std::vector<int>& run : runs1) {
+        // The run of l2 holding most partners of this run.
+        std::unordered_map<int, int> runOf2;
+        for (std::size_t k = 0; k < runs2.size(); ++k)
+          for (int v : runs2[k]) runOf2[v] = int(k);
+        std::vector<int> votes(runs2.size(), 0);
+        for (int v : run) {
+          const auto it = runOf2.find(partnerOf[v]);
+          if (it != runOf2.end()) ++votes[it->second];
+        }
+        if (votes.empty()) continue;
+        const int k2 = int(std::max_element(votes.begin(), votes.end()) - votes.begin());
+        if (votes[k2] == 0 || taken[k2]) continue;
+        taken[k2] = 1;
+        GapReport g;
+        g.closed = whole1 && whole2;
+        g.path_a = run;
+        g.path_b = runs2[k2];
+        for (int v : g.path_a)
+          if (partnerOf[v] >= 0) g.gap = std::max(g.gap, (P[partnerOf[v]] - P[v]).Norm());
+        if ((whole1 || whole2) && !g.closed) {
+          g.reason = "a whole border loop faces only part of another loop";
+          r.gaps.push_back(g);
+          continue;
+        }
+        r.gaps.push_back(g);
+      }
+    }
+    r.gaps_found = r.gaps.size();
+    // Stitch each pair on the current mesh (earlier stitches change borders).
+    for (std::size_t k = 0; k < r.gaps.size(); ++k) {
+      GapReport& g = r.gaps[k];
+      reportProgress(options.progress, 40 + int(55 * k / std::max<std::size_t>(1, r.gaps.size())),
+                     "Stitching");
+      if (!g.reason.empty()) continue;
+      StitchOptions so;
+      so.a = {g.path_a, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
+      so.b = {g.path_b, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
+      so.max_aspect_ratio = options.max_aspect_ratio;
+      try {
+        const StitchPlan plan = planStitch(mesh, so);
+        if (plan.conflicts > 0) {
+          g.reason = "the two sides are inconsistently oriented";
+          continue;
+        }
+        if (options.check_intersections && newIntersections(mesh, plan) > 0) {
+          g.reason = "the stitch would intersect the mesh";
+          continue;
+        }
+        StitchResult sr;
+        applyPlan(mesh, plan, sr);
+        g.stitched = true;
+        g.faces_added = sr.faces_added;
+        r.faces_added += sr.faces_added;
+        r.vertices_added += sr.vertices_added;
+        r.border_edges_after = std::size_t(long(r.border_edges_after) + plan.borderDelta);
+        ++r.gaps_stitched;
+      } catch (const Error& e) {
+        g.reason = e.what();
+      }
+    }
+  }
+  reportProgress(options.progress, 100, "Done");
+  r.time_ms = msSince(start);
+  return r;
+}
+
+// ================================================================ reports
+
+JsonObject toJson(const TrimResult& r) {
+  JsonObject j;
+  j.set("border_edges_before", r.border_edges_before)
+      .set("border_edges_after", r.border_edges_after)
+      .set("faces_added", 0)
+      .set("vertices_merged", 0)
+      .set("loop_vertices", r.loop.size())
+      .set("faces_kept", r.faces_kept)
+      .set("faces_removed", r.faces_removed)
+      .set("faces_on_loop", r.faces_on_loop)
+      .set("time_ms", r.time_ms);
+  return j;
+}
+
+JsonObject toJson(const StitchResult& r) {
+  JsonObject j;
+  j.set("border_edges_before", r.border_edges_before)
+      .set("border_edges_after", r.border_edges_after)
+      .set("faces_added", r.faces_added)
+      .set("vertices_merged", 0)
+      .set("vertices_added", r.vertices_added)
+      .set("closed", r.closed)
+      .set("reversed_b", r.reversed_b)
+      .set("orientation_conflicts", r.orientation_conflicts)
+      .set("max_aspect_ratio", r.max_aspect_ratio);
+  if (r.checked) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
+  j.set("time_ms", r.time_ms);
+  return j;
+}
+
+JsonObject toJson(const StitchSequenceResult& r) {
+  std::vector<JsonObject> steps;
+  for (const StitchResult& s : r.steps) steps.push_back(toJson(s));
+  JsonObject j;
+  j.set("border_edges_before", r.border_edges_before)
+      .set("border_edges_after", r.border_edges_after)
+      .set("faces_added", r.faces_added)
+      .set("vertices_merged", 0)
+      .set("vertices_added", r.vertices_added)
+      .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs)
+      .set("steps", steps)
+      .set("time_ms", r.time_ms);
+  return j;
+}
+
+JsonObject toJson(const CloseGapsResult& r) {
+  std::vector<JsonObject> gaps;
+  for (const GapReport& g : r.gaps) {
+    JsonObject o;
+    o.set("path_a_vertices", g.path_a.size())
+        .set("path_b_vertices", g.path_b.size())
+        .set("closed", g.closed)
+        .set("gap", g.gap)
+        .set("stitched", g.stitched)
+        .set("faces_added", g.faces_added);
+    if (!g.reason.empty()) o.set("reason", g.reason);
+    gaps.push_back(o);
+  }
+  JsonObject j;
+  j.set("border_edges_before", r.border_edges_before)
+      .set("border_edges_after", r.border_edges_after)
+      .set("faces_added", r.faces_added)
+      .set("vertices_merged", r.vertices_merged)
+      .set("border_edges_after_merge", r.border_edges_after_merge)
+      .set("edges_merged", r.edges_merged)
+      .set("merges_skipped", r.merges_skipped)
+      .set("vertices_added", r.vertices_added)
+      .set("gaps_found", r.gaps_found)
+      .set("gaps_stitched", r.gaps_stitched)
+      .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs)
+      .set("gaps", gaps)
+      .set("time_ms", r.time_ms);
+  return j;
+}
+
+}  // namespace meshmend

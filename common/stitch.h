@@ -1,0 +1,249 @@
+// Trimming a mesh along a loop of its vertices and stitching borders across
+// gaps (Ekeberg et al., "Trimming and stitching of surface meshes for a
+// dynamic vocal tract", papers/002). Trimming (§2.1) removes the faces on one
+// side of a closed vertex loop without creating vertices; stitching (§2.2)
+// fills the gap between two border paths with the merge-like triangulation
+// that always takes the shorter of the two next diagonals. Beyond the paper:
+// loops come from selections or a few picked vertices, stitched faces are
+// oriented like the faces they join, closed loops are aligned automatically,
+// wide gaps can be subdivided, junctions of three or more patches are
+// stitched sequentially with the remaining paths concatenated (Figure 3),
+// and facing borders are found and closed automatically (closeGaps).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "common/json.h"
+#include "common/mesh.h"
+#include "common/progress.h"
+
+namespace meshmend {
+
+// ---------------------------------------------------------------- trimming
+
+struct TrimOptions {
+  // ---- The loop: exactly one of these three is used, the first non-empty.
+  // Loop vertices in order (the last joins back to the first; repeating the
+  // first at the end is allowed); consecutive vertices must share an edge.
+  std::vector<int> loop;
+  // One flag per vertex: the selected vertices must form one closed path
+  // along mesh edges (a triangle of three selected vertices at a sharp turn
+  // is allowed: its short cut is not part of the path).
+  std::vector<bool> selected_vertices;
+  // A few vertices in order, joined by shortest edge paths (Dijkstra on edge
+  // lengths) into a loop; each leg avoids the vertices of the earlier ones.
+  std::vector<int> picked_vertices;
+
+  // ---- The side to keep. A face index: the faces on its side of the loop
+  // are kept. -1: the loop's orientation decides (§2.1): kept are the faces
+  // that run the loop's edges in the loop's direction, i.e. the side on the
+  // left of the loop as seen from the side the normals point to. A loop
+  // recovered from a selection has no direction: it needs keep_face.
+  int keep_face = -1;
+  // Drop the vertices that only removed faces used (indices change: see
+  // TrimResult::vertex_index). false keeps every vertex (some unreferenced).
+  bool remove_unreferenced_vertices = true;
+  Progress progress;  // called between stages
+};
+
+struct TrimResult {
+  std::vector<int> loop;  // the loop used, input vertex indices, in its direction
+  Mesh removed;           // the removed faces and their vertices, provenance kept
+  // For every input vertex its index in the trimmed mesh (-1: dropped).
+  std::vector<int> vertex_index;
+  std::size_t faces_kept = 0;
+  std::size_t faces_removed = 0;
+  std::size_t faces_on_loop = 0;  // faces with all three corners on the loop (classified too)
+  std::size_t border_edges_before = 0;
+  std::size_t border_edges_after = 0;
+  double time_ms = 0;
+};
+
+// Removes the faces on one side of a closed vertex loop. No vertex is added
+// or moved; connected components the loop does not touch are kept.
+// Throws InvalidInputError for an empty mesh, a non-finite coordinate, deleted
+// elements, a vertex index out of range, consecutive loop vertices that share
+// no edge, or a selection that is not one closed path (the message names the
+// vertex where it breaks and its position); TopologyError when the loop does
+// not separate the mesh (both sides are connected around it) or the side
+// cannot be decided by orientation (inconsistently oriented faces along the
+// loop). The mesh is unchanged when it throws.
+TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options);
+
+// ---------------------------------------------------------------- stitching
+
+// A border path: vertices in order along a border (consecutive vertices
+// normally share a border edge; they need not).
+struct BorderPath {
+  std::vector<int> vertices;
+  // Open path or closed loop (the last vertex joins back to the first).
+  // Auto: closed when the first vertex is repeated at the end or the first
+  // and last vertices (of three or more) share a border edge.
+  enum class Shape { Auto, Open, Closed } shape = Shape::Auto;
+};
+
+struct StitchOptions {
+  BorderPath a, b;  // the two paths; every vertex must be on a border edge
+  // Subdivision of wide gaps: when a stitched triangle's rung (the edge
+  // across the gap) is longer than max_aspect_ratio x the mean edge length
+  // of the two paths, rows of new vertices are inserted across the whole
+  // strip, evenly spaced between the paths, and each row is resampled at
+  // the edge length interpolated between the paths. 0 = never (no new vertices).
+  double max_aspect_ratio = 0;
+  int max_rows = 64;  // at most this many rows of new vertices
+  // Stitching two sides whose faces are oppositely oriented (one of them
+  // would need flipping) is refused with a TopologyError unless this is set;
+  // then the new faces follow path a's side and the conflicts are counted.
+  bool allow_orientation_conflict = false;
+  // Exact check that no new face intersects the mesh (or another new face)
+  // beyond the corners they share; counted in remaining_intersecting_pairs.
+  bool check_intersections = true;
+  Progress progress;  // called between stages
+};
+
+struct StitchResult {
+  std::size_t faces_added = 0;
+  std::size_t vertices_added = 0;  // rows of the subdivision
+  std::size_t border_edges_before = 0;
+  std::size_t border_edges_after = 0;
+  bool closed = false;      // the paths were stitched as two closed loops
+  bool reversed_b = false;  // path b was traversed backwards (orientation or geometry)
+  std::size_t orientation_conflicts = 0;  // border edges of a path against its majority direction
+                                          // (+ the whole side when allow_orientation_conflict)
+  // Intersecting pairs (exact, the self-intersection rule) involving a new
+  // face: with check_intersections, how many the stitch created.
+  std::size_t remaining_intersecting_pairs = 0;
+  bool checked = false;         // remaining_intersecting_pairs was counted
+  double max_aspect_ratio = 0;  // of the new faces: longest edge / shortest altitude
+  // The two end rungs of an open stitch (vertex on path a, vertex on path b),
+  // which are new border edges unless they existed; {-1,-1} for loops.
+  std::array<int, 2> first_rung{-1, -1}, last_rung{-1, -1};
+  std::vector<int> new_faces;     // indices of the new faces in the mesh
+  std::vector<int> new_vertices;  // indices of the new vertices
+  double time_ms = 0;
+};
+
+// Stitches the gap between two border paths of `mesh` (two layers: append
+// them first, meshmend::appended, and offset the indices of the second).
+// New faces (and, with subdivision, vertices) are appended; existing
+// indices stay. Paths may share their first or last vertex (a crack that
+// closes at a point). Throws InvalidInputError for an empty mesh, a
+// non-finite coordinate, a path vertex out of range, repeated, on both
+// paths or not on a border edge (the message names it), an open path with a
+// closed one, or a path of fewer than two vertices; TopologyError when the
+// sides are oppositely oriented (see allow_orientation_conflict) or a new
+// face would make an edge non-manifold (three faces) or run an edge the same
+// way as the face already on it. The mesh is unchanged when it throws.
+StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options);
+
+// Several patches stitched pairwise, in order (§2.2, Figure 3): after each
+// stitch, two remaining paths whose ends the stitch joined (an end of one on
+// the stitched path a's end, an end of the other on path b's matching end)
+// are concatenated through the new end rung, so that a later stitch covers
+// the junction too.
+struct StitchSequenceOptions {
+  std::vector<BorderPath> paths;
+  // Pairs of indices into `paths`, stitched in this order. A path that was
+  // concatenated into another is referred to by either original index.
+  std::vector<std::array<int, 2>> pairs;
+  bool concatenate = true;  // concatenate remaining paths joined by a stitch
+  StitchOptions stitch;     // everything but a and b
+};
+
+struct StitchSequenceResult {
+  std::vector<StitchResult> steps;  // one per pair
+  // For every step, the paths concatenated after it (original indices).
+  std::vector<std::vector<std::array<int, 2>>> concatenated;
+  std::size_t faces_added = 0;
+  std::size_t vertices_added = 0;
+  std::size_t border_edges_before = 0;
+  std::size_t border_edges_after = 0;
+  std::size_t remaining_intersecting_pairs = 0;
+  double time_ms = 0;
+};
+
+// Throws like stitchPaths (the message names the step); the mesh is
+// unchanged when it throws.
+StitchSequenceResult stitchPathsSequence(Mesh& mesh, const StitchSequenceOptions& options);
+
+// The border paths formed by selected vertices (one flag per vertex): each
+// connected run of selected border vertices along border edges, in the
+// border's direction, closed when it is a whole border loop. Selected
+// vertices not on a border are ignored. For the plugins: "two paths on one
+// layer" are the two runs returned here.
+std::vector<BorderPath> borderPathsFromSelection(const Mesh& mesh,
+                                                 const std::vector<bool>& selected);
+
+// ---------------------------------------------------------------- gap closing
+
+struct CloseGapsOptions {
+  // ---- Step 1 (what CGAL's stitch_borders does, with a tolerance): pairs
+  // of border edges whose end points coincide within merge_tolerance
+  // (absolute; 0 = exactly equal coordinates) and that run opposite ways are
+  // merged into one edge. A merge that would make an edge non-manifold, run
+  // it the same way twice or collapse a face is skipped.
+  double merge_tolerance = 0;
+  // ---- Step 2: border loops (or parts of them) facing each other within
+  // this distance are stitched (stitchPaths' triangulation). Relative to the
+  // bounding box diagonal unless gap_absolute; 0 = no stitching.
+  double max_gap = 0.01;
+  bool gap_absolute = false;
+  // Runs of fewer border vertices facing another border are left open.
+  int min_path_vertices = 2;
+  double max_aspect_ratio = 0;  // subdivision of the stitched strips (StitchOptions)
+  // Exact check per stitch; a stitch whose faces would intersect the mesh is
+  // left out (with its reason).
+  bool check_intersections = true;
+  Progress progress;  // called between stages
+};
+
+// One pair of facing border paths.
+struct GapReport {
+  std::vector<int> path_a, path_b;  // vertex indices in the output mesh
+  bool closed = false;              // two whole loops
+  double gap = 0;                   // largest distance from a vertex to its partner
+  bool stitched = false;
+  std::size_t faces_added = 0;
+  std::string reason;  // why it was left open
+};
+
+struct CloseGapsResult {
+  std::size_t border_edges_before = 0;
+  std::size_t border_edges_after_merge = 0;
+  std::size_t border_edges_after = 0;
+  std::size_t vertices_merged = 0;  // step 1
+  std::size_t edges_merged = 0;     // border edge pairs merged in step 1
+  std::size_t merges_skipped = 0;   // step 1 pairs refused (manifoldness, orientation)
+  std::size_t faces_added = 0;      // step 2
+  std::size_t vertices_added = 0;   // step 2 subdivision
+  std::size_t gaps_found = 0;       // facing pairs
+  std::size_t gaps_stitched = 0;
+  std::size_t remaining_intersecting_pairs = 0;  // involving new faces (0 with the check)
+  std::vector<GapReport> gaps;
+  // For every input vertex its index in the output (merged vertices share one).
+  std::vector<int> vertex_index;
+  double time_ms = 0;
+};
+
+// Closes the gaps between the borders of `mesh` (in place). Vertices merged
+// in step 1 are removed (indices change: see vertex_index); stitched faces
+// are appended. Never creates a non-manifold edge or an orientation conflict.
+// Throws InvalidInputError for an empty mesh, a non-finite coordinate or a
+// bad option.
+CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options = {});
+
+// Edges used by exactly one face.
+std::size_t countBorderEdges(const Mesh& mesh);
+
+// The report_file keys: border_edges_before, border_edges_after,
+// faces_added, vertices_merged (0 where not applicable), time_ms, and the
+// operation's own counts.
+JsonObject toJson(const TrimResult& result);
+JsonObject toJson(const StitchResult& result);
+JsonObject toJson(const StitchSequenceResult& result);
+JsonObject toJson(const CloseGapsResult& result);
+
+}  // namespace meshmend

@@ -1,0 +1,673 @@
+#include "common/stitch.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include "common/errors.h"
+#include "common/intersections.h"
+#include "mesh_builders.h"
+
+using namespace meshmend;
+using namespace meshmend::testing;
+
+namespace {
+
+// Edge counts by use: border (one face), non-manifold (three or more),
+// inconsistent (two faces running the edge the same way).
+struct EdgeStats {
+  std::size_t border = 0, nonManifold = 0, inconsistent = 0;
+};
+EdgeStats edgeStats(const Mesh& mesh) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  EdgeStats s;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 1) ++s.border;
+    if (j - i > 2) ++s.nonManifold;
+    if (j - i == 2 && T[uses[i].face][uses[i].corner] == T[uses[i + 1].face][uses[i + 1].corner])
+      ++s.inconsistent;
+    i = j;
+  }
+  return s;
+}
+
+// A sheet of (nu x nv) quads, each cut into two triangles, with vertex
+// (i, j) at pos(i, j) (index j * (nu + 1) + i); faces turn from du to dv.
+Mesh sheet(int nu, int nv, const std::function<Point3(int, int)>& pos) {
+  std::vector<Point3> p;
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) p.push_back(pos(i, j));
+  auto at = [&](int i, int j) { return j * (nu + 1) + i; };
+  std::vector<Triangle> t;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return makeMesh(p, t);
+}
+
+std::vector<int> row(int nu, int j, int offset = 0) {
+  std::vector<int> r;
+  for (int i = 0; i <= nu; ++i) r.push_back(offset + j * (nu + 1) + i);
+  return r;
+}
+std::vector<int> column(int nu, int nv, int i, int offset = 0) {
+  std::vector<int> c;
+  for (int j = 0; j <= nv; ++j) c.push_back(offset + j * (nu + 1) + i);
+  return c;
+}
+
+std::vector<int> reversed(std::vector<int> v) {
+  std::reverse(v.begin(), v.end());
+  return v;
+}
+
+// A mesh with every face turned over.
+Mesh flipped(const Mesh& m) {
+  std::vector<Triangle> t = trianglesOf(m);
+  for (Triangle& f : t) std::swap(f[1], f[2]);
+  return makeMesh(positionsOf(m), t);
+}
+
+// Torus around the z axis (radii R, r): `nu` steps around the axis, `nv`
+// around the tube; closed, outward normals. Vertex (i, j) = j * nu + i.
+Mesh torus(int nu, int nv, double R = 1, double r = 0.3) {
+  std::vector<Point3> p;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double u = 2 * M_PI * i / nu, v = 2 * M_PI * j / nv;
+      p.emplace_back((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u),
+                     r * std::sin(v));
+    }
+  auto at = [&](int i, int j) { return (j % nv) * nu + (i % nu); };
+  std::vector<Triangle> t;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return makeMesh(p, t);
+}
+
+// Every property a stitched mesh must have: the border edges expected,
+// edge-manifold, consistently oriented, vertices as expected, and no
+// intersecting pair at all (the inputs have none), by the exact count.
+void expectClean(const Mesh& m, std::size_t border, std::size_t vertices) {
+  const EdgeStats s = edgeStats(m);
+  EXPECT_EQ(s.border, border);
+  EXPECT_EQ(s.nonManifold, 0u);
+  EXPECT_EQ(s.inconsistent, 0u);
+  EXPECT_EQ(m.vert.size(), vertices);
+  EXPECT_EQ(selfIntersectingPairs(m), 0u);
+}
+
+std::string messageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// ---------------------------------------------------------------- Figure 2
+
+// Two sheets facing each other across a gap that widens along x: sheet a
+// above the curve f, sheet b below f - gap, with different densities.
+// Returns the mesh (a then b) and the two facing rows.
+struct TwoSheets {
+  Mesh mesh;
+  std::vector<int> a, b;
+  std::size_t borderBefore = 0;
+};
+
+TwoSheets smoothSheets(int na, int nb, double widen) {
+  const double w = 2, h = 0.1;
+  auto f = [](double x) { return 0.3 * std::sin(2 * x); };
+  auto gap = [&](double x) { return 0.02 + widen * x; };
+  const Mesh A = sheet(na, 3, [&](int i, int j) {
+    const double x = w * i / na;
+    return Point3(x, f(x) + j * h, 0);
+  });
+  const Mesh B = sheet(nb, 3, [&](int i, int j) {
+    const double x = w * i / nb;
+    return Point3(x, f(x) - gap(x) - (3 - j) * h, 0);
+  });
+  TwoSheets s;
+  s.mesh = appended(A, B);
+  s.a = row(na, 0);
+  s.b = row(nb, 3, int(A.vert.size()));
+  s.borderBefore = 2 * (na + 3) + 2 * (nb + 3);
+  return s;
+}
+
+TEST(StitchFigure2, ParallelPathsWithWideningGap) {
+  TwoSheets s = smoothSheets(40, 27, 0.15);
+  const std::size_t vertices = s.mesh.vert.size();
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = s.b;
+  const StitchResult r = stitchPaths(s.mesh, o);
+  // One sheet: the path edges are interior, the two end rungs are border.
+  EXPECT_EQ(r.faces_added, 40u + 27u);
+  EXPECT_EQ(r.vertices_added, 0u);
+  EXPECT_EQ(r.border_edges_before, s.borderBefore);
+  EXPECT_EQ(r.border_edges_after, s.borderBefore - 40 - 27 + 2);
+  EXPECT_FALSE(r.closed);
+  EXPECT_FALSE(r.reversed_b);
+  EXPECT_EQ(r.orientation_conflicts, 0u);
+  EXPECT_TRUE(r.checked);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(s.mesh, r.border_edges_after, vertices);
+}
+
+TEST(StitchFigure2, PathGivenBackwardsIsTurnedAround) {
+  TwoSheets s = smoothSheets(30, 21, 0.1);
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = reversed(s.b);
+  const StitchResult r = stitchPaths(s.mesh, o);
+  EXPECT_TRUE(r.reversed_b);
+  expectClean(s.mesh, s.borderBefore - 30 - 21 + 2, s.mesh.vert.size());
+}
+
+TEST(StitchFigure2, SharplyTurningStaircasePaths) {
+  // Regular grids cut along curves: their borders are staircases with
+  // sharp turns, the gap between them widens, and the cells differ.
+  const double ca = 0.1, cb = 0.07, w = 2;
+  auto f = [](double x) { return 1.0 + 0.4 * std::sin(1.5 * x); };
+  auto g = [&](double x) { return f(x) - 0.05 - 0.25 * x; };
+  const int nxa = int(std::lround(w / ca)), nxb = int(std::lround(w / cb));
+  const Mesh A = heightGrid(
+      nxa, 20, ca, [](double, double) { return 0.0; },
+      [&](double x, double y) { return y > f(x); });
+  const Mesh B = heightGrid(
+      nxb, 30, cb, [](double, double) { return 0.0; },
+      [&](double x, double y) { return y < g(x); });
+  // The staircase of each grid: along x, climbing at the column changes.
+  auto staircase = [](int nx, int ny, double cell, const std::function<bool(double, double)>& keep,
+                      bool lowestKept, int offset) {
+    std::vector<int> path;
+    auto at = [&](int i, int j) { return offset + j * (nx + 1) + i; };
+    int prevRow = -1;
+    for (int i = 0; i < nx; ++i) {
+      // The row of the border in column i: below the lowest kept cell (a),
+      // above the highest kept cell (b).
+      int r = lowestKept ? ny : 0;
+      for (int j = 0; j < ny; ++j)
+        if (keep((i + 0.5) * cell, (j + 0.5) * cell)) {
+          if (lowestKept) {
+            r = std::min(r, j);
+          } else {
+            r = std::max(r, j + 1);
+          }
+        }
+      if (prevRow >= 0)
+        for (int j = prevRow; j != r; j += r > prevRow ? 1 : -1) path.push_back(at(i, j));
+      path.push_back(at(i, r));
+      prevRow = r;
+    }
+    path.push_back(at(nx, prevRow));
+    return path;
+  };
+  Mesh m = appended(A, B);
+  const std::size_t vertices = m.vert.size();
+  const std::size_t borderBefore = edgeStats(m).border;
+  StitchOptions o;
+  o.a.vertices = staircase(
+      nxa, 20, ca, [&](double x, double y) { return y > f(x); }, true, 0);
+  o.b.vertices = staircase(
+      nxb, 30, cb, [&](double x, double y) { return y < g(x); }, false, int(A.vert.size()));
+  const StitchResult r = stitchPaths(m, o);
+  const std::size_t pathEdges = o.a.vertices.size() - 1 + o.b.vertices.size() - 1;
+  EXPECT_EQ(r.faces_added, pathEdges);
+  EXPECT_EQ(r.border_edges_after, borderBefore - pathEdges + 2);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(m, r.border_edges_after, vertices);
+}
+
+TEST(StitchFigure2, WideGapSubdivided) {
+  TwoSheets s = smoothSheets(20, 15, 0.8);
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = s.b;
+  Mesh plain = s.mesh;
+  const StitchResult coarse = stitchPaths(plain, o);
+  o.max_aspect_ratio = 3;
+  const std::size_t vertices = s.mesh.vert.size();
+  const StitchResult r = stitchPaths(s.mesh, o);
+  EXPECT_GT(r.vertices_added, 0u);
+  EXPECT_EQ(s.mesh.vert.size(), vertices + r.vertices_added);
+  EXPECT_LT(r.max_aspect_ratio, coarse.max_aspect_ratio / 2);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  const EdgeStats st = edgeStats(s.mesh);
+  EXPECT_EQ(st.border, r.border_edges_after);
+  EXPECT_EQ(st.nonManifold, 0u);
+  EXPECT_EQ(st.inconsistent, 0u);
+  EXPECT_EQ(selfIntersectingPairs(s.mesh), 0u);
+}
+
+// ---------------------------------------------------------------- Figure 4
+
+TEST(StitchFigure4, NonCoplanarPatches) {
+  // Sheet a in the plane z = 0 (y >= 0.1); sheet b tilted by 40 degrees
+  // about the x axis, so that the two planes meet along y = z = 0, in the
+  // middle of the gap.
+  const int na = 24, nb = 17, nv = 4;
+  const double c = std::cos(40 * M_PI / 180), sn = std::sin(40 * M_PI / 180);
+  const Mesh A =
+      sheet(na, nv, [&](int i, int j) { return Point3(2.0 * i / na, 0.1 + 0.9 * j / nv, 0); });
+  const Mesh B = sheet(nb, nv, [&](int i, int j) {
+    const double s = 1 - 0.9 * j / nv;
+    return Point3(2.0 * i / nb, -s * c, s * sn);
+  });
+  Mesh m = appended(A, B);
+  const std::size_t vertices = m.vert.size();
+  StitchOptions o;
+  o.a.vertices = row(na, 0);
+  o.b.vertices = row(nb, nv, int(A.vert.size()));
+  const StitchResult r = stitchPaths(m, o);
+  EXPECT_EQ(r.faces_added, std::size_t(na + nb));
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(m, 2 * (na + nv) + 2 * (nb + nv) - na - nb + 2, vertices);
+}
+
+// ---------------------------------------------------------------- Figure 3
+
+// Three rhombi of a hexagon, each shrunk towards its centre so that gaps
+// separate them and their corners near the hexagon's centre form a small
+// triangle: the junction. Patch k has side `minus` (towards hexagon vertex
+// 2k) and `plus` (towards 2k + 2), both starting at its inner corner.
+struct ThreePatches {
+  Mesh mesh;
+  std::array<std::vector<int>, 3> minus, plus;
+  std::size_t outerBorder = 0;
+};
+
+ThreePatches threePatches(const std::array<int, 3>& n) {
+  ThreePatches t;
+  auto hex = [](int k) { return Point3(std::cos(M_PI * k / 3), std::sin(M_PI * k / 3), 0); };
+  int offset = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Point3 u = hex(2 * k), v = hex(2 * k + 2), centre = (u + v) / 2;
+    const Mesh patch = sheet(n[k], n[k], [&](int i, int j) {
+      const Point3 p = u * (double(i) / n[k]) + v * (double(j) / n[k]);
+      return centre + (p - centre) * 0.94;
+    });
+    t.minus[k] = row(n[k], 0, offset);
+    t.plus[k] = column(n[k], n[k], 0, offset);
+    t.outerBorder += 2 * n[k];
+    t.mesh = k == 0 ? patch : appended(t.mesh, patch);
+    offset += int(patch.vert.size());
+  }
+  return t;
+}
+
+TEST(StitchFigure3, JunctionOfThreePatchesIsCovered) {
+  ThreePatches t = threePatches({9, 7, 11});
+  const std::size_t vertices = t.mesh.vert.size();
+  // Patch 2 faces both others with one path through its inner corner.
+  std::vector<int> third = reversed(t.plus[2]);
+  third.insert(third.end(), t.minus[2].begin() + 1, t.minus[2].end());
+  StitchSequenceOptions o;
+  o.paths = {{t.plus[0]}, {t.minus[1]}, {t.minus[0]}, {t.plus[1]}, {third}};
+  o.pairs = {{0, 1}, {2, 4}};
+  const StitchSequenceResult r = stitchPathsSequence(t.mesh, o);
+  ASSERT_EQ(r.steps.size(), 2u);
+  ASSERT_EQ(r.concatenated[0].size(), 1u);  // paths 2 and 3 joined at the junction
+  EXPECT_EQ(r.concatenated[0][0], (std::array<int, 2>{2, 3}));
+  // Only the hexagon's outline is left open: its three patch sides and the
+  // three gap ends.
+  EXPECT_EQ(r.border_edges_after, t.outerBorder + 3);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(t.mesh, t.outerBorder + 3, vertices);
+}
+
+TEST(StitchFigure3, SeparateStitchesLeaveTheJunctionOpen) {
+  // Figure 3b: the three pairs stitched on their own miss the junction face.
+  ThreePatches t = threePatches({9, 7, 11});
+  StitchSequenceOptions o;
+  o.paths = {{t.plus[0]}, {t.minus[1]}, {t.plus[1]}, {t.minus[2]}, {t.plus[2]}, {t.minus[0]}};
+  o.pairs = {{0, 1}, {2, 3}, {4, 5}};
+  o.concatenate = false;
+  const StitchSequenceResult r = stitchPathsSequence(t.mesh, o);
+  EXPECT_EQ(r.border_edges_after, t.outerBorder + 3 + 3);  // the junction triangle is a hole
+  const EdgeStats s = edgeStats(t.mesh);
+  EXPECT_EQ(s.nonManifold, 0u);
+  EXPECT_EQ(s.inconsistent, 0u);
+}
+
+// ---------------------------------------------------------------- loops
+
+TEST(StitchLoops, TwoTubeEndsOfDifferentDensity) {
+  const Mesh A = openTube(24, 6, 1, 1);
+  const Mesh B = moved(openTube(17, 5, 1.1, 1), {0, 0, 1.3});
+  Mesh m = appended(A, B);
+  const std::size_t vertices = m.vert.size();
+  StitchOptions o;
+  for (int i = 0; i < 24; ++i) o.a.vertices.push_back(6 * 24 + (i + 5) % 24);   // top of A
+  for (int i = 0; i < 17; ++i) o.b.vertices.push_back(int(A.vert.size()) + i);  // bottom of B
+  const StitchResult r = stitchPaths(m, o);
+  EXPECT_TRUE(r.closed);
+  EXPECT_EQ(r.faces_added, 24u + 17u);
+  EXPECT_EQ(r.border_edges_after, 24u + 17u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(m, 24 + 17, vertices);
+}
+
+// ---------------------------------------------------------------- bad input
+
+TEST(StitchErrors, PathOnInteriorVertex) {
+  TwoSheets s = smoothSheets(10, 8, 0.1);
+  StitchOptions o;
+  o.a.vertices = row(10, 1);  // the second row of sheet a: interior
+  o.b.vertices = s.b;
+  const Mesh before = s.mesh;
+  const std::string msg = messageOf([&] { stitchPaths(s.mesh, o); });
+  EXPECT_NE(msg.find("vertex 12 "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("not on a border"), std::string::npos) << msg;
+  EXPECT_THROW(stitchPaths(s.mesh, o), InvalidInputError);
+  EXPECT_EQ(trianglesOf(s.mesh), trianglesOf(before));
+}
+
+TEST(StitchErrors, OppositelyOrientedSides) {
+  const int na = 10, nb = 8;
+  const Mesh A = sheet(na, 2, [&](int i, int j) { return Point3(1.0 * i / na, 0.1 + 0.1 * j, 0); });
+  const Mesh B =
+      flipped(sheet(nb, 2, [&](int i, int j) { return Point3(1.0 * i / nb, -0.2 + 0.1 * j, 0); }));
+  Mesh m = appended(A, B);
+  StitchOptions o;
+  o.a.vertices = row(na, 0);
+  o.b.vertices = row(nb, 2, int(A.vert.size()));
+  const std::string msg = messageOf([&] { stitchPaths(m, o); });
+  EXPECT_NE(msg.find("oppositely oriented"), std::string::npos) << msg;
+  EXPECT_THROW(stitchPaths(m, o), TopologyError);
+  o.allow_orientation_conflict = true;
+  const StitchResult r = stitchPaths(m, o);
+  EXPECT_GT(r.orientation_conflicts, 0u);
+}
+
+TEST(StitchErrors, EmptyMeshAndNaN) {
+  Mesh empty;
+  StitchOptions o;
+  o.a.vertices = {0, 1};
+  o.b.vertices = {2, 3};
+  EXPECT_THROW(stitchPaths(empty, o), InvalidInputError);
+  TrimOptions t;
+  t.loop = {0, 1, 2};
+  EXPECT_THROW(trimAlongLoop(empty, t), InvalidInputError);
+  EXPECT_THROW(closeGaps(empty), InvalidInputError);
+  TwoSheets s = smoothSheets(10, 8, 0.1);
+  s.mesh.vert[3].P()[1] = std::numeric_limits<double>::quiet_NaN();
+  o.a.vertices = s.a;
+  o.b.vertices = s.b;
+  EXPECT_THROW(stitchPaths(s.mesh, o), InvalidInputError);
+  EXPECT_THROW(closeGaps(s.mesh), InvalidInputError);
+}
+
+TEST(StitchErrors, VertexOutOfRangeOrRepeated) {
+  TwoSheets s = smoothSheets(10, 8, 0.1);
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = {1 << 20, 5};
+  EXPECT_THROW(stitchPaths(s.mesh, o), InvalidInputError);
+  o.b.vertices = s.a;  // both paths the same
+  EXPECT_THROW(stitchPaths(s.mesh, o), InvalidInputError);
+}
+
+// ---------------------------------------------------------------- trimming
+
+TEST(Trim, EquatorByListKeepsTheLeftSide) {
+  const int rings = 8, segments = 12;
+  Mesh m = uvSphere(rings, segments);
+  const std::size_t faces = m.face.size();
+  TrimOptions o;
+  for (int j = 0; j < segments; ++j) o.loop.push_back(1 + (rings / 2 - 1) * segments + j);
+  const TrimResult r = trimAlongLoop(m, o);
+  // Running east along the equator, the north is on the left seen from outside.
+  EXPECT_EQ(r.faces_kept + r.faces_removed, faces);
+  EXPECT_EQ(r.faces_kept, faces / 2);
+  EXPECT_EQ(r.border_edges_before, 0u);
+  EXPECT_EQ(r.border_edges_after, std::size_t(segments));
+  for (const Triangle& t : trianglesOf(m)) {
+    const std::vector<Point3> P = positionsOf(m);
+    EXPECT_GT((P[t[0]] + P[t[1]] + P[t[2]])[2], 0);
+  }
+  for (const Triangle& t : trianglesOf(r.removed)) {
+    const std::vector<Point3> P = positionsOf(r.removed);
+    EXPECT_LT((P[t[0]] + P[t[1]] + P[t[2]])[2], 0);
+  }
+  EXPECT_EQ(edgeStats(r.removed).border, std::size_t(segments));
+  // No vertex is new: the loop is in both halves.
+  EXPECT_EQ(m.vert.size() + r.removed.vert.size(),
+            positionsOf(uvSphere(rings, segments)).size() + std::size_t(segments));
+  // Provenance: kept faces name their input faces.
+  FaceOriginHandle fo = faceOrigins(m);
+  for (std::size_t f = 0; f < m.face.size(); ++f) EXPECT_GE(fo[f].face, 0);
+  // Going west keeps the south.
+  Mesh south = uvSphere(rings, segments);
+  o.loop = reversed(o.loop);
+  trimAlongLoop(south, o);
+  const std::vector<Point3> P = positionsOf(south);
+  for (const Triangle& t : trianglesOf(south)) EXPECT_LT((P[t[0]] + P[t[1]] + P[t[2]])[2], 0);
+}
+
+// A 6 x 6 grid (normals +z) and the boundary of the square [1,4]^2 on it,
+// counter-clockwise. At two corners of the square a face has all three
+// corners on the loop (the grid's diagonals cut those corners).
+Mesh flatGrid() {
+  return heightGrid(
+      6, 6, 1.0, [](double, double) { return 0.0; }, [](double, double) { return true; });
+}
+int gridAt(int i, int j) {
+  return j * 7 + i;
+}
+std::vector<int> squareLoop() {
+  std::vector<int> l;
+  for (int i = 1; i < 4; ++i) l.push_back(gridAt(i, 1));
+  for (int j = 1; j < 4; ++j) l.push_back(gridAt(4, j));
+  for (int i = 4; i > 1; --i) l.push_back(gridAt(i, 4));
+  for (int j = 4; j > 1; --j) l.push_back(gridAt(1, j));
+  return l;
+}
+
+TEST(Trim, FacesWithAllCornersOnTheLoop) {
+  Mesh m = flatGrid();
+  TrimOptions o;
+  o.loop = squareLoop();
+  const TrimResult r = trimAlongLoop(m, o);
+  EXPECT_EQ(r.faces_on_loop, 2u);
+  EXPECT_EQ(r.faces_kept, 18u);  // the 9 squares inside, both corner faces with them
+  EXPECT_EQ(r.faces_removed, 72u - 18u);
+  EXPECT_EQ(r.border_edges_after, 12u);
+  EXPECT_EQ(m.vert.size(), 16u);
+  EXPECT_EQ(edgeStats(r.removed).border, 24u + 12u);
+  // Clockwise: the outside is kept and the corner faces go.
+  Mesh outside = flatGrid();
+  o.loop = reversed(o.loop);
+  const TrimResult r2 = trimAlongLoop(outside, o);
+  EXPECT_EQ(r2.faces_kept, 72u - 18u);
+  EXPECT_EQ(r2.faces_on_loop, 2u);
+}
+
+TEST(Trim, SelectionWithSharpTurnsAndAKeptFace) {
+  Mesh m = flatGrid();
+  TrimOptions o;
+  o.selected_vertices.assign(m.vert.size(), false);
+  for (int v : squareLoop()) o.selected_vertices[v] = true;
+  EXPECT_THROW(trimAlongLoop(m, o), InvalidInputError);  // no direction, no face
+  o.keep_face = 0;                                       // the corner square at the origin
+  const TrimResult r = trimAlongLoop(m, o);
+  EXPECT_EQ(r.faces_kept, 72u - 18u);
+  EXPECT_EQ(r.loop.size(), 12u);
+  Mesh inside = flatGrid();
+  o.keep_face = 2 * (2 * 6 + 2);  // a face of the square (2, 2)
+  EXPECT_EQ(trimAlongLoop(inside, o).faces_kept, 18u);
+}
+
+TEST(Trim, PickedVerticesJoinedByShortestPaths) {
+  Mesh m = flatGrid();
+  TrimOptions o;
+  o.picked_vertices = {gridAt(1, 1), gridAt(4, 1), gridAt(4, 4), gridAt(1, 4)};
+  const TrimResult r = trimAlongLoop(m, o);
+  EXPECT_EQ(r.loop, squareLoop());
+  EXPECT_EQ(r.faces_kept, 18u);
+}
+
+TEST(Trim, SelectionThatIsNotALoopNamesTheVertex) {
+  Mesh m = flatGrid();
+  TrimOptions o;
+  o.keep_face = 0;
+  o.selected_vertices.assign(m.vert.size(), false);
+  for (int i = 1; i <= 4; ++i) o.selected_vertices[gridAt(i, 1)] = true;  // an open path
+  std::string msg = messageOf([&] { trimAlongLoop(m, o); });
+  EXPECT_NE(msg.find("the path ends at vertex 8 (1, 1, 0)"), std::string::npos) << msg;
+  // A branch.
+  for (int v : squareLoop()) o.selected_vertices[v] = true;
+  o.selected_vertices[gridAt(5, 2)] = true;
+  msg = messageOf([&] { trimAlongLoop(m, o); });
+  EXPECT_NE(msg.find("vertex 18 (4, 2, 0) has 3 selected neighbours"), std::string::npos) << msg;
+  EXPECT_THROW(trimAlongLoop(m, o), InvalidInputError);
+  // A list whose neighbours share no edge.
+  TrimOptions l;
+  l.loop = {gridAt(1, 1), gridAt(3, 1), gridAt(3, 3)};
+  msg = messageOf([&] { trimAlongLoop(m, l); });
+  EXPECT_NE(msg.find("share no edge"), std::string::npos) << msg;
+  EXPECT_EQ(m.face.size(), 72u);  // unchanged
+}
+
+TEST(Trim, LoopThatDoesNotSeparate) {
+  const int nu = 16, nv = 8;
+  Mesh m = torus(nu, nv);
+  TrimOptions o;
+  for (int j = 0; j < nv; ++j) o.loop.push_back(j * nu);  // around the tube: a meridian
+  const std::string msg = messageOf([&] { trimAlongLoop(m, o); });
+  EXPECT_NE(msg.find("does not separate"), std::string::npos) << msg;
+  EXPECT_THROW(trimAlongLoop(m, o), TopologyError);
+  o.keep_face = 5;
+  EXPECT_THROW(trimAlongLoop(m, o), TopologyError);
+  EXPECT_EQ(m.face.size(), std::size_t(2 * nu * nv));
+}
+
+TEST(Trim, ThenStitchBack) {
+  // Trim a sphere at the equator, then stitch the two halves back.
+  Mesh north = uvSphere(8, 12);
+  TrimOptions o;
+  for (int j = 0; j < 12; ++j) o.loop.push_back(1 + 3 * 12 + j);
+  TrimResult r = trimAlongLoop(north, o);
+  Mesh south = moved(r.removed, {0, 0, -0.2});
+  Mesh m = appended(north, south);
+  const std::vector<bool> all(m.vert.size(), true);
+  const std::vector<BorderPath> paths = borderPathsFromSelection(m, all);
+  ASSERT_EQ(paths.size(), 2u);
+  EXPECT_EQ(paths[0].shape, BorderPath::Shape::Closed);
+  StitchOptions so;
+  so.a = paths[0];
+  so.b = paths[1];
+  const StitchResult sr = stitchPaths(m, so);
+  EXPECT_TRUE(sr.closed);
+  EXPECT_EQ(sr.faces_added, 24u);
+  expectClean(m, 0, m.vert.size());
+}
+
+// ---------------------------------------------------------------- close gaps
+
+// The two halves of a grid cube cut at z = 1/2, as separate meshes (the
+// seam's vertices duplicated), the upper one lifted by `lift`.
+Mesh openBoxHalves(int n, double lift) {
+  const Mesh cube = gridCube(n);
+  const std::vector<Point3> P = positionsOf(cube);
+  std::vector<Triangle> lower, upper;
+  for (const Triangle& t : trianglesOf(cube))
+    ((P[t[0]] + P[t[1]] + P[t[2]])[2] < 1.5 ? lower : upper).push_back(t);
+  return appended(makeMesh(P, lower), moved(makeMesh(P, upper), {0, 0, lift}));
+}
+
+TEST(CloseGaps, CoincidentDuplicatedBorderVertices) {
+  const int n = 4;
+  Mesh m = openBoxHalves(n, 0);
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_EQ(r.border_edges_before, 2u * 4 * n);
+  EXPECT_EQ(r.vertices_merged, 4u * n);
+  EXPECT_EQ(r.edges_merged, 4u * n);
+  EXPECT_EQ(r.merges_skipped, 0u);
+  EXPECT_EQ(r.faces_added, 0u);
+  EXPECT_EQ(r.border_edges_after, 0u);
+  expectClean(m, 0, 6u * n * n + 2);
+}
+
+TEST(CloseGaps, NearlyCoincidentWithinTolerance) {
+  Mesh m = openBoxHalves(4, 1e-7);
+  CloseGapsOptions o;
+  o.max_gap = 0;
+  EXPECT_EQ(closeGaps(m, o).vertices_merged, 0u);  // exact coincidence only
+  o.merge_tolerance = 1e-6;
+  const CloseGapsResult r = closeGaps(m, o);
+  EXPECT_EQ(r.vertices_merged, 16u);
+  EXPECT_EQ(r.border_edges_after, 0u);
+}
+
+TEST(CloseGaps, SmallGapBetweenBoxHalvesIsStitched) {
+  const int n = 4;
+  Mesh m = openBoxHalves(n, 0.02);
+  const std::size_t vertices = m.vert.size();
+  CloseGapsOptions o;
+  o.max_gap = 0.02;  // of the bounding box diagonal (about 1.75)
+  const CloseGapsResult r = closeGaps(m, o);
+  EXPECT_EQ(r.vertices_merged, 0u);
+  ASSERT_EQ(r.gaps_found, 1u);
+  EXPECT_TRUE(r.gaps[0].closed);
+  EXPECT_TRUE(r.gaps[0].stitched) << r.gaps[0].reason;
+  EXPECT_EQ(r.faces_added, 8u * n);
+  EXPECT_EQ(r.border_edges_after, 0u);
+  expectClean(m, 0, vertices);
+  // A bound below the gap leaves it open.
+  Mesh far = openBoxHalves(n, 0.02);
+  o.max_gap = 0.005;
+  EXPECT_EQ(closeGaps(far, o).border_edges_after, 2u * 4 * n);
+}
+
+TEST(CloseGaps, FacingSidesOfTwoPlates) {
+  // Two plates side by side: only their facing sides are stitched.
+  const Mesh A = sheet(10, 5, [](int i, int j) { return Point3(0.1 * i, 0.1 * j, 0); });
+  const Mesh B = sheet(7, 5, [](int i, int j) { return Point3(1.03 + 0.1 * i, 0.1 * j, 0); });
+  Mesh m = appended(A, B);
+  CloseGapsOptions o;
+  o.max_gap = 0.04;
+  o.gap_absolute = true;
+  const CloseGapsResult r = closeGaps(m, o);
+  EXPECT_EQ(r.gaps_stitched, 1u);
+  EXPECT_EQ(r.faces_added, 10u);
+  expectClean(m, 2 * 15 + 2 * 12 - 10 + 2, m.vert.size());
+  EXPECT_EQ(r.border_edges_after, 2u * 15 + 2 * 12 - 10 + 2);
+}
+
+TEST(Reports, JsonKeys) {
+  TwoSheets s = smoothSheets(10, 8, 0.1);
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = s.b;
+  const std::string j = toJson(stitchPaths(s.mesh, o)).str();
+  for (const char* key :
+       {"border_edges_before", "border_edges_after", "faces_added", "vertices_merged", "time_ms"})
+    EXPECT_NE(j.find(key), std::string::npos) << key;
+  Mesh box = openBoxHalves(3, 0);
+  const std::string c = toJson(closeGaps(box)).str();
+  for (const char* key :
+       {"border_edges_before", "border_edges_after", "faces_added", "vertices_merged", "time_ms"})
+    EXPECT_NE(c.find(key), std::string::npos) << key;
+  Mesh g = flatGrid();
+  TrimOptions t;
+  t.loop = squareLoop();
+  const std::string tj = toJson(trimAlongLoop(g, t)).str();
+  EXPECT_NE(tj.find("\"vertices_merged\":0"), std::string::npos) << tj;
+}
+
+}  // namespace
