@@ -473,8 +473,9 @@ class LocalEdges {
  public:
   struct Neighbour {
     int v;
-    int out;  // faces running (this -> v)
-    int in;   // faces running (v -> this)
+    int out;       // faces running (this -> v)
+    int in;        // faces running (v -> this)
+    int opposite;  // the third corner of a face on the edge
   };
 
   LocalEdges(const Mesh& mesh, const std::vector<int>& vertices) : slot_(mesh.vert.size(), -1) {
@@ -489,17 +490,18 @@ class LocalEdges {
         if (slot_[c[0]] < 0 && slot_[c[1]] < 0 && slot_[c[2]] < 0) continue;
         for (int k = 0; k < 3; ++k) {
           const int a = c[k], b = c[(k + 1) % 3];
-          if (slot_[a] >= 0) visit(slot_[a], b, true);
-          if (slot_[b] >= 0) visit(slot_[b], a, false);
+          const int o = c[(k + 2) % 3];
+          if (slot_[a] >= 0) visit(slot_[a], b, true, o);
+          if (slot_[b] >= 0) visit(slot_[b], a, false, o);
         }
       }
     };
-    forEachUse([&](int s, int, bool) { ++start_[s + 1]; });
+    forEachUse([&](int s, int, bool, int) { ++start_[s + 1]; });
     for (int s = 0; s < slots; ++s) start_[s + 1] += start_[s];
     entries_.resize(start_.back());
     std::vector<int> fill(start_.begin(), start_.end() - 1);
-    forEachUse([&](int s, int w, bool out) {
-      entries_[fill[s]++] = Neighbour{w, out ? 1 : 0, out ? 0 : 1};
+    forEachUse([&](int s, int w, bool out, int o) {
+      entries_[fill[s]++] = Neighbour{w, out ? 1 : 0, out ? 0 : 1, o};
     });
     // Merge the uses of one edge (a vertex has few).
     std::vector<int> newStart(start_.size(), 0);
@@ -524,7 +526,8 @@ class LocalEdges {
 
   // The entry for b among a's neighbours (a must be one of the vertices).
   const Neighbour* find(int a, int b) const {
-    const int s = slot_[a];
+    const int s = a >= 0 && std::size_t(a) < slot_.size() ? slot_[a] : -1;
+    if (s < 0) return nullptr;
     for (int i = start_[s]; i < start_[s + 1]; ++i)
       if (entries_[i].v == b) return &entries_[i];
     return nullptr;
@@ -616,12 +619,14 @@ std::vector<Point3> pointsOf(const Mesh& mesh, const std::vector<int>& path) {
 // (indices into `points`), from rung (a[0], b[0]) to (a.back(), b.back()):
 // each step advances along the list whose next diagonal is shorter, any
 // number of steps along one list. A step that would make a triangle with
-// exactly collinear corners takes the other list when it can. Faces are
+// exactly collinear corners takes the other list when it can, and so does a
+// step whose triangle would fold back over the face on its path edge
+// (valid(p, q, x): x lies beyond edge p-q, away from that face). Faces are
 // `forward` = (a[i], a[i+1], b[j]) and (b[j], a[i], b[j+1]), else reversed.
 // Returns, per step, whether it advanced along a.
-template <class PointOf>
+template <class PointOf, class Valid>
 std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, PointOf&& point,
-                         bool forward, std::vector<Triangle>& faces) {
+                         Valid&& valid, bool forward, std::vector<Triangle>& faces) {
   std::vector<char> steps;
   steps.reserve(a.size() + b.size());
   std::size_t i = 0, j = 0;
@@ -635,6 +640,8 @@ std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, P
       const Point3 &ai = point(a[i]), &ai1 = point(a[i + 1]), &bj = point(b[j]),
                    &bj1 = point(b[j + 1]);
       alongA = (ai1 - bj).SquaredNorm() <= (ai - bj1).SquaredNorm();
+      const bool validA = valid(a[i], a[i + 1], b[j]), validB = valid(b[j], b[j + 1], a[i]);
+      if (validA != validB) alongA = validA;
       const bool flat = alongA ? collinear(ai, ai1, bj) : collinear(bj, ai, bj1);
       if (flat && !(alongA ? collinear(bj, ai, bj1) : collinear(ai, ai1, bj))) alongA = !alongA;
     }
@@ -841,7 +848,16 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
 
   const int n = int(mesh.vert.size());
   auto existingPoint = [&](int v) -> Point3 { return mesh.vert[v].cP(); };
-  std::vector<char> steps = zipper(a, b, existingPoint, forward, plan.faces);
+  // Beyond edge p-q: on the other side of it than the face already on it,
+  // measured in that face's plane (any point is beyond an edge with no face).
+  auto beyond = [&](int p, int q, int x) {
+    const LocalEdges::Neighbour* e = edges.find(p, q);
+    if (!e || e->out + e->in != 1 || x >= n) return true;
+    const Point3 P = existingPoint(p), d = existingPoint(q) - P;
+    const Point3 normal = d ^ (existingPoint(e->opposite) - P);
+    return ((d ^ (existingPoint(x) - P)) * normal) < 0;
+  };
+  std::vector<char> steps = zipper(a, b, existingPoint, beyond, forward, plan.faces);
 
   // Rungs: an end rung may close an existing border edge; an inner rung
   // gets two new faces, so it must not exist yet.
@@ -895,11 +911,21 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
         rungs.push_back({a[i], b[j]});
       }
     }
-    double longest = 0;
-    for (const auto& r : rungs)
-      longest = std::max(longest, (existingPoint(r[0]) - existingPoint(r[1])).Norm());
-    const int strips =
-        h > 0 ? std::min(o.max_rows + 1, int(std::ceil(longest / (o.max_aspect_ratio * h)))) : 1;
+    double longest = 0, shortest = INFINITY;
+    for (const auto& r : rungs) {
+      const double l = (existingPoint(r[0]) - existingPoint(r[1])).Norm();
+      longest = std::max(longest, l);
+      shortest = std::min(shortest, l);
+    }
+    // One row count for the whole strip: enough for the widest rung, but
+    // never so many that rows crowd closer than h / max_aspect_ratio where
+    // the gap is narrowest (that would trade long slivers for flat ones).
+    int strips = 1;
+    if (h > 0) {
+      strips = int(std::ceil(longest / (o.max_aspect_ratio * h)));
+      strips = std::min(strips, int(std::floor(shortest * o.max_aspect_ratio / h)));
+      strips = std::max(1, std::min(strips, o.max_rows + 1));
+    }
     if (strips > 1) {
       plan.faces.clear();
       std::vector<std::vector<int>> rows{a};
@@ -928,7 +954,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
         return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
       };
       for (std::size_t k = 0; k + 1 < rows.size(); ++k)
-        zipper(rows[k], rows[k + 1], anyPoint, forward, plan.faces);
+        zipper(rows[k], rows[k + 1], anyPoint, beyond, forward, plan.faces);
       // End rungs are now chains of strips edges (new border edges).
       if (!A.closed) {
         const bool closesFirst = edges.uses(a.front(), b.front()) == 1;
@@ -1345,7 +1371,10 @@ void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
     std::unordered_map<int, int> into;
     if (d != a) into[d] = a;
     if (c != b) into[c] = b;
-    if (into.empty()) continue;
+    if (into.empty()) {  // closed by the merges before
+      ++r.edges_merged;
+      continue;
+    }
     auto mapped = [&](int v) {
       const auto it = into.find(v);
       return it == into.end() ? v : it->second;
