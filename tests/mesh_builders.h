@@ -183,4 +183,48 @@ inline Mesh openTube(int around, int along, double r, double h) {
   return makeMesh(p, t);
 }
 
+// A closed cylinder around the z axis from z = z0 to z0 + h with an
+// elliptic section (radii rx, ry): `around` vertices per ring, `along`
+// bands, each cap a fan around a centre vertex; outward normals.
+inline Mesh cappedCylinder(int around, int along, double rx, double ry, double z0, double h) {
+  std::vector<Point3> p;
+  for (int j = 0; j <= along; ++j)
+    for (int i = 0; i < around; ++i) {
+      const double a = 2 * M_PI * i / around;
+      p.emplace_back(rx * std::cos(a), ry * std::sin(a), z0 + h * j / along);
+    }
+  const int bottom = int(p.size());
+  p.emplace_back(0, 0, z0);
+  p.emplace_back(0, 0, z0 + h);
+  auto at = [&](int i, int j) { return j * around + (i % around); };
+  std::vector<Triangle> t;
+  for (int j = 0; j < along; ++j)
+    for (int i = 0; i < around; ++i) {
+      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  for (int i = 0; i < around; ++i) {
+    t.push_back({bottom, at(i + 1, 0), at(i, 0)});
+    t.push_back({bottom + 1, at(i, along), at(i + 1, along)});
+  }
+  return makeMesh(p, t);
+}
+
+// `m` with every face turned over (normals reversed), e.g. the inner skin
+// of a hollow part.
+inline Mesh flipped(const Mesh& m) {
+  std::vector<Triangle> t = trianglesOf(m);
+  for (Triangle& f : t) std::swap(f[1], f[2]);
+  return makeMesh(positionsOf(m), t);
+}
+
+// `m` with its coordinates rounded to a grid of spacing `step`, as a lossy
+// codec's quantisation does.
+inline Mesh quantized(const Mesh& m, double step) {
+  std::vector<Point3> p = positionsOf(m);
+  for (Point3& q : p)
+    for (int k = 0; k < 3; ++k) q[k] = std::round(q[k] / step) * step;
+  return makeMesh(p, trianglesOf(m));
+}
+
 }  // namespace meshmend::testing
