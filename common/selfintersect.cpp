@@ -954,6 +954,11 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
 
   // The mesh as arrays, welded; each vertex and face remembers its input index.
   MeshArrays arrays = arraysOf(input);
+  // Output in float is decided on float: the input as it will be stored
+  // too (MeshLab's already is), so only new and moved vertices change later.
+  if (options.round_to_float)
+    for (Point3& p : arrays.points)
+      p = Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
   std::vector<int> vertexOrigin(arrays.points.size()), faceOrigin(arrays.triangles.size());
   std::iota(vertexOrigin.begin(), vertexOrigin.end(), 0);
   std::iota(faceOrigin.begin(), faceOrigin.end(), 0);

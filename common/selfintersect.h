@@ -30,8 +30,9 @@ struct SelfIntersectionOptions {
   // or edge merge into it instead of leaving slivers, whose rounded corners
   // could cross again. Moves the surface by at most that much near a curve.
   double snap_tolerance = 0.05;
-  // Round new vertices for float storage (MeshLab's) before the region
-  // growing decides, so that its decisions hold for the stored mesh.
+  // Work on float coordinates (MeshLab's storage): the input is taken as
+  // float, and new vertices are rounded before the region growing decides,
+  // so that its decisions hold for the stored mesh.
   bool round_to_float = false;
   // Where the outer surface touches itself at a vertex or along an edge,
   // stitching gives each side its own copy of the vertex (§2.4); the copies
