@@ -314,30 +314,95 @@ struct NearPair {
 };
 
 // Every pair in scope closer than `radius` (boxes grown by radius / 2, so
-// that a pair at distance < radius always has overlapping boxes).
+// that a pair at distance < radius always has overlapping boxes): one tree
+// per layer for pairs within layers, the smaller layer's tree queried by the
+// larger one's faces for pairs between layers, one tree of all faces for both.
 std::vector<NearPair> pairsWithin(const Soup& soup, const std::vector<Point3>& P, double radius,
                                   std::size_t* candidates = nullptr) {
-  std::vector<Box> boxes(soup.faces()), grown(soup.faces());
-  parallelChunks(soup.faces(), [&](std::size_t b, std::size_t e, unsigned) {
+  const std::size_t nf = soup.faces();
+  std::vector<Box> boxes(nf), grown(nf);
+  // Unit normal and offset of each face's plane: a face whose corners all
+  // lie `radius` or more to one side of the other's plane is that far away.
+  std::vector<Point3> normal(nf);
+  std::vector<double> offset(nf);
+  parallelChunks(nf, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t f = b; f < e; ++f) {
       const Triangle& t = soup.triangles[f];
       boxes[f] = boxOf(P[t[0]], P[t[1]], P[t[2]]);
       grown[f] = inflated(boxes[f], radius / 2);
+      Point3 n = (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
+      const double len = n.Norm();
+      n = len > 0 ? n / len : Point3(0, 0, 0);
+      normal[f] = n;
+      offset[f] = n * P[t[0]];
     }
   });
-  const BoxTree tree(std::move(grown));
+  // Rounding in the plane test is far below `radius`; a margin of a
+  // millionth keeps it conservative.
+  const double planeRadius = radius * (1 + 1e-6);
+  auto beside = [&](std::uint32_t f, std::uint32_t g) {
+    if (normal[f] == Point3(0, 0, 0)) return false;
+    double lo = kInf, hi = -kInf;
+    for (int v : soup.triangles[g]) {
+      const double s = normal[f] * P[v] - offset[f];
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    return lo >= planeRadius || hi <= -planeRadius;
+  };
   struct alignas(64) Found {
     std::vector<NearPair> pairs;
     std::size_t candidates = 0;
   };
   std::vector<Found> found(workerCount());
   const double r2 = radius * radius;
-  tree.selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned w) {
+  auto visit = [&](std::uint32_t f, std::uint32_t g, unsigned w) {
+    if (g < f) std::swap(f, g);
     if (!soup.clearancePair(f, g) || gap2(boxes[f], boxes[g]) >= r2) return;
+    if (beside(f, g) || beside(g, f)) return;
     ++found[w].candidates;
     const double d = soup.distance(P, f, g);
     if (d < radius) found[w].pairs.push_back({f, g, d});
-  });
+  };
+  // Trees answer one self-join or one pass of queries: Morton order builds
+  // three times faster than median splits.
+  auto treeOf = [&](int first, int last) {
+    return BoxTree(std::vector<Box>(grown.begin() + first, grown.begin() + last),
+                   BoxTree::Layout::kMorton);
+  };
+  const int nl = soup.layers();
+  if (soup.scope == ClearanceScope::kBoth || nl == 1) {
+    if (soup.scope != ClearanceScope::kBetweenLayers) treeOf(0, int(nf)).selfPairs(visit);
+  } else if (soup.scope == ClearanceScope::kWithinLayers) {
+    for (int l = 0; l < nl; ++l) {
+      const std::uint32_t first = std::uint32_t(soup.faceOffset[l]);
+      treeOf(soup.faceOffset[l], soup.faceOffset[l + 1])
+          .selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned w) {
+            visit(first + f, first + g, w);
+          });
+    }
+  } else {
+    for (int a = 0; a < nl; ++a)
+      for (int b = a + 1; b < nl; ++b) {
+        const int sizeA = soup.faceOffset[a + 1] - soup.faceOffset[a];
+        const int sizeB = soup.faceOffset[b + 1] - soup.faceOffset[b];
+        const int small = sizeA <= sizeB ? a : b, large = sizeA <= sizeB ? b : a;
+        const BoxTree tree = treeOf(soup.faceOffset[small], soup.faceOffset[small + 1]);
+        const std::uint32_t firstSmall = std::uint32_t(soup.faceOffset[small]);
+        const int firstLarge = soup.faceOffset[large];
+        parallelChunks(
+            std::size_t(soup.faceOffset[large + 1] - firstLarge),
+            [&](std::size_t begin, std::size_t end, unsigned worker) {
+              for (std::size_t i = begin; i < end; ++i) {
+                const std::uint32_t g = std::uint32_t(firstLarge + i);
+                if (!overlap(grown[g], tree.bounds())) continue;
+                tree.query(grown[g], worker,
+                           [&](std::uint32_t f, unsigned w) { visit(firstSmall + f, g, w); });
+              }
+            },
+            1024);
+      }
+  }
   std::vector<NearPair> all;
   std::size_t count = 0;
   for (const Found& x : found) {
@@ -508,36 +573,45 @@ Eigen::VectorXd minimumNormStep(const SparseRows& J, const Eigen::VectorXd& d, d
       for (SparseRows::InnerIterator it(J, k); it; ++it) delta[it.col()] += change * it.value();
       worst = std::max(worst, std::abs(shortfall));
     }
-    if (worst < 0.1 * tolerance) break;
+    if (worst < 100 * tolerance) break;  // enough to tell the binding rows
   }
 
-  std::vector<Eigen::Triplet<double>> entries;
-  std::vector<double> r;
-  for (int k = 0; k < m; ++k) {
-    if (!(y[k] > 0)) continue;
-    for (SparseRows::InnerIterator it(J, k); it; ++it)
-      entries.emplace_back(int(r.size()), int(it.col()), it.value());
-    r.push_back(goal - d[k]);
+  std::vector<char> binding(m, 0);
+  for (int k = 0; k < m; ++k) binding[k] = y[k] > 0;
+  for (int round = 0; round < 4; ++round) {
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<double> r;
+    for (int k = 0; k < m; ++k) {
+      if (!binding[k]) continue;
+      for (SparseRows::InnerIterator it(J, k); it; ++it)
+        entries.emplace_back(int(r.size()), int(it.col()), it.value());
+      r.push_back(goal - d[k]);
+    }
+    if (r.empty()) return delta;
+    Eigen::SparseMatrix<double> JW(int(r.size()), J.cols());
+    JW.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(JW.transpose()) * JW;
+    double largest = 0;
+    for (int i = 0; i < H.rows(); ++i) largest = std::max(largest, H.coeff(i, i));
+    // The ridge keeps the solve defined for coordinates no binding row moves
+    // and in directions no row sees; small enough not to shorten the step.
+    Eigen::SparseMatrix<double> ridge(H.rows(), H.cols());
+    ridge.setIdentity();
+    H += ridge * (1e-10 * std::max(largest, 1e-300));
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
+    if (solver.info() != Eigen::Success) return delta;
+    const Eigen::VectorXd solved = solver.solve(
+        Eigen::VectorXd(JW.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), r.size())));
+    const Eigen::VectorXd predicted = d + J * solved;
+    bool short_ = false;
+    for (int k = 0; k < m; ++k)
+      if (norm2[k] > 0 && predicted[k] < goal - tolerance) {
+        short_ = true;
+        binding[k] = 1;  // a row Hildreth had not yet seen binding
+      }
+    if (!short_) return solved;
   }
-  if (r.empty()) return delta;
-  Eigen::SparseMatrix<double> JW(int(r.size()), J.cols());
-  JW.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(JW.transpose()) * JW;
-  double largest = 0;
-  for (int i = 0; i < H.rows(); ++i) largest = std::max(largest, H.coeff(i, i));
-  // The ridge keeps the solve defined for coordinates no binding row moves
-  // and in directions no row sees; small enough not to shorten the step.
-  Eigen::SparseMatrix<double> ridge(H.rows(), H.cols());
-  ridge.setIdentity();
-  H += ridge * (1e-10 * std::max(largest, 1e-300));
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
-  if (solver.info() != Eigen::Success) return delta;
-  const Eigen::VectorXd solved = solver.solve(
-      Eigen::VectorXd(JW.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), r.size())));
-  const Eigen::VectorXd predicted = d + J * solved;
-  for (int k = 0; k < m; ++k)
-    if (norm2[k] > 0 && predicted[k] < goal - tolerance) return delta;
-  return solved;
+  return delta;
 }
 
 }  // namespace
@@ -663,18 +737,32 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   Soup soup(constLayers, options.scope, options.exclusion_rings);
   const std::size_t nv = soup.points.size(), nf = soup.faces();
   const int nl = soup.layers();
+  // With round_to_float everything works on the input as MeshLab stores it
+  // (a no-op for a mesh that comes from MeshLab), so that only the moved
+  // vertices are rounded at the end, within the margin the solve keeps.
+  if (options.round_to_float)
+    for (Point3& p : soup.points)
+      for (int k = 0; k < 3; ++k) p[k] = double(float(p[k]));
 
   // The clearance is a distance between surfaces that do not meet: crossing
   // faces would have to pass through each other, which no small move does.
   {
     const auto t0 = Clock::now();
-    std::vector<MeshArrays> arrays;
-    for (const Mesh* m : constLayers) arrays.push_back(arraysOf(*m));
+    std::vector<MeshArrays> arrays(nl);
+    for (int l = 0; l < nl; ++l) {
+      const int first = soup.vertexOffset[l];
+      arrays[l].points.assign(soup.points.begin() + first,
+                              soup.points.begin() + soup.vertexOffset[l + 1]);
+      for (int f = soup.faceOffset[l]; f < soup.faceOffset[l + 1]; ++f)
+        arrays[l].triangles.push_back({soup.triangles[f][0] - first, soup.triangles[f][1] - first,
+                                       soup.triangles[f][2] - first});
+    }
     std::vector<const MeshArrays*> pointers;
     for (const MeshArrays& a : arrays) pointers.push_back(&a);
     FindIntersectionsOptions fo;
     fo.self = true;
     fo.cross = includesBetween(options.scope) && nl > 1;
+    fo.layout = 1;  // Morton order: one pass of queries
     const FindIntersectionsResult found = findIntersectionsInArrays(pointers, fo);
     for (int l = 0; l < nl; ++l)
       if (found.self_pairs[l] > 0)

@@ -106,8 +106,10 @@ struct ClearanceOptions {
   // below tau.
   double active_margin = 0.5;
   // Make the final positions float-representable (MeshLab stores floats):
-  // the solve aims a few float steps beyond tau, and the rounded result is
-  // checked again (distances and exact intersections).
+  // the input is taken as rounded to float (no change for MeshLab's meshes),
+  // the solve aims a few float steps of the largest coordinate beyond tau,
+  // and the rounded result is checked again (distances, exact intersections).
+  // Displacements are then measured from the rounded input.
   bool round_to_float = false;
   std::size_t max_listed_pairs = 10;  // pairs still short listed in the result
   Progress progress;                  // called once per iteration
