@@ -325,6 +325,9 @@ std::vector<NearPair> pairsWithin(const Soup& soup, const std::vector<Point3>& P
   // lie `radius` or more to one side of the other's plane is that far away.
   std::vector<Point3> normal(nf);
   std::vector<double> offset(nf);
+  // And the outward normals of its edges in its plane: neighbours on a
+  // smooth sheet are not beside each other's planes but beside an edge.
+  std::vector<std::array<Point3, 3>> side(nf);
   parallelChunks(nf, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t f = b; f < e; ++f) {
       const Triangle& t = soup.triangles[f];
@@ -335,6 +338,11 @@ std::vector<NearPair> pairsWithin(const Soup& soup, const std::vector<Point3>& P
       n = len > 0 ? n / len : Point3(0, 0, 0);
       normal[f] = n;
       offset[f] = n * P[t[0]];
+      for (int i = 0; i < 3; ++i) {
+        Point3 a = (P[t[(i + 1) % 3]] - P[t[i]]) ^ n;  // outward for a counter-clockwise face
+        const double l = a.Norm();
+        side[f][i] = l > 0 ? a / l : Point3(0, 0, 0);
+      }
     }
   });
   // Rounding in the plane test is far below `radius`; a margin of a
@@ -348,7 +356,15 @@ std::vector<NearPair> pairsWithin(const Soup& soup, const std::vector<Point3>& P
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    return lo >= planeRadius || hi <= -planeRadius;
+    if (lo >= planeRadius || hi <= -planeRadius) return true;
+    for (int i = 0; i < 3; ++i) {
+      const Point3& a = side[f][i];
+      const double from = a * P[soup.triangles[f][i]];
+      double nearest = kInf;
+      for (int v : soup.triangles[g]) nearest = std::min(nearest, a * P[v] - from);
+      if (nearest >= planeRadius) return true;
+    }
+    return false;
   };
   struct alignas(64) Found {
     std::vector<NearPair> pairs;

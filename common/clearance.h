@@ -7,11 +7,14 @@
 // and nine edge–edge distances (§4.1), which is the distance of two disjoint
 // triangles. Enforcing solves the paper's problem — minimal displacement such
 // that every pair distance ≥ τ — with Gauss-Newton steps on the active pairs
-// (those closer than τ plus a margin): the minimum-norm step of the linearised
-// distances comes from a sparse solve of (J Jᵀ + λI) y = r, Δx = Jᵀ y (not the
-// paper's dense SVD), and a backtracking line search keeps every intermediate
-// configuration free of intersections (conservative advancement along the
-// step, then the exact intersection test at its end).
+// (those closer than τ plus a margin, re-detected after every step): the
+// minimum-norm step of the linearised distances, rows beyond τ as
+// inequalities, comes from Hildreth's dual method, which picks the binding
+// rows, and a sparse solve over them, (J_Wᵀ J_W + λI) Δx = J_Wᵀ r = the
+// minimum-norm J_Wᵀ (J_W J_Wᵀ)⁻¹ r for small λ (not the paper's dense SVD).
+// A backtracking line search keeps every intermediate configuration free of
+// intersections: conservative advancement along the step for faces sharing
+// no vertex, the exact intersection test at its end for all moved faces.
 #pragma once
 
 #include <array>

@@ -427,6 +427,20 @@ TEST(EnforceClearance, ThinPlateThinnerThanTauIsReportedNotTorn) {
   EXPECT_GT(hi - lo, 0.05);
 }
 
+TEST(EnforceClearance, CancelledLeavesTheLayersUntouched) {
+  Mesh a = gridSquare(3, 0), b = gridSquare(3, 0.3, false);
+  const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);
+  std::vector<Mesh*> layers{&a, &b};
+  ClearanceOptions o;
+  o.tau = 0.5;
+  o.scope = ClearanceScope::kBetweenLayers;
+  int calls = 0;
+  o.progress = [&](int, const char*) { return ++calls < 3; };  // stop in the first step
+  EXPECT_THROW(enforceClearance(layers, o), CancelledError);
+  EXPECT_EQ(positionsOf(a), pa);
+  EXPECT_EQ(positionsOf(b), pb);
+}
+
 TEST(EnforceClearance, JsonKeys) {
   Mesh a = square(0), b = square(0.3, false);
   std::vector<Mesh*> layers{&a, &b};
