@@ -1174,12 +1174,13 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   }
   result.mean_displacement_all = nv ? sum / double(nv) : 0;
   result.mean_displacement_moved = result.vertices_moved ? sum / double(result.vertices_moved) : 0;
+  // The last chance to cancel comes before the layers change.
+  reportProgress(options.progress, 100, "Done");
   for (int l = 0; l < nl; ++l) {
     Mesh& mesh = *layers[l];
     for (int i = 0; i < soup.vertexOffset[l + 1] - soup.vertexOffset[l]; ++i)
       mesh.vert[i].P() = P[soup.vertexOffset[l] + i];
   }
-  reportProgress(options.progress, 100, "Done");
   result.time_ms = msSince(start);
   return result;
 }

@@ -435,7 +435,7 @@ TEST(EnforceClearance, CancelledLeavesTheLayersUntouched) {
   o.tau = 0.5;
   o.scope = ClearanceScope::kBetweenLayers;
   int calls = 0;
-  o.progress = [&](int, const char*) { return ++calls < 3; };  // stop in the first step
+  o.progress = [&](int, const char*) { return ++calls < 3; };  // stop after the first step
   EXPECT_THROW(enforceClearance(layers, o), CancelledError);
   EXPECT_EQ(positionsOf(a), pa);
   EXPECT_EQ(positionsOf(b), pb);
