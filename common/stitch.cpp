@@ -6,10 +6,12 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <future>
 #include <numeric>
 #include <queue>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -478,7 +480,10 @@ class LocalEdges {
     int opposite;  // the third corner of a face on the edge
   };
 
-  LocalEdges(const Mesh& mesh, const std::vector<int>& vertices) : slot_(mesh.vert.size(), -1) {
+  // With `among`, only the edges between two of the vertices are kept (what
+  // a stitch asks about: path edges and rungs), a fraction of the entries.
+  LocalEdges(const Mesh& mesh, const std::vector<int>& vertices, bool among = false)
+      : slot_(mesh.vert.size(), -1) {
     int slots = 0;
     for (int v : vertices)
       if (slot_[v] < 0) slot_[v] = slots++;
@@ -491,6 +496,7 @@ class LocalEdges {
         for (int k = 0; k < 3; ++k) {
           const int a = c[k], b = c[(k + 1) % 3];
           const int o = c[(k + 2) % 3];
+          if (among && (slot_[a] < 0 || slot_[b] < 0)) continue;
           if (slot_[a] >= 0) visit(slot_[a], b, true, o);
           if (slot_[b] >= 0) visit(slot_[b], a, false, o);
         }
@@ -536,6 +542,7 @@ class LocalEdges {
     const Neighbour* e = find(a, b);
     return e ? e->out + e->in : 0;
   }
+  // On a border edge (with `among`: on one to another of the vertices).
   bool onBorder(int a) const {
     const int s = slot_[a];
     for (int i = start_[s]; i < start_[s + 1]; ++i)
@@ -713,20 +720,30 @@ void rotate(std::vector<T>& v, std::size_t first) {
 StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
   StitchPlan plan;
   PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
+  std::vector<char> inA(mesh.vert.size(), 0);
   {
-    std::vector<char> seen(mesh.vert.size(), 0);
-    checkDistinct(mesh, A, seen, "a");
+    checkDistinct(mesh, A, inA, "a");
     std::vector<char> seenB(mesh.vert.size(), 0);
     checkDistinct(mesh, B, seenB, "b");
   }
   std::vector<int> all = A.v;
   all.insert(all.end(), B.v.begin(), B.v.end());
-  const LocalEdges edges(mesh, all);
-  for (const auto* p : {&A, &B})
-    for (int v : p->v)
-      if (!edges.onBorder(v))
-        throw InvalidInputError(describeVertex(mesh, v) + " of path " + (p == &A ? "a" : "b") +
-                                " is not on a border edge: stitch paths must follow borders");
+  const LocalEdges edges(mesh, all, true);
+  // Most path vertices are on a border edge of their path; the others are
+  // checked against all their edges.
+  {
+    std::vector<int> unsure;
+    for (int v : all)
+      if (!edges.onBorder(v)) unsure.push_back(v);
+    if (!unsure.empty()) {
+      const LocalEdges full(mesh, unsure);
+      for (const auto* p : {&A, &B})
+        for (int v : p->v)
+          if (!edges.onBorder(v) && !full.onBorder(v))
+            throw InvalidInputError(describeVertex(mesh, v) + " of path " + (p == &A ? "a" : "b") +
+                                    " is not on a border edge: stitch paths must follow borders");
+    }
+  }
   // Auto shape: a path whose ends share a border edge goes all around.
   for (auto [p, path] : {std::make_pair(&A, &o.a), std::make_pair(&B, &o.b)})
     if (path->shape == BorderPath::Shape::Auto && !p->closed && p->v.size() >= 3 &&
@@ -739,9 +756,8 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
   plan.closed = A.closed;
   // Shared vertices: only the ends of open paths (a crack closing at a point).
   {
-    std::unordered_set<int> inA(A.v.begin(), A.v.end());
     for (std::size_t k = 0; k < B.v.size(); ++k)
-      if (inA.count(B.v[k])) {
+      if (inA[B.v[k]]) {
         const bool endOfB = k == 0 || k + 1 == B.v.size();
         const bool endOfA = B.v[k] == A.v.front() || B.v[k] == A.v.back();
         if (A.closed || !endOfA || !endOfB)
@@ -1029,7 +1045,34 @@ void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
 }  // namespace
 
 std::size_t countBorderEdges(const Mesh& mesh) {
-  return borderEdgesOf(trianglesOf(mesh));
+  // Each edge's other end listed at its smaller end (a counting sort), then
+  // the few per vertex sorted: linear, and lighter than full edge uses.
+  const Vertex* base = mesh.vert.data();
+  const std::size_t n = mesh.vert.size();
+  std::vector<int> start(n + 1, 0);
+  for (const Face& f : mesh.face)
+    for (int k = 0; k < 3; ++k) ++start[std::min(f.cV(k) - base, f.cV((k + 1) % 3) - base) + 1];
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<int> other(start.back());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (const Face& f : mesh.face)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = f.cV(k) - base, b = f.cV((k + 1) % 3) - base;
+      other[fill[std::min(a, b)]++] = int(std::max(a, b));
+    }
+  std::size_t border = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    int* b = other.data() + start[v];
+    int* e = other.data() + start[v + 1];
+    std::sort(b, e);
+    for (int* i = b; i != e;) {
+      int* j = i + 1;
+      while (j != e && *j == *i) ++j;
+      if (j - i == 1) ++border;
+      i = j;
+    }
+  }
+  return border;
 }
 
 StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
@@ -1040,15 +1083,28 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
     throw InvalidInputError("max_aspect_ratio and max_rows must not be negative");
   reportProgress(options.progress, 0, "Planning the stitch");
   StitchResult r;
+  // The mesh's border edges are counted (for the report) on the second
+  // core while the stitch is planned: both only read the mesh.
+  auto borderCount = std::async(std::launch::async, [&mesh] {
+    const auto t = Clock::now();
+    const std::size_t count = countBorderEdges(mesh);
+    return std::make_pair(count, msSince(t));
+  });
+  auto clock = Clock::now();
   const StitchPlan plan = planStitch(mesh, options);
+  r.stage_ms.plan = msSince(clock);
   if (options.check_intersections) {
     reportProgress(options.progress, 50, "Checking intersections");
+    clock = Clock::now();
     r.remaining_intersecting_pairs = newIntersections(mesh, plan);
     r.checked = true;
+    r.stage_ms.check = msSince(clock);
   }
   reportProgress(options.progress, 90, "Writing");
-  r.border_edges_before = countBorderEdges(mesh);
+  std::tie(r.border_edges_before, r.stage_ms.count) = borderCount.get();
+  clock = Clock::now();
   applyPlan(mesh, plan, r);
+  r.stage_ms.write = msSince(clock);
   r.border_edges_after = std::size_t(long(r.border_edges_before) + plan.borderDelta);
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);

@@ -124,6 +124,13 @@ struct StitchResult {
   std::vector<int> new_faces;     // indices of the new faces in the mesh
   std::vector<int> new_vertices;  // indices of the new vertices
   double time_ms = 0;
+  // Where the time went, in milliseconds: triangulating (with the border
+  // and orientation checks), the exact intersection check, counting the
+  // mesh's border edges (on a second thread, during the triangulation),
+  // writing the new elements.
+  struct StageTimes {
+    double plan = 0, check = 0, count = 0, write = 0;
+  } stage_ms;
 };
 
 // Stitches the gap between two border paths of `mesh` (two layers: append
