@@ -124,7 +124,8 @@ struct ClearanceResult {
   // "reached", "iterations" (max_iterations used up), "stalled" (the line
   // search found no step that helps: locked vertices, the cap, or a tau the
   // shape cannot allow), "locked" (every pair still short has only locked or
-  // capped vertices).
+  // capped vertices), "rounding" (tau was reached, but rounding to float
+  // brought pairs back under it: see warnings).
   std::string stop_reason;
   double min_distance_before = 0, min_distance_after = 0;  // over pairs in scope
   std::size_t violating_pairs_before = 0;                  // face pairs closer than tau
