@@ -21,10 +21,10 @@
 //
 // Each method runs in child processes (benchmarks/harness.h). A first child
 // fills one copy, timing the call by hand, and writes the filled mesh
-// (DIR/<method>.off) and a report (DIR/<method>.json: faces added, ours' full
-// HoleFillResult, the first run's time) outside the clock; the harness then
-// times N runs on copies made beforehand, so that copying the input is never
-// timed. A method whose first run takes over 10 s is not repeated. Without
+// (DIR/<method>.ply for ours, .off for the peers) and a report (DIR/<method>.json: faces added,
+// ours' full HoleFillResult, the first run's time) outside the clock; the harness then times N runs
+// on copies made beforehand, so that copying the input is never timed. A method whose first run
+// takes over 10 s is not repeated. Without
 // --out-dir nothing is written and only the times are printed.
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
@@ -38,6 +38,8 @@
 
 #include <vcg/complex/algorithms/clean.h>
 #include <vcg/complex/algorithms/hole.h>
+#include <vcg/complex/algorithms/update/bounding.h>
+#include <vcg/complex/algorithms/update/normal.h>
 #include <vcg/complex/append.h>
 #include <vcg/complex/complex.h>
 
@@ -76,6 +78,11 @@ void toMlMesh(const Mesh& in, MlMesh& out) {
     for (int k = 0; k < 3; ++k) f->V(k) = &out.vert[std::size_t(t[k])];
     ++f;
   }
+  // What meshlabserver does after loading (MeshModel::UpdateBoxAndNormals):
+  // the ears' quality reads the face normals around the hole.
+  vcg::tri::UpdateBounding<MlMesh>::Box(out);
+  vcg::tri::UpdateNormal<MlMesh>::PerFaceNormalized(out);
+  vcg::tri::UpdateNormal<MlMesh>::PerVertexAngleWeighted(out);
 }
 
 // MeshLab's filter: adjacency, refusal of non-manifold edges, ear cutting
@@ -160,7 +167,7 @@ Filler<OursInput> ours(const std::string& file, HoleFairing fairing) {
     return long(in.result.faces_added);
   };
   f.write = [](OursInput& in, long, double ms, const std::string& stem) {
-    writeMesh(stem + ".off", in.mesh);
+    writeMesh(stem + ".ply", in.mesh);  // binary doubles: every coordinate exact
     JsonObject j = toJson(in.result);
     j.set("first_run_ms", ms);
     writeJsonFile(stem + ".json", j);
@@ -306,7 +313,9 @@ int main(int argc, char** argv) {
     }
     JsonObject j = toJson(m);
     if (first.ok) j.set("first_run_ms", double(first.result) / 1000);
-    if (!stem.empty() && first.ok) j.set("output", stem + ".off").set("report", stem + ".json");
+    if (!stem.empty() && first.ok)
+      j.set("output", stem + (name.rfind("meshmend", 0) == 0 ? ".ply" : ".off"))
+          .set("report", stem + ".json");
     results.push_back(j);
     std::fprintf(stderr, "  %-22s %s\n", name.c_str(), j.str().c_str());
   }

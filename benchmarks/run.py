@@ -5,6 +5,7 @@ and rewrites the matching section of docs/BENCHMARKS.md.
     benchmarks/run.py intersections [--repeat N]
     benchmarks/run.py split [--repeat N]
     benchmarks/run.py selfintersect [--repeat N]
+    benchmarks/run.py holes [--repeat N]        (needs numpy: /usr/bin/python3)
 
 Needs scripts/setup to have run (the private MeshLab prefix) and ../shared
 beside the project (the real meshes). Builds the C++ runners if needed."""
@@ -400,6 +401,21 @@ def selfintersect(repeat):
     return "\n".join(out)
 
 
+def holes(repeat):
+    """Hole filling: fidelity and speed (benchmarks/holes.py), with the
+    measuring tools of ../shared/tools built beside the runners."""
+    try:
+        import holes as driver
+    except ImportError as e:
+        sys.exit(f"the holes benchmark needs numpy (Debian: python3-numpy): {e}")
+    tools = BUILD / "shared-tools"
+    subprocess.run(["cmake", "-S", str(ROOT.parent / "shared" / "tools"), "-B", str(tools),
+                    "-DCMAKE_BUILD_TYPE=Release"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", str(tools), "-j", str(os.cpu_count() or 2), "--target",
+                    "meshcheck", "peer_holefill"], check=True, stdout=subprocess.DEVNULL)
+    return driver.section(BUILD, repeat, machine())
+
+
 def write_section(name, title, body):
     text = DOC.read_text() if DOC.exists() else (
         "# Benchmarks\n\nSide-by-side measurements of MeshMend against its peers, written by "
@@ -415,17 +431,21 @@ def write_section(name, title, body):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("benchmark", choices=["intersections", "split", "selfintersect"])
+    parser.add_argument("benchmark", choices=["intersections", "split", "selfintersect", "holes"])
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
     # Self-intersection removal needs its runner only (no MeshLab plugin).
-    build_runners(["bench_selfintersect"] if args.benchmark == "selfintersect" else RUNNERS)
+    # Hole filling needs its runner only (MeshLab's filter runs from the prefix).
+    build_runners({"selfintersect": ["bench_selfintersect"],
+                   "holes": ["bench_holes"]}.get(args.benchmark, RUNNERS))
     if args.benchmark == "intersections":
         write_section("intersections", "Intersection detection", intersections(args.repeat))
     if args.benchmark == "split":
         write_section("split", "Intersect and split", split(args.repeat))
     if args.benchmark == "selfintersect":
         write_section("selfintersect", "Self-intersection removal", selfintersect(args.repeat))
+    if args.benchmark == "holes":
+        write_section("holes", "Hole filling", holes(args.repeat))
     print(f"updated {DOC}")
 
 
