@@ -177,6 +177,22 @@ TEST(RemoveSelfIntersections, TorusWhoseHoleIsPinchedGetsTwoHoles) {
   EXPECT_LT(volumeOf(r.mesh), volumeOf(closing));  // the overlap counts once
 }
 
+TEST(RemoveSelfIntersections, TorusWhoseHoleClosesBecomesASphere) {
+  // Both inner walls squeezed towards the axis (x -> x - 0.75 tanh(x / 0.05)
+  // near the hole), strongly enough that near the hole's ends the surface
+  // folds over itself: the walls pass through each other along the whole
+  // hole, which closes (genus 1 -> 0).
+  std::vector<Point3> p = positionsOf(torus(1, 0.45, 96, 24));
+  for (Point3& q : p) q[0] -= 0.75 * std::tanh(q[0] / 0.05) * std::exp(-q[1] * q[1] / 0.3);
+  const Mesh closing = makeMesh(p, trianglesOf(torus(1, 0.45, 96, 24)));
+  const SelfIntersectionResult r = removeSelfIntersections(closing);
+  expectValid(r);
+  EXPECT_GT(r.intersecting_pairs_before, 0u);
+  EXPECT_EQ(r.genus_before, 1);
+  EXPECT_EQ(r.components_after, 1);
+  EXPECT_EQ(r.genus_after, 0);
+}
+
 TEST(RemoveSelfIntersections, InflatedPartThatTouchesItselfCloses) {
   // A coiled tube whose end lies over its start: thin, it passes by; once
   // inflated the end and start overlap and the ring closes (genus 0 -> 1).
