@@ -2142,6 +2142,38 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         }
         result.new_vertices.push_back(int(v));
       }
+      // A patch vertex takes the origin of the border vertex nearest to it
+      // along the patch's edges: colours, quality and texture coordinates
+      // then continue into the patch instead of leaving it blank.
+      auto inPatch = [&](int v) {
+        return std::size_t(v) >= s.inputVertices && !s.splitOrigins.count(v);
+      };
+      std::vector<std::vector<int>> neighbours(newVertices);
+      for (int f : s.patchFaces)
+        for (int k = 0; k < 3; ++k) {
+          const int a = s.triangles[f][k], b = s.triangles[f][(k + 1) % 3];
+          if (inPatch(a)) neighbours[std::size_t(a) - s.inputVertices].push_back(b);
+          if (inPatch(b)) neighbours[std::size_t(b) - s.inputVertices].push_back(a);
+        }
+      std::vector<int> border(newVertices, -1), queue;
+      for (std::size_t i = 0; i < newVertices; ++i)
+        for (int w : neighbours[i])
+          if (!inPatch(w)) {
+            border[i] = w;
+            queue.push_back(int(i));
+            break;
+          }
+      for (std::size_t head = 0; head < queue.size(); ++head) {
+        const int i = queue[head];
+        for (int w : neighbours[std::size_t(i)])
+          if (inPatch(w) && border[std::size_t(w) - s.inputVertices] < 0) {
+            border[std::size_t(w) - s.inputVertices] = border[std::size_t(i)];
+            queue.push_back(int(std::size_t(w) - s.inputVertices));
+          }
+      }
+      for (std::size_t i = 0; i < newVertices; ++i)
+        if (border[i] >= 0 && inPatch(int(s.inputVertices + i)))
+          vo[s.inputVertices + i] = vo[border[i]];
     }
     for (const auto& [f, corners] : s.inputCorners)
       for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];

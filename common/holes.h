@@ -144,7 +144,9 @@ struct HoleFillResult {
 // Fills the holes of `mesh` in place. New vertices and faces are appended
 // (existing indices stay; a face split by the pre-treatment keeps its index
 // for one half); provenance: split vertices lie on the face they split,
-// patch faces and vertices have no origin face.
+// patch vertices take the origin of the border vertex nearest to them along
+// the patch's edges (so attributes carried by origins continue into the
+// patch), patch faces have no origin face.
 // Throws InvalidInputError for an empty mesh, a non-finite coordinate,
 // deleted elements or a bad option; the mesh is unchanged when it throws
 // (CancelledError included). A mesh without holes is returned unchanged with

@@ -249,12 +249,25 @@ TEST(HolePretreatment, SplitsLongBorderEdgesAndTheirFaces) {
   for (double l : lengths) mean += l;
   mean /= double(lengths.size());
   for (double l : lengths) EXPECT_LE(l, 1.5 * mean + 1e-12);
-  // The split vertices lie on the fan's face they split, by provenance.
+  // The split vertices (new vertices of faces outside the patch) lie on the
+  // fan's face they split, by provenance; patch vertices name the border
+  // vertex whose attributes they take.
   VertexOriginHandle vo = vertexOrigins(m);
-  int onFaces = 0;
-  for (int v : r.new_vertices)
-    if (vo[v].face >= 0) ++onFaces;
-  EXPECT_EQ(onFaces, 3);
+  std::set<int> onSurface;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (!patch.count(int(f)))
+      for (int v : T[f]) onSurface.insert(v);
+  int split = 0;
+  for (int v : r.new_vertices) {
+    if (onSurface.count(v)) {
+      ++split;
+      EXPECT_GE(vo[v].face, 0);
+      EXPECT_LT(vo[v].vertex, 0);
+    } else {
+      EXPECT_TRUE(vo[v].vertex >= 0 || vo[v].face >= 0) << "patch vertex " << v;
+    }
+  }
+  EXPECT_EQ(split, 3);
 }
 
 TEST(HolePretreatment, FactorZeroLeavesTheBorderAlone) {
