@@ -1,0 +1,496 @@
+#include "filter_mend_clearance.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "common/clearance.h"
+#include "plugins/bridge/filter_support.h"
+#include "plugins/bridge/mesh_bridge.h"
+
+#include <vcg/complex/algorithms/update/bounding.h>
+#include <vcg/complex/algorithms/update/normal.h>
+
+using namespace meshmend;
+using namespace meshmend::bridge;
+
+namespace {
+
+// The order of the "scope" choices in the dialog and in scripts.
+enum Scope { kWithinCurrent, kBetweenTwo, kBothOfTwo };
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+ClearancePlugin::ClearancePlugin() {
+  typeList << MEASURE_CLEARANCE << ENFORCE_CLEARANCE;
+  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+}
+
+QString ClearancePlugin::filterName(FilterIDType id) const {
+  return id == MEASURE_CLEARANCE ? "MeshMend: Measure Clearance"
+                                 : "MeshMend: Enforce Minimum Clearance";
+}
+
+QString ClearancePlugin::filterInfo(FilterIDType id) const {
+  const QString pairs =
+      "Two faces count when they share no vertex (faces of different layers never do); their "
+      "distance is the smallest of their vertex-face and edge-edge distances. Between layers, "
+      "the layer matrices are applied, so the distances are those seen in the viewer. ";
+  if (id == MEASURE_CLEARANCE)
+    return "Measures the clearance: the smallest distance between non-adjacent faces within the "
+           "current layer, between two chosen layers, or both. " +
+           pairs +
+           "Each vertex gets the smallest distance of a pair involving one of its faces as its "
+           "quality (capped at twice tau; run Filters > Color Creation and Processing > "
+           "Colorize by vertex quality to see it), the faces closer than tau are selected, and "
+           "the log gives the minimum, the closest pairs and a histogram of the pair distances. "
+           "Nothing moves.<br>"
+           "Method: the distance functions of <i>Aycheh and Kyung</i>, <b>\"Self-intersection "
+           "avoidance for 3-D triangular mesh model\"</b>, with a spatial index over the faces.";
+  return "Moves vertices as little as possible until every pair of non-adjacent faces in the "
+         "scope (within the current layer, between two chosen layers, or both) is at least tau "
+         "apart. " +
+         pairs +
+         "Selected vertices can be locked; a cap limits how far any vertex moves. The input "
+         "must be free of intersections (the message names the MeshMend filter that resolves "
+         "them); every intermediate configuration stays free of them. When tau cannot be "
+         "reached (locked vertices, the cap, a part thinner than tau) the filter moves what it "
+         "can, keeps the mesh intact and reports the pairs still short. Connectivity, "
+         "attributes and the layer matrices stay as they were; the result is float as MeshLab "
+         "stores it, and checked as such.<br>"
+         "Method: <i>Aycheh and Kyung</i>, <b>\"Self-intersection avoidance for 3-D triangular "
+         "mesh model\"</b>: Gauss-Newton steps on the distances of the pairs closer than tau, "
+         "the minimum-norm step from a sparse least-squares solve (instead of the paper's dense "
+         "SVD), and a backtracking line search that also keeps the surfaces from crossing.";
+}
+
+void ClearancePlugin::initParameterSet(QAction* a, MeshDocument& md,
+                                       RichParameterList& parameters) {
+  MeshModel* current = md.mm();
+  MeshModel* other = current;
+  for (MeshModel* m : md.meshList)
+    if (m != current) {
+      other = m;
+      break;
+    }
+  // Percentages of tau and the cap are of the diagonal of all layers (as
+  // placed by their matrices), the frame the distances are measured in. A
+  // document without a box yet (nothing loaded) gets 1: percent of a unit.
+  const Box3m box = md.bbox();
+  const float diagonal = box.IsNull() ? 1.0f : box.Diag();
+  const bool measuring = ID(a) == MEASURE_CLEARANCE;
+  parameters.addParam(RichAbsPerc(
+      "tau", diagonal * 0.01f, 0, diagonal, "Clearance tau",
+      measuring ? "The clearance to check, in mesh units or as a percentage of the bounding box "
+                  "diagonal: faces of pairs closer than this are selected; 0 only measures the "
+                  "minimum. Vertex quality is capped at twice this."
+                : "The smallest distance every pair of non-adjacent faces in the scope must "
+                  "reach, in mesh units or as a percentage of the bounding box diagonal; must "
+                  "be more than 0."));
+  parameters.addParam(RichEnum(
+      "scope", kWithinCurrent,
+      QStringList() << "Within the current layer"
+                    << "Between two chosen layers"
+                    << "Both (within and between the two chosen layers)",
+      "Scope",
+      "Which face pairs count. Within the current layer: its own non-adjacent faces (the inner "
+      "and outer skin of a shell, a fold). Between two chosen layers: faces of the first against "
+      "faces of the second (layer matrices applied). Both: the two chosen layers, within each "
+      "and between them."));
+  parameters.addParam(RichMesh("first_layer", current, &md, "First layer",
+                               "First of the two chosen layers (scopes 'between' and 'both'); "
+                               "in a script, the layer's index in loading order."));
+  parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
+                               "Second of the two chosen layers (scopes 'between' and 'both'); "
+                               "in a script, the layer's index in loading order."));
+  parameters.addParam(RichInt(
+      "exclusion_rings", 1, "Adjacent within (rings)",
+      "Faces of one layer within this many vertex rings of each other are neighbours and never "
+      "compared. 1: faces sharing a vertex (the paper's rule). 2: also faces touching a "
+      "neighbour of a corner, so that a tau near the edge length measures the gaps between "
+      "sheets rather than the mesh's own resolution."));
+  if (!measuring) {
+    parameters.addParam(RichBool(
+        "lock_selected", false, "Lock selected vertices",
+        "Selected vertices do not move (select a part that must keep its shape, e.g. the bore "
+        "a piston must fit). A pair short of tau whose faces are all locked is reported, not "
+        "solved."));
+    parameters.addParam(RichAbsPerc(
+        "max_displacement", 0, 0, diagonal, "Max vertex displacement",
+        "No vertex moves farther than this from where it was, in mesh units or as a percentage "
+        "of the bounding box diagonal; a vertex that reaches it stays there and the others go "
+        "on without it. 0: no cap."));
+    parameters.addParam(RichInt(
+        "max_iterations", ClearanceOptions().max_iterations, "Max iterations",
+        "Gauss-Newton steps at most; each step re-detects the pairs closer than tau. The filter "
+        "stops earlier when tau is reached."));
+  }
+  parameters.addParam(RichString(
+      "report_file", "", "Report file (JSON)",
+      measuring
+          ? "When not empty, the measurement is also written to this path as one JSON object: "
+            "tau, min_distance, violating_pairs, faces_below_tau, histogram, closest, shortest, "
+            "time_ms (compute time, file I/O excluded), ..."
+          : "When not empty, the outcome is also written to this path as one JSON object: tau, "
+            "reached, stop_reason, min_distance_before, min_distance_after, "
+            "violating_pairs_before, violating_pairs_after, max_displacement, "
+            "mean_displacement, displacement_lower_bound, short_pairs, time_ms, ..."));
+}
+
+namespace {
+
+// The layers the scope and layer parameters choose, and the core scope.
+struct Chosen {
+  std::vector<MeshModel*> layers;
+  ClearanceScope scope = ClearanceScope::kWithinLayers;
+};
+
+Chosen chosenLayers(MeshDocument& md, const RichParameterList& parameters) {
+  const int scope = parameters.getEnum("scope");
+  if (scope == kWithinCurrent) {
+    if (!md.mm()) throw InvalidInputError("there is no current layer: open a mesh first");
+    return {{md.mm()}, ClearanceScope::kWithinLayers};
+  }
+  if (scope != kBetweenTwo && scope != kBothOfTwo)
+    throw InvalidInputError("unknown scope " + std::to_string(scope) +
+                            ": use 0 (within), 1 (between) or 2 (both)");
+  MeshModel* a = parameters.getMesh("first_layer");
+  MeshModel* b = parameters.getMesh("second_layer");
+  if (!a || !b) throw InvalidInputError("choose the two layers");
+  if (a == b)
+    throw InvalidInputError("the same layer (" + layerName(*a) +
+                            ") was chosen twice: choose two different layers, or use the scope "
+                            "'Within the current layer'");
+  return {{a, b}, scope == kBetweenTwo ? ClearanceScope::kBetweenLayers : ClearanceScope::kBoth};
+}
+
+// The chosen layers as core meshes in one frame: every layer's matrix is
+// applied, so that distances are those the user sees (and a percentage of
+// the document's diagonal means the same for every scope).
+struct Inputs {
+  Chosen chosen;
+  std::vector<Mesh> cores;
+};
+
+void readInputs(MeshDocument& md, const RichParameterList& parameters, Inputs& in) {
+  in.chosen = chosenLayers(md, parameters);
+  in.cores = std::vector<Mesh>(in.chosen.layers.size());
+  for (std::size_t i = 0; i < in.chosen.layers.size(); ++i) {
+    toCore(in.chosen.layers[i]->cm, in.cores[i], {int(i), true});
+    requireFacesAndFiniteCoordinates(in.cores[i], layerName(*in.chosen.layers[i]));
+  }
+}
+
+// The core names layers by their index among the chosen ones; users know
+// them by name.
+std::string layerList(const std::vector<MeshModel*>& layers) {
+  std::string s;
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    s += (i ? ", " : "") + std::string("layer ") + std::to_string(i) + " is '" +
+         toStd(layers[i]->label()) + "'";
+  return s;
+}
+
+std::vector<std::string> labels(const std::vector<MeshModel*>& layers) {
+  std::vector<std::string> names;
+  for (MeshModel* m : layers) names.push_back(toStd(m->label()));
+  return names;
+}
+
+// A core face index as MeshLab's face index in its layer (the index users see
+// in MeshLab's info tools, deleted slots included).
+int meshlabFace(const std::vector<Mesh>& cores, int layer, int face) {
+  FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(cores[layer]));
+  return fo[face].face;
+}
+
+std::string describe(const ClearancePair& p, const std::vector<Mesh>& cores,
+                     const std::vector<MeshModel*>& layers) {
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "%.6g between face %d of '%s' and face %d of '%s' (%s), at (%.6g, %.6g, %.6g) "
+                "and (%.6g, %.6g, %.6g)",
+                p.distance, meshlabFace(cores, p.layer_a, p.face_a),
+                toStd(layers[p.layer_a]->label()).c_str(), meshlabFace(cores, p.layer_b, p.face_b),
+                toStd(layers[p.layer_b]->label()).c_str(),
+                p.kind == "edge_edge" ? "edge to edge" : "vertex to face", p.point_a[0],
+                p.point_a[1], p.point_a[2], p.point_b[0], p.point_b[1], p.point_b[2]);
+  return text;
+}
+
+// The same pairs in the report, with MeshLab's face indices.
+std::vector<JsonObject> pairsJson(const std::vector<ClearancePair>& pairs,
+                                  const std::vector<Mesh>& cores) {
+  std::vector<JsonObject> out;
+  for (const ClearancePair& p : pairs)
+    out.push_back(
+        JsonObject()
+            .set("layer_a", p.layer_a)
+            .set("face_a", meshlabFace(cores, p.layer_a, p.face_a))
+            .set("layer_b", p.layer_b)
+            .set("face_b", meshlabFace(cores, p.layer_b, p.face_b))
+            .set("kind", p.kind)
+            .set("distance", p.distance)
+            .set("point_a", std::vector<double>{p.point_a[0], p.point_a[1], p.point_a[2]})
+            .set("point_b", std::vector<double>{p.point_b[0], p.point_b[1], p.point_b[2]}));
+  return out;
+}
+
+// A distance parameter: finite and not negative.
+double distanceParameter(const RichParameterList& parameters, const char* name, const char* what) {
+  const double value = parameters.getAbsPerc(name);
+  if (!std::isfinite(value) || value < 0)
+    throw InvalidInputError(std::string(what) + " must be a distance of 0 or more (got " +
+                            std::to_string(value) + ")");
+  return value;
+}
+
+}  // namespace
+
+bool ClearancePlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                                  vcg::CallBackPos* cb) {
+  return guarded(*this, errorMessage, [&] {
+    if (ID(a) == MEASURE_CLEARANCE)
+      measure(md, parameters, cb);
+    else
+      enforce(md, parameters, cb);
+  });
+}
+
+void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& parameters,
+                              vcg::CallBackPos* cb) {
+  ClearanceMeasureOptions options;
+  options.tau = distanceParameter(parameters, "tau", "tau");
+  options.exclusion_rings = parameters.getInt("exclusion_rings");
+  options.progress = progressFrom(cb);
+  Inputs in;
+  reportProgress(options.progress, 0, "MeshMend: reading the layers");
+  readInputs(md, parameters, in);
+  const std::vector<MeshModel*>& layers = in.chosen.layers;
+  options.scope = in.chosen.scope;
+  std::vector<const Mesh*> meshes;
+  for (const Mesh& m : in.cores) meshes.push_back(&m);
+  const ClearanceMeasure r = measureClearance(meshes, options);
+
+  JsonObject report = toJson(r);
+  report.set("scope", toString(options.scope)).set("layers", labels(layers));
+  if (r.found) report.set("closest", pairsJson({r.closest}, in.cores).front());
+  report.set("shortest", pairsJson(r.shortest, in.cores));
+  writeReport(parameters.getString("report_file"), report);
+
+  // The document changes only from here on: quality and selection, no geometry.
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    MeshModel& model = *layers[l];
+    model.updateDataMask(MeshModel::MM_VERTQUALITY);
+    CMeshO& cm = model.cm;
+    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    FaceOriginHandle fo = faceOrigins(in.cores[l]);
+    for (std::size_t v = 0; v < r.vertex_clearance[l].size(); ++v)
+      cm.vert[vo[v].vertex].Q() = float(r.vertex_clearance[l][v]);
+    for (CFaceO& f : cm.face) f.ClearS();
+    for (std::size_t f = 0; f < r.faces_below_tau[l].size(); ++f)
+      if (r.faces_below_tau[l][f]) cm.face[fo[f].face].SetS();
+  }
+
+  const char* scopeText = options.scope == ClearanceScope::kWithinLayers    ? "within"
+                          : options.scope == ClearanceScope::kBetweenLayers ? "between"
+                                                                            : "within and between";
+  std::string where = layerName(*layers[0]);
+  if (layers.size() > 1)
+    where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
+  if (!r.found) {
+    Log("MeshMend: no pair of non-adjacent faces %s %s: nothing to measure", scopeText,
+        where.c_str());
+    return;
+  }
+  Log("MeshMend: clearance %s %s: minimum %s", scopeText, where.c_str(),
+      describe(r.closest, in.cores, layers).c_str());
+  if (options.tau > 0)
+    Log("  %zu face pairs closer than tau = %.6g; %zu faces selected", r.violating_pairs,
+        options.tau, r.faces_below_tau_count);
+  for (std::size_t i = 1; i < r.shortest.size(); ++i)
+    Log("  pair %zu: %s", i + 1, describe(r.shortest[i], in.cores, layers).c_str());
+  Log("  face pairs by distance (vertex quality = local clearance, capped at %.6g):", r.local_max);
+  const std::size_t bins = r.histogram.size();
+  for (std::size_t b = 0; b < bins; ++b)
+    Log("    [%.4g, %.4g): %zu", r.local_max * double(b) / double(bins),
+        r.local_max * double(b + 1) / double(bins), r.histogram[b]);
+  Log("  %zu candidate pairs measured in %.0f ms", r.candidate_pairs, r.time_ms);
+}
+
+void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& parameters,
+                              vcg::CallBackPos* cb) {
+  ClearanceOptions options;
+  options.tau = distanceParameter(parameters, "tau", "tau");
+  if (!(options.tau > 0))
+    throw InvalidInputError(
+        "tau must be more than 0: it is the distance every pair of faces "
+        "must reach");
+  options.max_displacement =
+      distanceParameter(parameters, "max_displacement", "the max vertex displacement");
+  options.max_iterations = parameters.getInt("max_iterations");
+  if (options.max_iterations < 1) throw InvalidInputError("max iterations must be at least 1");
+  options.exclusion_rings = parameters.getInt("exclusion_rings");
+  options.round_to_float = true;  // MeshLab stores float: reach tau in what it will store
+  options.progress = progressFrom(cb);
+
+  Inputs in;
+  reportProgress(options.progress, 0, "MeshMend: reading the layers");
+  readInputs(md, parameters, in);
+  const std::vector<MeshModel*>& layers = in.chosen.layers;
+  options.scope = in.chosen.scope;
+  const bool lock = parameters.getBool("lock_selected");
+  std::size_t lockedCount = 0;
+  if (lock) {
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+      VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+      std::vector<char> locked(in.cores[l].vert.size(), 0);
+      for (std::size_t v = 0; v < locked.size(); ++v) {
+        locked[v] = layers[l]->cm.vert[vo[v].vertex].IsS();
+        lockedCount += locked[v];
+      }
+      options.locked.push_back(std::move(locked));
+    }
+  }
+
+  // Where each vertex was, in the common frame: the core works on it rounded
+  // to float (round_to_float), so a vertex it did not move comes back as
+  // exactly that rounding.
+  std::vector<std::vector<Point3>> start(layers.size());
+  for (std::size_t l = 0; l < layers.size(); ++l)
+    for (const Vertex& v : in.cores[l].vert) {
+      const Point3& p = v.cP();
+      start[l].push_back(Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))));
+    }
+
+  std::vector<Mesh*> meshes;
+  for (Mesh& m : in.cores) meshes.push_back(&m);
+  ClearanceResult r;
+  try {
+    r = enforceClearance(meshes, options);
+  } catch (const TopologyError& e) {
+    throw TopologyError(std::string(e.what()) + " (" + layerList(layers) + ")");
+  }
+
+  // MeshLab keeps each layer in its own frame, placed by its matrix: the
+  // moved vertices go back through the inverse matrix; the others keep their
+  // stored coordinates bit for bit. As a layer with a matrix other than the
+  // identity rounds a second time, what will be stored is measured again.
+  const auto writeStart = std::chrono::steady_clock::now();
+  std::vector<std::vector<std::pair<int, vcg::Point3f>>> moves(layers.size());
+  bool anyMatrix = false;
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    const CMeshO& cm = layers[l]->cm;
+    const bool identity = cm.Tr == Matrix44m::Identity();
+    anyMatrix |= !identity;
+    const vcg::Matrix44d inverse = vcg::Inverse(vcg::Matrix44d::Construct(cm.Tr));
+    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
+      const Point3& p = in.cores[l].vert[v].cP();
+      if (p == start[l][v]) continue;
+      moves[l].emplace_back(vo[v].vertex,
+                            vcg::Point3f::Construct(identity ? p : Point3(inverse * p)));
+    }
+  }
+  std::size_t verifiedPairs = r.violating_pairs_after;
+  double verifiedMinimum = r.min_distance_after;
+  if (anyMatrix && r.vertices_moved > 0) {
+    reportProgress(options.progress, 98, "MeshMend: checking the stored result");
+    // The cores are not needed in the common frame any more (only their face
+    // provenance is): they take the positions as they will be stored.
+    std::vector<const Mesh*> stored;
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+      const CMeshO& cm = layers[l]->cm;
+      const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
+      std::vector<int> slot(cm.vert.size(), -1);
+      VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+      for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
+        slot[vo[v].vertex] = int(v);
+        in.cores[l].vert[v].P() = tr * Point3::Construct(cm.vert[vo[v].vertex].cP());
+      }
+      for (const auto& [vertex, p] : moves[l])
+        in.cores[l].vert[slot[vertex]].P() = tr * Point3::Construct(p);
+      stored.push_back(&in.cores[l]);
+    }
+    ClearanceMeasureOptions check;
+    check.tau = options.tau;
+    check.scope = options.scope;
+    check.exclusion_rings = options.exclusion_rings;
+    const ClearanceMeasure m = measureClearance(stored, check);
+    verifiedPairs = m.violating_pairs;
+    verifiedMinimum = m.found ? m.min_distance : r.min_distance_after;
+  }
+  const double writeMs = msSince(writeStart);
+
+  JsonObject report = toJson(r);
+  report.set("scope", toString(options.scope))
+      .set("layers", labels(layers))
+      .set("locked_vertices", lockedCount)
+      .set("short_pairs", pairsJson(r.short_pairs, in.cores))
+      .set("time_ms", r.time_ms + writeMs);
+  if (anyMatrix && r.vertices_moved > 0) {
+    // What the layers hold after writing back through their matrices.
+    report.set("min_distance_after", verifiedMinimum)
+        .set("violating_pairs_after", verifiedPairs)
+        .set("min_distance_after_solve", r.min_distance_after)
+        .set("violating_pairs_after_solve", r.violating_pairs_after);
+  }
+  writeReport(parameters.getString("report_file"), report);
+
+  // The only change to the document, made last: positions of moved vertices.
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    if (moves[l].empty()) continue;
+    CMeshO& cm = layers[l]->cm;
+    for (const auto& [vertex, p] : moves[l]) cm.vert[vertex].P() = p;
+    // Face normals follow the new geometry; vertex normals stay as they were
+    // (the moves are at most about tau, and imported normals survive).
+    vcg::tri::UpdateBounding<CMeshO>::Box(cm);
+    vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(cm);
+  }
+
+  const char* scopeText = options.scope == ClearanceScope::kWithinLayers    ? "within"
+                          : options.scope == ClearanceScope::kBetweenLayers ? "between"
+                                                                            : "within and between";
+  std::string where = layerName(*layers[0]);
+  if (layers.size() > 1)
+    where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
+  Log("MeshMend: clearance %s %s, tau = %.6g: %s", scopeText, where.c_str(), r.tau,
+      r.reached ? "reached" : "NOT reached");
+  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", r.min_distance_before,
+      verifiedMinimum, r.violating_pairs_before, verifiedPairs);
+  Log("  %zu vertices moved (%zu locked): max displacement %.6g (no solution moves less than "
+      "%.6g), mean %.6g; %d iterations, %.0f ms",
+      r.vertices_moved, lockedCount, r.max_displacement, r.displacement_lower_bound,
+      r.mean_displacement_moved, r.iterations, r.time_ms + writeMs);
+  if (lock && lockedCount == 0) Log("  note: no vertex is selected, so none was locked");
+  if (r.vertices_capped) Log("  %zu vertices stopped at the max displacement", r.vertices_capped);
+  if (!r.reached) {
+    std::string why;
+    if (r.stop_reason == "locked")
+      why =
+          "every pair still short has only locked (selected) or capped vertices: deselect "
+          "some, raise the max displacement, or lower tau";
+    else if (r.stop_reason == "iterations")
+      why = "the max iterations were used up: raise them";
+    else if (r.stop_reason == "stalled")
+      why =
+          "no step that keeps the surfaces apart gets closer to tau (locked vertices, the "
+          "cap, or a part thinner than tau allows)";
+    else
+      why = r.stop_reason;
+    Log("  tau not reached: %s", why.c_str());
+    for (std::size_t i = 0; i < r.short_pairs.size(); ++i)
+      Log("  short pair %zu: %s", i + 1, describe(r.short_pairs[i], in.cores, layers).c_str());
+  }
+  for (const std::string& w : r.warnings) Log("  warning: %s", w.c_str());
+  if (r.remaining_intersecting_pairs)
+    Log("  check: %zu intersecting pairs in the float result", r.remaining_intersecting_pairs);
+  reportProgress(options.progress, 100, "MeshMend: done");
+}
+
+MESHLAB_PLUGIN_NAME_EXPORTER(ClearancePlugin)
