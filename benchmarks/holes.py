@@ -598,8 +598,8 @@ def fill_and_measure(tools, hole, repeat):
             results[m].update({"filled": report["holes_filled"] == 1,
                                "fairing": h.get("fairing"), "reason": h.get("reason", ""),
                                "edges_split": report["edges_split"],
-                               "stage_ms": report["stage_ms"],
-                               "hole_ms": h.get("time_ms")})
+                               "stage_ms": report["median_stage_ms"],
+                               "hole_ms": report["median_holes_ms"]})
             results[m].update(measure_output(tools, hole, hV, hF, m, d / f"{m}.ply"))
     # CGAL: the peer program writes the filled mesh; bench_holes timed the same call.
     peer = json.loads(subprocess.run([str(tools.peer_holefill), str(holed), "--out",
@@ -762,10 +762,9 @@ def speed(tools, repeat, work, fidelity_holes):
                                    d / "meshmend_regression.ply")
     if timing["cgal_refine_fair"]["ok"]:
         h["cgal"] = measure_output(tools, h, hV, hF, "cgal", d / "cgal_refine_fair.off")
-    hole = h["report"]["holes"][0] if h["report"]["holes"] else {}
     h["rows"] = [speed_row("sphere, 1,000-edge hole", h["border_edges"], h["faces"],
                            timing["meshmend_regression"], timing["cgal_refine_fair"],
-                           timing["meshlab_close_holes"], hole.get("time_ms"))]
+                           timing["meshlab_close_holes"], h["report"]["median_holes_ms"])]
     for f in fidelity_holes:
         if f["label"] == "round L":
             r = f["results"]
@@ -788,6 +787,10 @@ def fmt_ms(ms):
 
 def fmt_d(x):
     return "–" if x is None else f"{x:.3f}" if x < 10 else f"{x:.1f}"
+
+
+def short_reason(reason):
+    return reason.replace(" patch would intersect itself or the mesh", " intersects")
 
 
 def at_least_as_good(ours, peer, key):
@@ -876,7 +879,7 @@ def tables(holes, sp, repeat, machine, elapsed):
         o = res[OURS[0]]
         shape = o.get("fairing", "–") or "–"
         if o.get("reason"):
-            shape += f" ({o['reason']})"
+            shape += f" ({short_reason(o['reason'])})"
         out.append(f"| {h['mesh']} {h['label']} | {unit:.4g} | " + " | ".join(hs) +
                    f" | {shape} | {o.get('edges_split', '–')} |")
     # Summary.
@@ -900,12 +903,29 @@ def tables(holes, sp, repeat, machine, elapsed):
             "Each of our shapes against CGAL by mean distance: " +
             ", ".join(f"{MODE_LABEL[m].split(': ')[1]} {best_mode[m]} of {n}" for m in OURS) + ".",
             ""]
+    open_holes = {m: [f"{h['mesh']} {h['label']}" for h in holes
+                      if not h["results"][m].get("filled")] for m in ["meshmend_regression",
+                                                                       "cgal", "meshlab"]}
+    fallbacks = [f"{h['mesh']} {h['label']}" for h in holes
+                 if h["results"][OURS[0]].get("filled") and
+                 h["results"][OURS[0]].get("fairing") != "laplacian_regression"]
+    out[-1:] = ["",
+                "Holes left open (or partly open): ours (default) "
+                f"{len(open_holes['meshmend_regression'])} "
+                f"({', '.join(open_holes['meshmend_regression']) or 'none'}; every shape failed "
+                "our exact intersection check), CGAL "
+                f"{len(open_holes['cgal'])} ({', '.join(open_holes['cgal']) or 'none'}), MeshLab "
+                f"{len(open_holes['meshlab'])} ({', '.join(open_holes['meshlab']) or 'none'}). "
+                "A hole that ours leaves open counts as a loss against any peer that closed it. "
+                f"Ours fell back to a flatter shape on {len(fallbacks)} "
+                f"({', '.join(fallbacks) or 'none'}).",
+                ""]
     # Times of the fidelity holes.
     out += [f"Times of the fidelity holes (ms, medians of {repeat} runs of `bench_holes` in child "
             "processes, the input copied beforehand). Ours: `fillHoles` on the whole holed mesh, "
             "which includes finding the border and writing the patch into the mesh, two passes "
             "over the whole mesh; *hole only* is the hole's own time in our report (split, "
-            "patch, shape, exact check; first run). CGAL: the `triangulate_refine_and_fair_hole` "
+            f"patch, shape, exact check; median of {repeat} more fills). CGAL: the `triangulate_refine_and_fair_hole` "
             "call alone, the border cycle found beforehand. MeshLab: what its filter runs "
             "(face-face adjacency, the non-manifold check, vcglib's "
             "`EarCuttingIntersectionFill` with `SelfIntersectionEar`), compiled from the same "
@@ -969,8 +989,9 @@ def tables(holes, sp, repeat, machine, elapsed):
     if "cgal" in sp:
         facts.append(f"CGAL {sp['cgal']['faces_added']:,}")
     out += ["",
-            f"On the sphere hole {', '.join(facts)}. Stages of ours' first run (ms): " +
-            ", ".join(f"{k} {v:.1f}" for k, v in rep["stage_ms"].items() if v >= 0.05) + "."]
+            f"On the sphere hole {', '.join(facts)}. Ours' stages (ms, medians): " +
+            ", ".join(f"{k} {v:.1f}" for k, v in rep["median_stage_ms"].items() if v >= 0.05) +
+            "."]
     if sp.get("ours", {}).get("mean") is not None and sp.get("cgal", {}).get("mean") is not None:
         out[-1] += (f" Patch to the removed cap, mean / max in ē ({unit:.4g}): ours "
                     f"{fmt_d(sp['ours']['mean'] / unit)} / {fmt_d(sp['ours']['max'] / unit)}, "
