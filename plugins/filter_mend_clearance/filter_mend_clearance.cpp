@@ -326,11 +326,10 @@ void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& paramet
 void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& parameters,
                               vcg::CallBackPos* cb) {
   ClearanceOptions options;
-  options.tau = distanceParameter(parameters, "tau", "tau");
-  if (!(options.tau > 0))
-    throw InvalidInputError(
-        "tau must be more than 0: it is the distance every pair of faces "
-        "must reach");
+  options.tau = parameters.getAbsPerc("tau");
+  if (!(options.tau > 0) || !std::isfinite(options.tau))
+    throw InvalidInputError("tau must be more than 0 (got " + std::to_string(options.tau) +
+                            "): it is the distance every pair of faces must reach");
   options.max_displacement =
       distanceParameter(parameters, "max_displacement", "the max vertex displacement");
   options.max_iterations = parameters.getInt("max_iterations");
@@ -358,15 +357,34 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
     }
   }
 
-  // Where each vertex was, in the common frame: the core works on it rounded
-  // to float (round_to_float), so a vertex it did not move comes back as
-  // exactly that rounding.
-  std::vector<std::vector<Point3>> start(layers.size());
+  // A layer placed by a matrix other than the identity is not float in the
+  // common frame: the core's rounding (round_to_float) shifts it by up to half
+  // a float step of its placed coordinates, and the moved vertices round once
+  // more in the layer's own frame. The solve aims beyond tau by more than
+  // both; the distances and displacements reported are measured here on the
+  // exact input and on what the layers will store.
+  bool anyMatrix = false;
+  for (MeshModel* m : layers) anyMatrix |= !(m->cm.Tr == Matrix44m::Identity());
+  ClearanceMeasureOptions check;
+  check.tau = options.tau;
+  check.scope = options.scope;
+  check.exclusion_rings = options.exclusion_rings;
+  std::vector<const Mesh*> constCores;
+  for (const Mesh& m : in.cores) constCores.push_back(&m);
+  ClearanceMeasure exactBefore;
+  const auto measureStart = std::chrono::steady_clock::now();
+  if (anyMatrix) exactBefore = measureClearance(constCores, check);
+
+  // Where each vertex was in the common frame, exactly and as the core takes
+  // it (rounded to float): a vertex it did not move comes back as the latter.
+  std::vector<std::vector<Point3>> exact(layers.size()), rounded(layers.size());
   for (std::size_t l = 0; l < layers.size(); ++l)
     for (const Vertex& v : in.cores[l].vert) {
       const Point3& p = v.cP();
-      start[l].push_back(Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))));
+      exact[l].push_back(p);
+      rounded[l].push_back(Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))));
     }
+  double ownMs = msSince(measureStart);
 
   std::vector<Mesh*> meshes;
   for (Mesh& m : in.cores) meshes.push_back(&m);
@@ -379,31 +397,37 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
 
   // MeshLab keeps each layer in its own frame, placed by its matrix: the
   // moved vertices go back through the inverse matrix; the others keep their
-  // stored coordinates bit for bit. As a layer with a matrix other than the
-  // identity rounds a second time, what will be stored is measured again.
+  // stored coordinates bit for bit.
   const auto writeStart = std::chrono::steady_clock::now();
   std::vector<std::vector<std::pair<int, vcg::Point3f>>> moves(layers.size());
-  bool anyMatrix = false;
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const CMeshO& cm = layers[l]->cm;
     const bool identity = cm.Tr == Matrix44m::Identity();
-    anyMatrix |= !identity;
     const vcg::Matrix44d inverse = vcg::Inverse(vcg::Matrix44d::Construct(cm.Tr));
     VertexOriginHandle vo = vertexOrigins(in.cores[l]);
     for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
       const Point3& p = in.cores[l].vert[v].cP();
-      if (p == start[l][v]) continue;
+      if (p == rounded[l][v]) continue;
       moves[l].emplace_back(vo[v].vertex,
                             vcg::Point3f::Construct(identity ? p : Point3(inverse * p)));
     }
   }
-  std::size_t verifiedPairs = r.violating_pairs_after;
-  double verifiedMinimum = r.min_distance_after;
-  if (anyMatrix && r.vertices_moved > 0) {
+
+  // The outcome as stored. Without matrices it is the core's own (it checked
+  // its float result); with them, it is measured again on the stored floats.
+  double minBefore = r.min_distance_before, minAfter = r.min_distance_after;
+  std::size_t pairsBefore = r.violating_pairs_before, pairsAfter = r.violating_pairs_after;
+  double maxMove = r.max_displacement, meanMoved = r.mean_displacement_moved,
+         meanAll = r.mean_displacement_all;
+  if (anyMatrix) {
     reportProgress(options.progress, 98, "MeshMend: checking the stored result");
+    minBefore = exactBefore.found ? exactBefore.min_distance : minBefore;
+    pairsBefore = exactBefore.violating_pairs;
     // The cores are not needed in the common frame any more (only their face
     // provenance is): they take the positions as they will be stored.
-    std::vector<const Mesh*> stored;
+    std::size_t vertices = 0, moved = 0;
+    double sum = 0;
+    maxMove = 0;
     for (std::size_t l = 0; l < layers.size(); ++l) {
       const CMeshO& cm = layers[l]->cm;
       const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
@@ -411,34 +435,48 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
       VertexOriginHandle vo = vertexOrigins(in.cores[l]);
       for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
         slot[vo[v].vertex] = int(v);
-        in.cores[l].vert[v].P() = tr * Point3::Construct(cm.vert[vo[v].vertex].cP());
+        in.cores[l].vert[v].P() = exact[l][v];
       }
-      for (const auto& [vertex, p] : moves[l])
-        in.cores[l].vert[slot[vertex]].P() = tr * Point3::Construct(p);
-      stored.push_back(&in.cores[l]);
+      for (const auto& [vertex, p] : moves[l]) {
+        const int v = slot[vertex];
+        in.cores[l].vert[v].P() = tr * Point3::Construct(p);
+        const double d = Point3(in.cores[l].vert[v].cP() - exact[l][v]).Norm();
+        maxMove = std::max(maxMove, d);
+        sum += d;
+        moved += d > 0;
+      }
+      vertices += in.cores[l].vert.size();
     }
-    ClearanceMeasureOptions check;
-    check.tau = options.tau;
-    check.scope = options.scope;
-    check.exclusion_rings = options.exclusion_rings;
-    const ClearanceMeasure m = measureClearance(stored, check);
-    verifiedPairs = m.violating_pairs;
-    verifiedMinimum = m.found ? m.min_distance : r.min_distance_after;
+    meanMoved = moved ? sum / double(moved) : 0;
+    meanAll = vertices ? sum / double(vertices) : 0;
+    const ClearanceMeasure after = measureClearance(constCores, check);
+    minAfter = after.found ? after.min_distance : minAfter;
+    pairsAfter = after.violating_pairs;
   }
-  const double writeMs = msSince(writeStart);
+  ownMs += msSince(writeStart);
 
   JsonObject report = toJson(r);
   report.set("scope", toString(options.scope))
       .set("layers", labels(layers))
       .set("locked_vertices", lockedCount)
       .set("short_pairs", pairsJson(r.short_pairs, in.cores))
-      .set("time_ms", r.time_ms + writeMs);
-  if (anyMatrix && r.vertices_moved > 0) {
-    // What the layers hold after writing back through their matrices.
-    report.set("min_distance_after", verifiedMinimum)
-        .set("violating_pairs_after", verifiedPairs)
-        .set("min_distance_after_solve", r.min_distance_after)
-        .set("violating_pairs_after_solve", r.violating_pairs_after);
+      .set("time_ms", r.time_ms + ownMs);
+  if (anyMatrix) {
+    // What the layers hold, placed by their matrices; the solve's own values
+    // (on the input rounded to float in the common frame) are kept beside.
+    report.set("min_distance_before", minBefore)
+        .set("violating_pairs_before", pairsBefore)
+        .set("min_distance_after", minAfter)
+        .set("violating_pairs_after", pairsAfter)
+        .set("max_displacement", maxMove)
+        .set("mean_displacement", meanMoved)
+        .set("mean_displacement_moved", meanMoved)
+        .set("mean_displacement_all", meanAll)
+        .set("solve", JsonObject()
+                          .set("min_distance_before", r.min_distance_before)
+                          .set("min_distance_after", r.min_distance_after)
+                          .set("violating_pairs_after", r.violating_pairs_after)
+                          .set("max_displacement", r.max_displacement));
   }
   writeReport(parameters.getString("report_file"), report);
 
@@ -461,12 +499,13 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
     where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
   Log("MeshMend: clearance %s %s, tau = %.6g: %s", scopeText, where.c_str(), r.tau,
       r.reached ? "reached" : "NOT reached");
-  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", r.min_distance_before,
-      verifiedMinimum, r.violating_pairs_before, verifiedPairs);
+  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", minBefore, minAfter,
+      pairsBefore, pairsAfter);
   Log("  %zu vertices moved (%zu locked): max displacement %.6g (no solution moves less than "
       "%.6g), mean %.6g; %d iterations, %.0f ms",
-      r.vertices_moved, lockedCount, r.max_displacement, r.displacement_lower_bound,
-      r.mean_displacement_moved, r.iterations, r.time_ms + writeMs);
+      r.vertices_moved, lockedCount, maxMove, r.displacement_lower_bound, meanMoved, r.iterations,
+      r.time_ms + ownMs);
+  if (anyMatrix) Log("  layer matrices applied; moved vertices written back in each layer's frame");
   if (lock && lockedCount == 0) Log("  note: no vertex is selected, so none was locked");
   if (r.vertices_capped) Log("  %zu vertices stopped at the max displacement", r.vertices_capped);
   if (!r.reached) {
