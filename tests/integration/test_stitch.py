@@ -495,7 +495,7 @@ def read_ply(path):
                         st = struct.Struct(order + sizes[p[0]])
                         row.append(st.unpack_from(data, pos)[0]); pos += st.size
                 (V if name == "vertex" else F).append(row)
-    vprops = [p[-1] for p in elements[0][2]]
+    vprops = [p[-1] for name, _, props in elements if name == "vertex" for p in props]
     xi, yi, zi = vprops.index("x"), vprops.index("y"), vprops.index("z")
     points = [(v[xi], v[yi], v[zi]) for v in V]
     faces = [tuple(f[0]) for f in F if len(f[0]) == 3]
@@ -509,3 +509,156 @@ def mlp_matrices(path):
         values = [float(x) for x in mesh.find("MLMatrix44").text.split()]
         out[mesh.get("label")] = [values[4 * r:4 * r + 4] for r in range(4)]
     return out
+
+
+def main_component(V, F):
+    """The largest vertex-connected part, compacted."""
+    import numpy as np
+    parent = np.arange(len(V))
+
+    def root(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+    for a, b, c in F:
+        ra = root(a)
+        parent[root(b)] = ra
+        parent[root(c)] = ra
+    roots = np.array([root(t[0]) for t in F])
+    values, counts = np.unique(roots, return_counts=True)
+    F = F[roots == values[counts.argmax()]]
+    used = np.unique(F)
+    remap = -np.ones(len(V), int)
+    remap[used] = np.arange(len(used))
+    return V[used], remap[F]
+
+
+def outer_border(F):
+    """The longest closed border loop, in the direction of its faces."""
+    uses = set()
+    for a, b, c in F:
+        uses.update(((a, b), (b, c), (c, a)))
+    nxt = {u: v for (u, v) in uses if (v, u) not in uses}
+    seen, best = set(), []
+    for s in nxt:
+        if s in seen:
+            continue
+        loop, v = [s], nxt[s]
+        seen.add(s)
+        while v != s and v not in seen and v in nxt:
+            loop.append(v)
+            seen.add(v)
+            v = nxt[v]
+        if v == s:  # a closed loop (a bow-tie vertex can end a walk early)
+            best = max(best, loop, key=len)
+    return best
+
+
+def geodesic(V, F, s, t, avoid):
+    """Shortest edge path from s to t that avoids the vertices in `avoid`."""
+    import heapq
+    adjacency = {}
+    for a, b, c in F:
+        for u, v in ((a, b), (b, c), (c, a)):
+            adjacency.setdefault(u, set()).add(v)
+            adjacency.setdefault(v, set()).add(u)
+    dist, came = {s: 0.0}, {}
+    queue = [(0.0, s)]
+    while queue:
+        d, u = heapq.heappop(queue)
+        if u == t:
+            break
+        if d > dist[u]:
+            continue
+        for w in adjacency[u]:
+            if w in avoid and w != t:
+                continue
+            nd = d + float(((V[u] - V[w]) ** 2).sum() ** 0.5)
+            if nd < dist.get(w, math.inf):
+                dist[w], came[w] = nd, u
+                heapq.heappush(queue, (nd, w))
+    path = [t]
+    while path[-1] != s:
+        path.append(came[path[-1]])
+    return path[::-1]
+
+
+@pytest.mark.xfail(reason="not reached yet: after the trim, a vertex of the geodesic cut of lato000 "
+                          "is not on the new border (the stitch refuses the path); see the log",
+                   strict=False)
+def test_two_range_scans_trimmed_and_stitched_into_one_part(tmp_path):
+    """lato000 and lato180 (opposite sides of one object, aligned by
+    partial.mlp, their borders 57 units apart across the unscanned flank):
+    each scan's ragged border facing the other is trimmed away along a loop
+    (a geodesic cut between the ends of the facing run, back along the run),
+    and the two cuts are stitched, with subdivision, into one part."""
+    require_shared_data()
+    import numpy as np
+    scans = DATA / "range_scans"
+    matrices = mlp_matrices(scans / "partial.mlp")
+    parts = []
+    for name in ("lato000.ply", "lato180.ply"):
+        V, F = read_ply(scans / name)
+        m = np.array(matrices[name])
+        V = np.array(V, float) @ m[:3, :3].T + m[:3, 3]  # the layer matrix, applied here
+        parts.append(main_component(V, np.array(F)))
+    (VA, FA), (VB, FB) = parts
+    oa, ob = np.array(outer_border(FA)), np.array(outer_border(FB))
+    D = np.sqrt(((VA[oa][:, None, :] - VB[ob][None, :, :]) ** 2).sum(-1))
+
+    def facing_run(d, loop, bound):
+        """The longest run of the loop within `bound` of the other border."""
+        near = d < bound
+        start = int(np.argmin(near))
+        best, current = [], []
+        for k in range(1, len(loop) + 1):
+            i = (start + k) % len(loop)
+            if near[i]:
+                current.append(int(loop[i]))
+            else:
+                best, current = max(best, current, key=len), []
+        return max(best, current, key=len)
+
+    bound = D.min() + 12
+    runs = [facing_run(D.min(1), oa, bound), facing_run(D.min(0), ob, bound)]
+    files, loops, cuts, keep = [], [], [], []
+    for (V, F), run, name in zip(parts, runs, ("a", "b")):
+        cut = geodesic(V, F, run[0], run[-1], set(run))
+        loops.append(cut + run[-2:0:-1])  # along the cut, back along the run
+        cuts.append(cut)
+        far = np.argmax(((V[F].mean(1) - V[run].mean(0)) ** 2).sum(-1))  # a face far from it
+        keep.append(int(far))
+        files.append(write_off(tmp_path / f"{name}.off", V.tolist(), F.tolist()))
+    steps = [(TRIM, {"loop_vertices": indices(loops[0]), "keep_side": 1, "keep_face": keep[0],
+                     "remove_unreferenced_vertices": False, "report_file": "{report0}"}),
+             (STITCH, {"paths_from": 1, "first_layer": 0, "second_layer": 1,
+                       "path_a": indices(cuts[0]), "path_b": indices(cuts[1]),
+                       "max_aspect_ratio": 3, "report_file": "{report2}"})]
+    script = mlx(*steps)
+    # The second layer's trim: MeshLab's "Change the current layer" step.
+    trim_b = mlx((TRIM, {"loop_vertices": indices(loops[1]), "keep_side": 1,
+                         "keep_face": keep[1], "remove_unreferenced_vertices": False,
+                         "report_file": "{report1}"}))
+    trim_b = trim_b.split("<FilterScript>\n")[1].split("</FilterScript>")[0]
+    change = (' <filter name="Change the current layer">\n  <Param type="RichMesh" value="{}" '
+              'name="layer" description="" tooltip=""/>\n </filter>\n')
+    script = before(script, TRIM, [change.format(0)])  # meshlabserver's current: the last loaded
+    script = script.replace(f' <filter name="{STITCH}">',
+                            change.format(1) + trim_b + f' <filter name="{STITCH}">')
+    out = tmp_path / "assembled.ply"
+    run = run_server(tmp_path, files, script, outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    trim_a, trim_b_report, stitched = run.reports
+    after = meshcheck(out)
+    V, F = read_ply(out)
+    V, F = np.array(V), np.array(F)
+    _, Fmain = main_component(V, F)
+    print(f"\nrange scans: facing runs {len(runs[0])} / {len(runs[1])} border vertices, cuts "
+          f"{len(cuts[0])} / {len(cuts[1])}; trimmed {trim_a['faces_removed']} + "
+          f"{trim_b_report['faces_removed']} faces; stitched {stitched['faces_added']} faces, "
+          f"{stitched['vertices_added']} new vertices; intersecting pairs "
+          f"{after['self_intersecting_pairs']}; one part: {len(Fmain) == len(F)}")
+    assert len(Fmain) == len(F)  # one vertex-connected part
+    assert after["non_manifold_edges"] == 0 and after["orientation_inconsistent_edges"] == 0
+    assert stitched["remaining_intersecting_pairs"] == 0
