@@ -46,7 +46,8 @@ QString ClearancePlugin::filterInfo(FilterIDType id) const {
            "current layer, between two chosen layers, or both. " +
            pairs +
            "Each vertex gets the smallest distance of a pair involving one of its faces as its "
-           "quality (capped at twice tau; run Filters > Color Creation and Processing > "
+           "quality (capped at twice tau, or twice the minimum when tau is 0; run Filters > Color "
+           "Creation and Processing > "
            "Colorize by vertex quality to see it), the faces closer than tau are selected, and "
            "the log gives the minimum, the closest pairs and a histogram of the pair distances. "
            "Nothing moves.<br>"
@@ -88,7 +89,7 @@ void ClearancePlugin::initParameterSet(QAction* a, MeshDocument& md,
       "tau", diagonal * 0.01f, 0, diagonal, "Clearance tau",
       measuring ? "The clearance to check, in mesh units or as a percentage of the bounding box "
                   "diagonal: faces of pairs closer than this are selected; 0 only measures the "
-                  "minimum. Vertex quality is capped at twice this."
+                  "minimum. Vertex quality is capped at twice this (twice the minimum when 0)."
                 : "The smallest distance every pair of non-adjacent faces in the scope must "
                   "reach, in mesh units or as a percentage of the bounding box diagonal; must "
                   "be more than 0."));
@@ -292,6 +293,7 @@ void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& paramet
     FaceOriginHandle fo = faceOrigins(in.cores[l]);
     for (std::size_t v = 0; v < r.vertex_clearance[l].size(); ++v)
       cm.vert[vo[v].vertex].Q() = float(r.vertex_clearance[l][v]);
+    if (!(options.tau > 0)) continue;  // no tau: nothing to select, the user's selection stays
     for (CFaceO& f : cm.face) f.ClearS();
     for (std::size_t f = 0; f < r.faces_below_tau[l].size(); ++f)
       if (r.faces_below_tau[l][f]) cm.face[fo[f].face].SetS();

@@ -362,6 +362,25 @@ def test_measure_parallel_sheets_at_a_known_distance(tmp_path):
     np.testing.assert_array_equal(Vout, np.array(V, np.float32).astype(float))  # nothing moved
 
 
+def test_measure_sample_gives_the_minimum_of_the_shell(tmp_path):
+    """samples/measure_clearance.mlx (tau 0: only the minimum) agrees with
+    meshcheck on the nested spheres."""
+    V, F = nested_spheres()
+    src = write_ply(tmp_path / "shell.ply", V, F)
+    script = (ROOT / "samples" / "measure_clearance.mlx").read_text().replace(
+        'name="report_file" value=""', 'name="report_file" value="{report0}"')
+    run = run_server(tmp_path, [src], script)
+    assert run.returncode == 0, run.log[-3000:]
+    r = run.report
+    check = meshcheck(src, "--min-distance")["min_distance"]
+    assert r["min_distance"] == pytest.approx(check["distance"], rel=1e-6)
+    # One face of each skin (the outer one holds the first 1280 faces); the
+    # icosphere's symmetry makes several pairs tie, so not necessarily meshcheck's.
+    assert (r["closest"]["face_a"] < 1280) != (r["closest"]["face_b"] < 1280)
+    assert r["violating_pairs"] == 0 and r["faces_below_tau"] == 0
+    assert r["local_max"] == pytest.approx(2 * r["min_distance"])
+
+
 def test_measure_and_select_then_delete_the_close_faces(tmp_path):
     d, tau = 0.1, 0.15
     V, F = coarse_sheets(d)
