@@ -979,8 +979,30 @@ Domain domainOf(const std::vector<Point3>& pts, const Point3& meanFaceNormal) {
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(cov);
   const Eigen::Vector3d e = eigen.eigenvectors().col(0);
-  if (projectOnPlane(pts, centroid, Point3(e[0], e[1], e[2]), d)) return d;
+  const Point3 fitted(e[0], e[1], e[2]);
+  if (projectOnPlane(pts, centroid, fitted, d)) return d;
   if (meanFaceNormal.Norm() > 0 && projectOnPlane(pts, centroid, meanFaceNormal, d)) return d;
+  // The boundary's vector area (half the sum of p_i x p_i+1): the direction
+  // in which the loop encloses the most area, often simple where the
+  // best-fit plane folds the loop over itself.
+  Point3 area(0, 0, 0);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    area += (pts[i] - centroid) ^ (pts[(i + 1) % pts.size()] - centroid);
+  if (area.Norm() > 0 && projectOnPlane(pts, centroid, area, d)) return d;
+  // Directions tilted around those by up to 60 degrees.
+  for (const Point3& axis : {area, meanFaceNormal, fitted}) {
+    if (!(axis.Norm() > 0)) continue;
+    const Point3 n = axis / axis.Norm();
+    Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
+    u.Normalize();
+    const Point3 v = n ^ u;
+    for (double tilt : {15.0, 30.0, 45.0, 60.0})
+      for (int k = 0; k < 8; ++k) {
+        const double t = tilt * M_PI / 180, a = k * M_PI / 4;
+        const Point3 dir = n * std::cos(t) + (u * std::cos(a) + v * std::sin(a)) * std::sin(t);
+        if (projectOnPlane(pts, centroid, dir, d)) return d;
+      }
+  }
   d.planar = false;
   d.uv.clear();
   double perimeter = 0;
