@@ -1090,6 +1090,7 @@ class LsSvm {
     const std::size_t n = x.size();
     if (n < 4) return false;
     centres_ = x;
+    targets_ = y;
     inverseSupport_ = 1 / support;
     Eigen::MatrixXd K(n, n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -1107,6 +1108,8 @@ class LsSvm {
     alpha_ = nu - bias_ * eta;
     return alpha_.allFinite() && std::isfinite(bias_);
   }
+
+  const std::vector<double>& targets() const { return targets_; }
 
   double predict(const Eigen::Vector3d& p) const {
     double f = bias_;
@@ -1128,6 +1131,7 @@ class LsSvm {
     return r < 1 ? wendland(r) : 0.0;
   }
   std::vector<Eigen::Vector3d> centres_;
+  std::vector<double> targets_;
   Eigen::VectorXd alpha_;
   double bias_ = 0, inverseSupport_ = 1;
 };
@@ -1896,9 +1900,17 @@ class HoleFiller {
       Eigen::Vector3d centre;
       double scale = 1;
       if (learnCurvature(model, centre, scale, report)) {
+        // Predictions stay within the curvatures seen around the hole (the
+        // 5th to 95th percentile): scan noise learned near the border must
+        // not extrapolate into a balloon in the middle of a large hole.
+        std::vector<double> seen = model.targets();
+        std::sort(seen.begin(), seen.end());
+        const double low = seen[seen.size() / 20] / scale,
+                     high = seen[seen.size() - 1 - seen.size() / 20] / scale;
         std::vector<double> curvature(rowVertex_.size());
         for (std::size_t r = 0; r < rowVertex_.size(); ++r)
-          curvature[r] = model.predict((toEigen(x[rowVertex_[r]]) - centre) / scale) / scale;
+          curvature[r] = std::clamp(
+              model.predict((toEigen(x[rowVertex_[r]]) - centre) / scale) / scale, low, high);
         Eigen::MatrixXd delta(Eigen::Index(rowVertex_.size()), 3);
         for (int iteration = 0; iteration < 3; ++iteration) {
           for (std::size_t r = 0; r < rowVertex_.size(); ++r) {
