@@ -985,7 +985,7 @@ def tables(holes, sp, repeat, machine, elapsed):
     hole = rep["holes"][0] if rep["holes"] else {}
     unit = sp["mean_edge"]
     facts = [f"ours added {rep['faces_added']:,} faces (shape "
-             f"{hole.get('fairing', '–')}{'; ' + hole['reason'] if hole.get('reason') else ''})"]
+             f"{hole.get('fairing', '–')}{'; ' + short_reason(hole['reason']) if hole.get('reason') else ''})"]
     if "cgal" in sp:
         facts.append(f"CGAL {sp['cgal']['faces_added']:,}")
     out += ["",
