@@ -30,6 +30,14 @@ inline std::string layerName(const MeshModel& m) {
   return "layer '" + toStd(m.label()) + "'";
 }
 
+// The default "second layer" of a two-layer filter: the first layer that
+// is not the current one (the current one when it is alone).
+inline MeshModel* layerOtherThanCurrent(MeshDocument& md) {
+  for (MeshModel* m : md.meshList)
+    if (m != md.mm()) return m;
+  return md.mm();
+}
+
 // MeshLab's progress callback as a core Progress (null callback: no reports).
 inline Progress progressFrom(vcg::CallBackPos* cb) {
   return [cb](int percent, const char* stage) { return cb ? cb(percent, stage) : true; };

@@ -73,12 +73,7 @@ QString ClearancePlugin::filterInfo(FilterIDType id) const {
 void ClearancePlugin::initParameterSet(QAction* a, MeshDocument& md,
                                        RichParameterList& parameters) {
   MeshModel* current = md.mm();
-  MeshModel* other = current;
-  for (MeshModel* m : md.meshList)
-    if (m != current) {
-      other = m;
-      break;
-    }
+  MeshModel* other = layerOtherThanCurrent(md);
   // Percentages of tau and the cap are of the diagonal of all layers (as
   // placed by their matrices), the frame the distances are measured in. A
   // document without a box yet (nothing loaded) gets 1: percent of a unit.

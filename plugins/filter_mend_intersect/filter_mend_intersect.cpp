@@ -63,12 +63,7 @@ QString IntersectPlugin::filterInfo(FilterIDType id) const {
 void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
                                        RichParameterList& parameters) {
   MeshModel* current = md.mm();
-  MeshModel* other = current;
-  for (MeshModel* m : md.meshList)
-    if (m != current) {
-      other = m;
-      break;
-    }
+  MeshModel* other = layerOtherThanCurrent(md);
   parameters.addParam(RichEnum(
       "mode", kWithinCurrent,
       QStringList() << "Within the current layer"

@@ -263,12 +263,7 @@ void StitchPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterL
                  "lost."));
   } else if (ID(a) == STITCH_BOUNDARIES) {
     MeshModel* current = md.mm();
-    MeshModel* other = current;
-    for (MeshModel* m : md.meshList)
-      if (m != current) {
-        other = m;
-        break;
-      }
+    MeshModel* other = layerOtherThanCurrent(md);
     parameters.addParam(RichEnum(
         "paths_from", kTwoPathsOneLayer,
         QStringList() << "Two paths on the current layer"
