@@ -227,4 +227,43 @@ inline Mesh quantized(const Mesh& m, double step) {
   return makeMesh(p, trianglesOf(m));
 }
 
+// `mesh` without the faces whose centroid `cut` accepts (a hole).
+template <class Cut>
+Mesh withHole(const Mesh& mesh, Cut&& cut) {
+  std::vector<Triangle> kept;
+  const std::vector<Point3> P = positionsOf(mesh);
+  for (const Triangle& t : trianglesOf(mesh))
+    if (!cut((P[t[0]] + P[t[1]] + P[t[2]]) / 3.0)) kept.push_back(t);
+  return makeMesh(P, kept);
+}
+
+// Signed volume enclosed by a closed, consistently oriented mesh.
+inline double volumeOf(const Mesh& m) {
+  const std::vector<Point3> P = positionsOf(m);
+  double v = 0;
+  for (const Triangle& t : trianglesOf(m)) v += P[t[0]] * (P[t[1]] ^ P[t[2]]);
+  return v / 6;
+}
+
+// Edge counts by use: border (one face), non-manifold (three or more),
+// inconsistent (two faces running the edge the same way).
+struct EdgeStats {
+  std::size_t border = 0, nonManifold = 0, inconsistent = 0;
+};
+inline EdgeStats edgeStats(const Mesh& mesh) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  const std::vector<EdgeUse> uses = edgeUses(T);
+  EdgeStats s;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    if (j - i == 1) ++s.border;
+    if (j - i > 2) ++s.nonManifold;
+    if (j - i == 2 && T[uses[i].face][uses[i].corner] == T[uses[i + 1].face][uses[i + 1].corner])
+      ++s.inconsistent;
+    i = j;
+  }
+  return s;
+}
+
 }  // namespace meshmend::testing

@@ -12,6 +12,7 @@ namespace {
 
 using testing::box;
 using testing::uvSphere;
+using testing::withHole;
 
 InspectResult check(const Mesh& m) {
   InspectOptions o;
@@ -33,16 +34,6 @@ FaceLabels labelsOf(SplitResult& r) {
   FaceOriginHandle fo = faceOrigins(r.merged);
   for (std::size_t f = 0; f < r.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
   return labels;
-}
-
-// `mesh` without the faces whose centroid `cut` accepts (a hole).
-template <class Cut>
-Mesh withHole(const Mesh& mesh, Cut&& cut) {
-  std::vector<Triangle> kept;
-  const std::vector<Point3> P = positionsOf(mesh);
-  for (const Triangle& t : trianglesOf(mesh))
-    if (!cut((P[t[0]] + P[t[1]] + P[t[2]]) / 3.0)) kept.push_back(t);
-  return makeMesh(P, kept);
 }
 
 SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {

@@ -16,13 +16,6 @@ using namespace meshmend::testing;
 
 namespace {
 
-double volumeOf(const Mesh& m) {
-  const std::vector<Point3> P = positionsOf(m);
-  double v = 0;
-  for (const Triangle& t : trianglesOf(m)) v += P[t[0]] * (P[t[1]] ^ P[t[2]]);
-  return v / 6;
-}
-
 // Both meshes in one layer (two components).
 Mesh together(const Mesh& a, const Mesh& b) {
   return appended(a, b);

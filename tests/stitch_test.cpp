@@ -16,27 +16,6 @@ using namespace meshmend::testing;
 
 namespace {
 
-// Edge counts by use: border (one face), non-manifold (three or more),
-// inconsistent (two faces running the edge the same way).
-struct EdgeStats {
-  std::size_t border = 0, nonManifold = 0, inconsistent = 0;
-};
-EdgeStats edgeStats(const Mesh& mesh) {
-  const std::vector<Triangle> T = trianglesOf(mesh);
-  const std::vector<EdgeUse> uses = edgeUses(T);
-  EdgeStats s;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-    if (j - i == 1) ++s.border;
-    if (j - i > 2) ++s.nonManifold;
-    if (j - i == 2 && T[uses[i].face][uses[i].corner] == T[uses[i + 1].face][uses[i + 1].corner])
-      ++s.inconsistent;
-    i = j;
-  }
-  return s;
-}
-
 // A sheet of (nu x nv) quads, each cut into two triangles, with vertex
 // (i, j) at pos(i, j) (index j * (nu + 1) + i); faces turn from du to dv.
 Mesh sheet(int nu, int nv, const std::function<Point3(int, int)>& pos) {
