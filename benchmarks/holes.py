@@ -912,8 +912,8 @@ def tables(holes, sp, repeat, machine, elapsed):
     out[-1:] = ["",
                 "Holes left open (or partly open): ours (default) "
                 f"{len(open_holes['meshmend_regression'])} "
-                f"({', '.join(open_holes['meshmend_regression']) or 'none'}; every shape failed "
-                "our exact intersection check), CGAL "
+                f"({', '.join(open_holes['meshmend_regression']) or 'none'}; our reasons in the "
+                "table above), CGAL "
                 f"{len(open_holes['cgal'])} ({', '.join(open_holes['cgal']) or 'none'}), MeshLab "
                 f"{len(open_holes['meshlab'])} ({', '.join(open_holes['meshlab']) or 'none'}). "
                 "A hole that ours leaves open counts as a loss against any peer that closed it. "
