@@ -964,47 +964,11 @@ bool projectOnPlane(const std::vector<Point3>& pts, Point3 origin, Point3 normal
   return true;
 }
 
-// The front's domain: the best-fit plane of the boundary if the boundary
-// projects onto it as a simple polygon, else the plane of the faces' mean
-// normal, else a circle (boundary vertices spaced by arc length).
-Domain domainOf(const std::vector<Point3>& pts, const Point3& meanFaceNormal) {
+// A circle with the boundary vertices spaced by arc length: a domain for
+// any loop, where no plane gives a simple projection.
+Domain diskDomain(const std::vector<Point3>& pts) {
   Domain d;
-  Point3 centroid(0, 0, 0);
-  for (const Point3& p : pts) centroid += p;
-  centroid /= double(pts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Point3& p : pts) {
-    const Eigen::Vector3d r(p[0] - centroid[0], p[1] - centroid[1], p[2] - centroid[2]);
-    cov += r * r.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(cov);
-  const Eigen::Vector3d e = eigen.eigenvectors().col(0);
-  const Point3 fitted(e[0], e[1], e[2]);
-  if (projectOnPlane(pts, centroid, fitted, d)) return d;
-  if (meanFaceNormal.Norm() > 0 && projectOnPlane(pts, centroid, meanFaceNormal, d)) return d;
-  // The boundary's vector area (half the sum of p_i x p_i+1): the direction
-  // in which the loop encloses the most area, often simple where the
-  // best-fit plane folds the loop over itself.
-  Point3 area(0, 0, 0);
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    area += (pts[i] - centroid) ^ (pts[(i + 1) % pts.size()] - centroid);
-  if (area.Norm() > 0 && projectOnPlane(pts, centroid, area, d)) return d;
-  // Directions tilted around those by up to 60 degrees.
-  for (const Point3& axis : {area, meanFaceNormal, fitted}) {
-    if (!(axis.Norm() > 0)) continue;
-    const Point3 n = axis / axis.Norm();
-    Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
-    u.Normalize();
-    const Point3 v = n ^ u;
-    for (double tilt : {15.0, 30.0, 45.0, 60.0})
-      for (int k = 0; k < 8; ++k) {
-        const double t = tilt * M_PI / 180, a = k * M_PI / 4;
-        const Point3 dir = n * std::cos(t) + (u * std::cos(a) + v * std::sin(a)) * std::sin(t);
-        if (projectOnPlane(pts, centroid, dir, d)) return d;
-      }
-  }
   d.planar = false;
-  d.uv.clear();
   double perimeter = 0;
   std::vector<double> at;
   for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -1017,6 +981,51 @@ Domain domainOf(const std::vector<Point3>& pts, const Point3& meanFaceNormal) {
     d.uv.push_back({radius * std::cos(phi), radius * std::sin(phi)});
   }
   return d;
+}
+
+// The front's domains, in the order tried: the first plane the boundary
+// projects onto as a simple polygon (its best-fit plane, the plane of the
+// faces' mean normal, of its vector area, or one tilted around those), then
+// the disk. A patch that does not fit over the plane gets a second chance
+// over the disk.
+std::vector<Domain> domainsOf(const std::vector<Point3>& pts, const Point3& meanFaceNormal) {
+  Domain d;
+  Point3 centroid(0, 0, 0);
+  for (const Point3& p : pts) centroid += p;
+  centroid /= double(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Point3& p : pts) {
+    const Eigen::Vector3d r(p[0] - centroid[0], p[1] - centroid[1], p[2] - centroid[2]);
+    cov += r * r.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(cov);
+  const Eigen::Vector3d e = eigen.eigenvectors().col(0);
+  const Point3 fitted(e[0], e[1], e[2]);
+  if (projectOnPlane(pts, centroid, fitted, d)) return {d, diskDomain(pts)};
+  if (meanFaceNormal.Norm() > 0 && projectOnPlane(pts, centroid, meanFaceNormal, d))
+    return {d, diskDomain(pts)};
+  // The boundary's vector area (half the sum of p_i x p_i+1): the direction
+  // in which the loop encloses the most area, often simple where the
+  // best-fit plane folds the loop over itself.
+  Point3 area(0, 0, 0);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    area += (pts[i] - centroid) ^ (pts[(i + 1) % pts.size()] - centroid);
+  if (area.Norm() > 0 && projectOnPlane(pts, centroid, area, d)) return {d, diskDomain(pts)};
+  // Directions tilted around those by up to 60 degrees.
+  for (const Point3& axis : {area, meanFaceNormal, fitted}) {
+    if (!(axis.Norm() > 0)) continue;
+    const Point3 n = axis / axis.Norm();
+    Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
+    u.Normalize();
+    const Point3 v = n ^ u;
+    for (double tilt : {15.0, 30.0, 45.0, 60.0})
+      for (int k = 0; k < 8; ++k) {
+        const double t = tilt * M_PI / 180, a = k * M_PI / 4;
+        const Point3 dir = n * std::cos(t) + (u * std::cos(a) + v * std::sin(a)) * std::sin(t);
+        if (projectOnPlane(pts, centroid, dir, d)) return {d, diskDomain(pts)};
+      }
+  }
+  return {diskDomain(pts)};
 }
 
 // ---- Cotangent Laplacian rows --------------------------------------------------
@@ -1464,12 +1473,30 @@ class HoleFiller {
       return false;
     }
 
-    const Domain domain = domainOf(boundary, faceNormals);
+    std::string problems;
+    for (const Domain& domain : domainsOf(boundary, faceNormals))
+      if (fillOver(domain, splitFaces, report, problems)) return true;
+    report.reason = problems;
+    return false;
+  }
+
+ private:
+  // One attempt over `domain`; what went wrong is added to `problems`.
+  bool fillOver(const Domain& domain, const std::vector<int>& splitFaces, HoleReport& report,
+                std::string& problems) {
+    auto note = [&](const std::string& what) {
+      problems += (problems.empty() ? "" : "; ") +
+                  std::string(domain.planar ? "over its plane: " : "over a disk: ") + what;
+    };
     report.planar_domain = domain.planar;
+    report.reason.clear();
     auto clock = Clock::now();
     const bool covered = triangulate(domain, report);
     times_.triangulate += msSince(clock);
-    if (!covered) return false;
+    if (!covered) {
+      note(report.reason);
+      return false;
+    }
 
     // Patch faces in mesh numbering; new vertices follow the surface's.
     const std::size_t base = s_.points.size();
@@ -1487,7 +1514,7 @@ class HoleFiller {
     for (HoleFairing m : {HoleFairing::LaplacianRegression, HoleFairing::Biharmonic,
                           HoleFairing::Harmonic, HoleFairing::Flat})
       if (int(m) <= int(options_.fairing)) modes.push_back(m);
-    std::string problems;
+    std::string failed;
     for (HoleFairing mode : modes) {
       PatchShape shape;
       shape.positions = flat;
@@ -1496,7 +1523,7 @@ class HoleFiller {
       const bool faired = mode == HoleFairing::Flat || fair(mode, shape, report);
       times_.fair += msSince(clock);
       if (!faired) {
-        problems += std::string(problems.empty() ? "" : "; ") + toString(mode) + ": solver failed";
+        failed += std::string(failed.empty() ? "" : "; ") + toString(mode) + ": solver failed";
         continue;
       }
       for (std::size_t v = n_; v < shape.positions.size(); ++v)
@@ -1508,24 +1535,24 @@ class HoleFiller {
         const std::size_t pairs = patchIntersections(s_, patchTriangles_, added, splitFaces);
         times_.check += msSince(clock);
         if (pairs > 0) {
-          problems += std::string(problems.empty() ? "" : "; ") + toString(mode) +
-                      " patch would intersect itself or the mesh (" + std::to_string(pairs) +
-                      " pairs)";
+          failed += std::string(failed.empty() ? "" : "; ") + toString(mode) +
+                    " patch would intersect itself or the mesh (" + std::to_string(pairs) +
+                    " pairs)";
           continue;
         }
       }
       commit(shape, report);
-      if (mode != options_.fairing)
-        report.reason = "fell back: " + problems;
+      if (!problems.empty()) failed = problems + (failed.empty() ? "" : "; ") + failed;
+      if (mode != options_.fairing || !problems.empty())
+        report.reason = "fell back: " + failed;
       else if (shape.fairing != mode)
         report.reason = "fell back to biharmonic: " + report.reason;
       return true;
     }
-    report.reason = "no patch fits: " + problems;
+    note("no patch fits: " + failed);
     return false;
   }
 
- private:
   bool triangulate(const Domain& domain, HoleReport& report) {
     std::vector<double> sizes(n_);
     for (std::size_t k = 0; k < n_; ++k) {
