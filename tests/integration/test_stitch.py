@@ -586,7 +586,7 @@ def geodesic(V, F, s, t, avoid):
 
 @pytest.mark.xfail(reason="not reached yet: after the trim, a vertex of the geodesic cut of lato000 "
                           "is not on the new border (the stitch refuses the path); see the log",
-                   strict=False)
+                   strict=True)
 def test_two_range_scans_trimmed_and_stitched_into_one_part(tmp_path):
     """lato000 and lato180 (opposite sides of one object, aligned by
     partial.mlp, their borders 57 units apart across the unscanned flank):
