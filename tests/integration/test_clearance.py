@@ -623,3 +623,44 @@ def test_range_scans_pushed_to_a_clearance_of_one(tmp_path):
     moved = sum(int(np.count_nonzero(np.any(read_ply(o)[0] != read_ply(f)[0], axis=1)))
                 for f, o in zip(files, outs))
     assert moved == r["vertices_moved"]
+
+
+# ---- the paper's quantisation experiment on a real scan ----------------------
+
+def read_obj(path):
+    V, F = [], []
+    for line in open(path):
+        parts = line.split()
+        if parts and parts[0] == "v":
+            V.append(tuple(float(x) for x in parts[1:4]))
+        elif parts and parts[0] == "f":
+            F.append(tuple(int(p.split("/")[0]) - 1 for p in parts[1:4]))
+    return V, F
+
+
+def test_quantised_scan_pushed_back_to_tau(tmp_path):
+    """spot.obj with its coordinates rounded to 9 bits of its diagonal, as a
+    lossy codec would: non-adjacent faces come closer than tau = 0.004.
+    Afterwards meshcheck's own minimum distance is at least tau (minus float
+    rounding) and nothing intersects; the displacement stays of the order of
+    what the worst pair needs."""
+    require_shared_data()
+    V, F = read_obj(DATA / "scanned/spot.obj")
+    P = np.array(V)
+    step = np.linalg.norm(P.max(axis=0) - P.min(axis=0)) / 512
+    Q = np.round(P / step) * step
+    src = write_off(tmp_path / "spot_quantised.off", [tuple(q) for q in Q], F)
+    before = meshcheck(src, "--min-distance")
+    assert before["self_intersecting_pairs"] == 0
+    tau = 0.004
+    assert before["min_distance"]["distance"] < tau
+    out = tmp_path / "spot_out.ply"
+    run = run_server(tmp_path, [src], enforce_script(tau=tau), outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    r, after = run.report, meshcheck(out, "--min-distance")
+    assert r["reached"], r
+    assert after["min_distance"]["distance"] >= tau - rounding_tolerance(after["bbox_diagonal"])
+    assert after["self_intersecting_pairs"] == 0
+    assert (after["faces"], after["border_edges"]) == (before["faces"], before["border_edges"])
+    need = (tau - before["min_distance"]["distance"]) / 2
+    assert need * (1 - 1e-6) <= r["max_displacement"] <= 3 * (tau - before["min_distance"]["distance"])
