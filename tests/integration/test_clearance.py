@@ -664,3 +664,82 @@ def test_quantised_scan_pushed_back_to_tau(tmp_path):
     assert (after["faces"], after["border_edges"]) == (before["faces"], before["border_edges"])
     need = (tau - before["min_distance"]["distance"]) / 2
     assert need * (1 - 1e-6) <= r["max_displacement"] <= 3 * (tau - before["min_distance"]["distance"])
+
+
+# ---- the paper's box and piston experiments ------------------------------------
+
+def grid_box(n, half, center=(0.0, 0.0, 0.0), inward=False):
+    """A closed box of half-size `half`, each side an n x n grid of squares
+    cut in two (12 n^2 faces), its vertices shared along the edges."""
+    index, V, F = {}, [], []
+
+    def vertex(p):
+        key = tuple(round(c * 1e9) for c in p)
+        if key not in index:
+            index[key] = len(V)
+            V.append(tuple(center[k] + half * p[k] for k in range(3)))
+        return index[key]
+
+    for axis in range(3):
+        for sign in (-1, 1):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+
+            def point(i, j):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[v] = sign, -1 + 2 * i / n, -1 + 2 * j / n
+                return vertex(p)
+
+            for i in range(n):
+                for j in range(n):
+                    a, b, c, d = point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)
+                    quad = [(a, b, c), (a, c, d)] if sign > 0 else [(a, c, b), (a, d, c)]
+                    F += [(t[0], t[2], t[1]) for t in quad] if inward else quad
+    return V, F
+
+
+def cylinder(radius, height, segments, rings, center=(0.0, 0.0), inward=False):
+    """A closed cylinder along z (two capped ends with a centre vertex)."""
+    V = [(center[0] + radius * math.cos(2 * math.pi * s / segments),
+          center[1] + radius * math.sin(2 * math.pi * s / segments), height * r / rings - height / 2)
+         for r in range(rings + 1) for s in range(segments)]
+    at = lambda r, s: r * segments + s % segments
+    F = []
+    for r in range(rings):
+        for s in range(segments):
+            F += [(at(r, s), at(r, s + 1), at(r + 1, s + 1)), (at(r, s), at(r + 1, s + 1), at(r + 1, s))]
+    bottom, top = len(V), len(V) + 1
+    V += [(center[0], center[1], -height / 2), (center[0], center[1], height / 2)]
+    F += [(bottom, at(0, s + 1), at(0, s)) for s in range(segments)]
+    F += [(top, at(rings, s), at(rings, s + 1)) for s in range(segments)]
+    if inward:
+        F = [(a, c, b) for a, b, c in F]
+    return V, F
+
+
+@pytest.mark.parametrize("case", ["layered box", "piston in cylinder"])
+def test_paper_experiments_pushed_to_tau(tmp_path, case):
+    """The paper's two synthetic experiments: a box whose inner skin comes
+    within 0.02 of the outer one (1,176 faces, tau 0.03), and a piston in a
+    bore with a too-tight fit (2,112 faces, tau 0.02). Checked by meshcheck."""
+    if case == "layered box":
+        V, F = combined(grid_box(7, 1.0), grid_box(7, 0.95, (0.03, 0.0, 0.0), inward=True))
+        tau = 0.03
+    else:
+        V, F = combined(cylinder(0.5, 2.0, 48, 10, inward=True),
+                        cylinder(0.49, 1.6, 48, 10, center=(0.005, 0.0)))
+        tau = 0.02
+    src = write_off(tmp_path / "parts.off", V, F)
+    before = meshcheck(src, "--min-distance")
+    assert before["self_intersecting_pairs"] == 0 and before["is_closed"]
+    assert before["min_distance"]["distance"] < tau
+    out = tmp_path / "out.ply"
+    run = run_server(tmp_path, [src], enforce_script(tau=tau), outputs=[out])
+    assert run.returncode == 0, run.log[-3000:]
+    r, after = run.report, meshcheck(out, "--min-distance")
+    assert r["reached"], r
+    assert after["min_distance"]["distance"] >= tau - rounding_tolerance(after["bbox_diagonal"])
+    assert after["self_intersecting_pairs"] == 0 and after["is_closed"]
+    worst = before["min_distance"]["distance"]
+    assert r["displacement_lower_bound"] == pytest.approx((tau - worst) / 2, rel=1e-3)
+    assert (tau - worst) / 2 * (1 - 1e-6) <= r["max_displacement"] <= 2 * (tau - worst), r
+    assert r["mean_displacement"] <= r["max_displacement"]
