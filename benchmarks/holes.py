@@ -28,7 +28,6 @@ import argparse
 import json
 import math
 import os
-import platform
 import shutil
 import subprocess
 import sys
@@ -999,18 +998,6 @@ def tables(holes, sp, repeat, machine, elapsed):
     return "\n".join(out)
 
 
-def machine():
-    cpu = "?"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores ({cpu}), {platform.system()} {platform.release()}"
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -1018,6 +1005,7 @@ def main():
     parser.add_argument("--keep", help="work folder to keep (holes, fills, patches, results.json)")
     parser.add_argument("--only", help="one mesh (e.g. spot), for a quick look")
     args = parser.parse_args()
+    from run import machine  # the machine line every section uses
     build = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
     print(section(build, args.repeat, machine(), args.keep, args.only))
 
