@@ -9,6 +9,7 @@ import xml.etree.ElementTree as ET
 from xml.sax.saxutils import escape
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -158,3 +159,76 @@ def cube():
     F = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4),
          (2, 6, 3), (3, 6, 7), (0, 4, 2), (2, 4, 6), (1, 3, 5), (3, 7, 5)]
     return V, F
+
+
+# ---- reading meshlabserver's output (binary or ASCII PLY) ---------------------
+
+_PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
+              "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
+              "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4", "double": "f8",
+              "float64": "f8"}
+
+
+def read_ply(path):
+    """Vertices (float64 from the stored values), triangles, and the vertex
+    properties by name."""
+    data = path.read_bytes()
+    end = data.index(b"end_header") + len(b"end_header")
+    end = data.index(b"\n", end) + 1
+    header = data[:end].decode("ascii").splitlines()
+    fmt = header[1].split()[1]
+    elements = []
+    for line in header:
+        w = line.split()
+        if w and w[0] == "element":
+            elements.append((w[1], int(w[2]), []))
+        elif w and w[0] == "property":
+            elements[-1][2].append(w[1:])
+    if fmt == "ascii":
+        tokens = data[end:].split()
+        pos, out = 0, {}
+        for name, count, props in elements:
+            rows = []
+            for _ in range(count):
+                row = []
+                for p in props:
+                    if p[0] == "list":
+                        k = int(tokens[pos]); pos += 1
+                        row.append([int(x) for x in tokens[pos:pos + k]]); pos += k
+                    else:
+                        row.append(float(tokens[pos])); pos += 1
+                rows.append(row)
+            out[name] = (props, rows)
+        vprops, vrows = out["vertex"]
+        names = [p[-1] for p in vprops]
+        values = {n: np.array([r[i] for r in vrows], float) for i, n in enumerate(names)}
+        fi = [p[-1] for p in out["face"][0]].index("vertex_indices")
+        F = np.array([r[fi] for r in out["face"][1]], np.int64)
+        return np.stack([values["x"], values["y"], values["z"]], 1), F, values
+    assert fmt == "binary_little_endian", fmt
+    pos, V, F, values = end, None, None, {}
+    for name, count, props in elements:
+        if all(p[0] != "list" for p in props):
+            dtype = np.dtype([(p[1], "<" + _PLY_TYPES[p[0]]) for p in props])
+            table = np.frombuffer(data, dtype=dtype, count=count, offset=pos)
+            pos += dtype.itemsize * count
+            if name == "vertex":
+                values = {p[1]: table[p[1]].astype(float) for p in props}
+                V = np.stack([values["x"], values["y"], values["z"]], 1)
+            continue
+        assert name == "face", props
+        rows = []
+        for _ in range(count):
+            row = None
+            for p in props:
+                if p[0] == "list":
+                    ct, it = "<" + _PLY_TYPES[p[1]], "<" + _PLY_TYPES[p[2]]
+                    k = int(np.frombuffer(data, ct, 1, pos)[0]); pos += np.dtype(ct).itemsize
+                    idx = np.frombuffer(data, it, k, pos); pos += np.dtype(it).itemsize * k
+                    if p[3] == "vertex_indices":
+                        row = idx
+                else:
+                    pos += np.dtype("<" + _PLY_TYPES[p[0]]).itemsize
+            rows.append(row)
+        F = np.array(rows, np.int64)
+    return V, F, values

@@ -13,8 +13,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from conftest import (BUILD, DATA, ROOT, SHARED, meshcheck, mlx, require_shared_data, run_server,
-                      write_off)
+from conftest import (BUILD, DATA, ROOT, SHARED, meshcheck, mlx, read_ply, require_shared_data,
+                      run_server, write_off)
 
 TRIM = "MeshMend: Trim Along Vertex Loop"
 STITCH = "MeshMend: Stitch Boundaries"
@@ -439,68 +439,6 @@ def test_close_gaps_leaves_no_more_borders_than_cgal(tmp_path, name):
 
 # ---- an assembly of two real range scans --------------------------------------
 
-def read_ply(path):
-    """Vertices and triangles of a binary or ASCII PLY (x, y, z float; faces
-    as a uchar/int list; other properties skipped)."""
-    data = path.read_bytes()
-    end = data.index(b"end_header") + len(b"end_header")
-    end = data.index(b"\n", end) + 1
-    header = data[:end].decode("ascii").splitlines()
-    fmt = header[1].split()[1]
-    elements = []
-    for line in header:
-        w = line.split()
-        if w[0] == "element":
-            elements.append([w[1], int(w[2]), []])
-        elif w[0] == "property":
-            elements[-1][2].append(w[1:])
-    sizes = {"char": "b", "uchar": "B", "int8": "b", "uint8": "B", "short": "h", "ushort": "H",
-             "int": "i", "uint": "I", "int32": "i", "uint32": "I", "float": "f", "float32": "f",
-             "double": "d", "float64": "d", "int16": "h", "uint16": "H"}
-    V, F = [], []
-    if fmt == "ascii":
-        tokens = data[end:].split()
-        pos = 0
-        for name, count, props in elements:
-            for _ in range(count):
-                row = []
-                for p in props:
-                    if p[0] == "list":
-                        k = int(tokens[pos]); pos += 1
-                        row.append([int(t) for t in tokens[pos:pos + k]]); pos += k
-                    else:
-                        row.append(float(tokens[pos])); pos += 1
-                (V if name == "vertex" else F).append(row)
-    else:
-        order = "<" if fmt == "binary_little_endian" else ">"
-        pos = end
-        for name, count, props in elements:
-            simple = all(p[0] != "list" for p in props)
-            if simple:
-                st = struct.Struct(order + "".join(sizes[p[0]] for p in props))
-                for _ in range(count):
-                    row = st.unpack_from(data, pos); pos += st.size
-                    if name == "vertex":
-                        V.append(row)
-                continue
-            for _ in range(count):
-                row = []
-                for p in props:
-                    if p[0] == "list":
-                        cs, ts = struct.Struct(order + sizes[p[1]]), struct.Struct(order + sizes[p[2]])
-                        (k,) = cs.unpack_from(data, pos); pos += cs.size
-                        row.append(list(struct.unpack_from(order + sizes[p[2]] * k, data, pos)))
-                        pos += ts.size * k
-                    else:
-                        st = struct.Struct(order + sizes[p[0]])
-                        row.append(st.unpack_from(data, pos)[0]); pos += st.size
-                (V if name == "vertex" else F).append(row)
-    vprops = [p[-1] for name, _, props in elements if name == "vertex" for p in props]
-    xi, yi, zi = vprops.index("x"), vprops.index("y"), vprops.index("z")
-    points = [(v[xi], v[yi], v[zi]) for v in V]
-    faces = [tuple(f[0]) for f in F if len(f[0]) == 3]
-    return points, faces
-
 
 def mlp_matrices(path):
     root = ET.parse(path).getroot()
@@ -599,7 +537,7 @@ def test_two_range_scans_trimmed_and_stitched_into_one_part(tmp_path):
     matrices = mlp_matrices(scans / "partial.mlp")
     parts = []
     for name in ("lato000.ply", "lato180.ply"):
-        V, F = read_ply(scans / name)
+        V, F, _ = read_ply(scans / name)
         m = np.array(matrices[name])
         V = np.array(V, float) @ m[:3, :3].T + m[:3, 3]  # the layer matrix, applied here
         parts.append(main_component(V, np.array(F)))
@@ -651,8 +589,7 @@ def test_two_range_scans_trimmed_and_stitched_into_one_part(tmp_path):
     assert run.returncode == 0, run.log[-3000:]
     trim_a, trim_b_report, stitched = run.reports
     after = meshcheck(out)
-    V, F = read_ply(out)
-    V, F = np.array(V), np.array(F)
+    V, F, _ = read_ply(out)
     _, Fmain = main_component(V, F)
     print(f"\nrange scans: facing runs {len(runs[0])} / {len(runs[1])} border vertices, cuts "
           f"{len(cuts[0])} / {len(cuts[1])}; trimmed {trim_a['faces_removed']} + "
