@@ -1051,7 +1051,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       const std::size_t facesBefore = merged.triangles.size();
       std::vector<int> index;
       snapper.compact(merged, index);
-      rebuildSeparate(merged, index, snappedTo, curves, outputs, r.merged_vertex, r.curve_edges);
+      if (options.separate_meshes) {
+        rebuildSeparate(merged, index, snappedTo, curves, outputs, r.merged_vertex, r.curve_edges);
+      } else {
+        // No per-mesh outputs to rebuild: only where each input vertex went.
+        for (std::vector<int>& global : r.merged_vertex)
+          for (int& g : global) g = index[g];
+      }
       r.new_vertices -= r.vertices_snapped;
       r.faces_added = r.faces_added + merged.triangles.size() - facesBefore;
       double smallest = M_PI;
@@ -1071,6 +1077,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
     r.merged_curve_edges.assign(curves.begin(), curves.end());
+    if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});  // they go with `meshes`
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
   }
   reportProgress(options.progress, 100, "Done");
