@@ -662,7 +662,9 @@ ClearanceMeasure measureClearance(const std::vector<const Mesh*>& layers,
   m.tau = options.tau;
   // Without tau or cap, the search starts at a quarter of the mean edge
   // length and grows until the closest pair is found.
-  double startRadius = options.local_max > 0 ? options.local_max : 2 * options.tau;
+  // Pairs up to tau must all be found (counted, selected), whatever the
+  // local clearance cap.
+  double startRadius = std::max(options.local_max, 2 * options.tau);
   if (!(startRadius > 0)) {
     double sum = 0;
     for (const Triangle& t : soup.triangles) sum += (P[t[0]] - P[t[1]]).Norm();
@@ -757,8 +759,7 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   // (a no-op for a mesh that comes from MeshLab), so that only the moved
   // vertices are rounded at the end, within the margin the solve keeps.
   if (options.round_to_float)
-    for (Point3& p : soup.points)
-      for (int k = 0; k < 3; ++k) p[k] = double(float(p[k]));
+    for (Point3& p : soup.points) p = roundedToFloat(p);
 
   // The clearance is a distance between surfaces that do not meet: crossing
   // faces would have to pass through each other, which no small move does.
@@ -1094,8 +1095,7 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   for (std::size_t v = 0; v < nv; ++v) movedVertex[v] = !(P[v] == P0[v]);
   if (options.round_to_float) {
     for (std::size_t v = 0; v < nv; ++v)
-      if (movedVertex[v])
-        for (int k = 0; k < 3; ++k) P[v][k] = double(float(P[v][k]));
+      if (movedVertex[v]) P[v] = roundedToFloat(P[v]);
     result.rounded_to_float = true;
   }
   {

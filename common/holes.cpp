@@ -18,6 +18,7 @@
 
 #include "common/box_tree.h"
 #include "common/errors.h"
+#include "common/intersections.h"
 #include "common/predicates.h"
 #include "common/triangle_intersection.h"
 
@@ -514,7 +515,6 @@ class AdvancingFront {
                  const std::vector<std::pair<int, int>>& existingEdges, Settings settings)
       : uv(std::move(boundary)), size(std::move(boundarySize)), settings_(settings) {
     const std::size_t n = uv.size();
-    boundaryCount_ = n;
     Vec2 lo = uv[0], hi = uv[0];
     double mean = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -565,8 +565,6 @@ class AdvancingFront {
     }
     return clipEars();
   }
-
-  std::size_t boundaryCount() const { return boundaryCount_; }
 
  private:
   struct Node {
@@ -879,7 +877,7 @@ class AdvancingFront {
   }
 
   Settings settings_;
-  std::size_t boundaryCount_ = 0, alive_ = 0, budget_ = 0;
+  std::size_t alive_ = 0, budget_ = 0;
   double minSize_ = 0;
   std::vector<Node> nodes_;
   std::vector<EdgeRecord> edgeRecords_;
@@ -1162,9 +1160,7 @@ struct Surface {
   std::vector<Point3> points;
   bool roundToFloat = false;  // new vertices take float coordinates (HoleFillOptions)
   // Where a new vertex at p is stored.
-  Point3 stored(const Point3& p) const {
-    return roundToFloat ? Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))) : p;
-  }
+  Point3 stored(const Point3& p) const { return roundToFloat ? roundedToFloat(p) : p; }
   std::vector<Triangle> triangles;
   std::size_t inputVertices = 0, inputFaces = 0;
   std::unique_ptr<VertexFaces> adjacency;
@@ -1205,6 +1201,7 @@ struct Checkpoint {
   std::vector<std::pair<int, Triangle>> changedFaces;   // in change order
   std::vector<std::pair<std::uint64_t, int>> ownerLog;  // key, previous owner (-1: none)
   std::vector<int> splitVertices;
+  std::vector<int> newInputCorners;  // input faces first changed since the checkpoint
 };
 
 void setOwner(Surface& s, Checkpoint& undo, std::uint64_t key, int face) {
@@ -1226,6 +1223,7 @@ void restore(Surface& s, Checkpoint& undo) {
       s.borderOwner[it->first] = it->second;
   }
   for (int v : undo.splitVertices) s.splitOrigins.erase(v);
+  for (int f : undo.newInputCorners) s.inputCorners.erase(f);
   s.points.resize(undo.points);
   s.triangles.resize(undo.triangles);
   s.inputFaceOf.resize(undo.triangles - s.inputFaces);
@@ -1260,7 +1258,10 @@ std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Ch
       const int c = t[(k + 2) % 3];
       const int m = int(s.points.size());
       const int f0 = s.inputFace(f);
-      if (std::size_t(f) < s.inputFaces && !s.inputCorners.count(f)) s.inputCorners[f] = t;
+      if (std::size_t(f) < s.inputFaces && !s.inputCorners.count(f)) {
+        s.inputCorners[f] = t;
+        undo.newInputCorners.push_back(f);
+      }
       s.points.push_back(s.stored((s.points[a] + s.points[b]) / 2));
       s.splitOrigins[m] = {f0, (s.barycentricIn(a, f0) + s.barycentricIn(b, f0)) / 2};
       undo.splitVertices.push_back(m);
@@ -2020,34 +2021,6 @@ void validate(const Mesh& mesh, const HoleFillOptions& o) {
       bad("selected vertex " + std::to_string(v) + " is not a vertex of the mesh");
 }
 
-// Exact count of the intersecting pairs that involve one of `faces`.
-std::size_t countPairsInvolving(const std::vector<Point3>& P, const std::vector<Triangle>& T,
-                                const std::vector<int>& faces) {
-  if (faces.empty()) return 0;
-  std::vector<Box> boxes;
-  std::vector<char> mine(T.size(), 0);
-  for (int f : faces) {
-    boxes.push_back(boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]));
-    mine[f] = 1;
-  }
-  const BoxTree tree(boxes);
-  std::atomic<std::size_t> pairs{0};
-  auto pointsOf = [&](const Triangle& t) { return TrianglePoints{P[t[0]], P[t[1]], P[t[2]]}; };
-  auto degenerate = [&](const Triangle& t) { return collinear(P[t[0]], P[t[1]], P[t[2]]); };
-  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-    for (std::size_t g = begin; g < end; ++g) {
-      const Triangle& tg = T[g];
-      if (degenerate(tg)) continue;
-      tree.query(boxOf(P[tg[0]], P[tg[1]], P[tg[2]]), worker, [&](std::uint32_t i, unsigned) {
-        const int f = faces[i];
-        if (std::size_t(f) == g || (mine[g] && std::size_t(f) > g) || degenerate(T[f])) return;
-        if (facesIntersect(T[f], pointsOf(T[f]), tg, pointsOf(tg))) ++pairs;
-      });
-    }
-  });
-  return pairs;
-}
-
 }  // namespace
 
 HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
@@ -2174,7 +2147,12 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     changed.insert(changed.end(), s.splitFaces.begin(), s.splitFaces.end());
     for (const auto& [f, corners] : s.inputCorners) changed.push_back(f);
     const auto verifyStart = Clock::now();
-    result.remaining_intersecting_pairs = countPairsInvolving(s.points, s.triangles, changed);
+    std::vector<char> isChanged(s.triangles.size(), 0);
+    for (int f : changed) isChanged[std::size_t(f)] = 1;
+    result.remaining_intersecting_pairs =
+        intersectingOf(s.points, s.triangles,
+                       pairsWithChangedFaces(s.points, s.triangles, isChanged))
+            .size();
     result.stage_ms.verify = msSince(verifyStart);
     result.verified = true;
   }

@@ -105,8 +105,7 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
 std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat) {
   MeshArrays arrays = arraysOf(mesh);
   if (asFloat)
-    for (Point3& p : arrays.points)
-      for (int k = 0; k < 3; ++k) p[k] = double(float(p[k]));
+    for (Point3& p : arrays.points) p = roundedToFloat(p);
   FindIntersectionsOptions o;
   o.cross = false;
   return findIntersectionsInArrays({&arrays}, o).self_pairs[0];

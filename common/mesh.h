@@ -134,6 +134,11 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c);
 
 bool isFinite(const Point3& p);
 
+// `p` as MeshLab stores it: each coordinate rounded to float.
+inline Point3 roundedToFloat(const Point3& p) {
+  return Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
+}
+
 // Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh
 // has no faces or a non-finite coordinate.
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what);

@@ -850,9 +850,7 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
       length[v] += (P[t[(i + 1) % 3]] - P[v]).Norm();
       ++count[v];
     }
-  auto stored = [asFloat](const Point3& p) {
-    return asFloat ? Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))) : p;
-  };
+  auto stored = [asFloat](const Point3& p) { return asFloat ? roundedToFloat(p) : p; };
   // Candidate positions per copy, in the order tried; the last is home.
   std::vector<int> moving;
   std::vector<std::vector<Point3>> steps(P.size());
@@ -957,8 +955,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   // Output in float is decided on float: the input as it will be stored
   // too (MeshLab's already is), so only new and moved vertices change later.
   if (options.round_to_float)
-    for (Point3& p : arrays.points)
-      p = Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
+    for (Point3& p : arrays.points) p = roundedToFloat(p);
   std::vector<int> vertexOrigin(arrays.points.size()), faceOrigin(arrays.triangles.size());
   std::iota(vertexOrigin.begin(), vertexOrigin.end(), 0);
   std::iota(faceOrigin.begin(), faceOrigin.end(), 0);

@@ -1107,7 +1107,7 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   if (merged.fn == 0) return 0;
   const std::vector<Point3> exact = positionsOf(merged);
   std::vector<Point3> P = exact;
-  for (Point3& p : P) p = Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
+  for (Point3& p : P) p = roundedToFloat(p);
   const std::vector<Triangle> T = trianglesOf(merged);
   VertexOriginHandle vo = vertexOrigins(merged);
 

@@ -580,7 +580,6 @@ class Polyline {
     for (std::size_t i = 1; i < p_.size(); ++i) s_[i] = s_[i - 1] + (p_[i] - p_[i - 1]).Norm();
   }
   double length() const { return s_.back(); }
-  const std::vector<Point3>& points() const { return p_; }
   // The point at arc length s (clamped), and the fractional vertex index.
   Point3 at(double s, double* index = nullptr) const {
     if (p_.size() == 1 || s <= 0) {
@@ -992,8 +991,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
 }
 
 // Exact count of the intersecting pairs that involve a planned face.
-std::size_t newIntersections(const Mesh& mesh, const StitchPlan& plan,
-                             std::vector<char>* badFaces = nullptr) {
+std::size_t newIntersections(const Mesh& mesh, const StitchPlan& plan) {
   std::vector<Point3> P = positionsOf(mesh);
   P.insert(P.end(), plan.newPoints.begin(), plan.newPoints.end());
   std::vector<Triangle> T = trianglesOf(mesh);
@@ -1001,14 +999,7 @@ std::size_t newIntersections(const Mesh& mesh, const StitchPlan& plan,
   T.insert(T.end(), plan.faces.begin(), plan.faces.end());
   std::vector<char> changed(T.size(), 0);
   std::fill(changed.begin() + first, changed.end(), 1);
-  const auto pairs = intersectingOf(P, T, pairsWithChangedFaces(P, T, changed));
-  if (badFaces) {
-    badFaces->assign(plan.faces.size(), 0);
-    for (const auto& p : pairs)
-      for (std::uint32_t f : p)
-        if (f >= first) (*badFaces)[f - first] = 1;
-  }
-  return pairs.size();
+  return intersectingOf(P, T, pairsWithChangedFaces(P, T, changed)).size();
 }
 
 void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {

@@ -45,9 +45,12 @@ void expectSound(const Mesh& mesh, std::size_t borderEdges) {
   EXPECT_EQ(selfIntersectingPairs(mesh), 0u);
 }
 
+// Options with one shape, and the independent recount on (so that
+// remaining_intersecting_pairs is counted, not only known).
 HoleFillOptions withFairing(HoleFairing fairing) {
   HoleFillOptions o;
   o.fairing = fairing;
+  o.verify = true;
   return o;
 }
 
@@ -273,6 +276,7 @@ TEST(HoleFront, ElongatedHole) {
     return c[0] > 5 && c[0] < 35 && c[1] > 19.25 && c[1] < 20.75;
   });
   HoleFillOptions o;
+  o.verify = true;
   o.max_boundary_edges = 300;  // not the outer border
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_filled, 1u);
@@ -447,6 +451,7 @@ TEST(HoleChecks, HoleWhoseFillMustCrossAnotherPartIsSkipped) {
   const std::vector<Point3> before = positionsOf(m);
   const std::size_t facesBefore = std::size_t(m.fn);
   HoleFillOptions o;
+  o.verify = true;
   o.max_boundary_edges = 100;
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_found, 2u);
@@ -630,7 +635,6 @@ Mesh sphereBand(int segments, double cap, int rings) {
 
 TEST(HoleLarge, ThousandBorderVertexHoleIsFilled) {
   Mesh m = sphereBand(1000, 0.6, 6);
-  ASSERT_GT(volumeOf(withHole(m, [](const Point3&) { return false; })), -1);
   HoleFillOptions o;
   o.verify = true;
   std::vector<bool> top(std::size_t(m.vn), false);

@@ -379,7 +379,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
     for (const Vertex& v : in.cores[l].vert) {
       const Point3& p = v.cP();
       exact[l].push_back(p);
-      rounded[l].push_back(Point3(double(float(p[0])), double(float(p[1])), double(float(p[2]))));
+      rounded[l].push_back(roundedToFloat(p));
     }
   double ownMs = msSince(measureStart);
 
@@ -452,7 +452,10 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   }
   ownMs += msSince(writeStart);
 
+  // With matrices the verdict is the one on what the layers will hold.
+  const bool reached = anyMatrix ? r.reached && pairsAfter == 0 : r.reached;
   JsonObject report = toJson(r);
+  if (reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
   report.set("scope", toString(options.scope))
       .set("layers", labels(layers))
       .set("locked_vertices", lockedCount)
@@ -495,7 +498,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   if (layers.size() > 1)
     where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
   Log("MeshMend: clearance %s %s, tau = %.6g: %s", scopeText, where.c_str(), r.tau,
-      r.reached ? "reached" : "NOT reached");
+      reached ? "reached" : "NOT reached");
   Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", minBefore, minAfter,
       pairsBefore, pairsAfter);
   Log("  %zu vertices moved (%zu locked): max displacement %.6g (no solution moves less than "
@@ -505,9 +508,14 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   if (anyMatrix) Log("  layer matrices applied; moved vertices written back in each layer's frame");
   if (lock && lockedCount == 0) Log("  note: no vertex is selected, so none was locked");
   if (r.vertices_capped) Log("  %zu vertices stopped at the max displacement", r.vertices_capped);
-  if (!r.reached) {
+  if (!reached) {
     std::string why;
-    if (r.stop_reason == "locked")
+    if (r.reached)
+      why =
+          "rounding to the layers' own frames (their matrices) took some pairs back below tau: "
+          "apply the matrices first (Filters > Normals, Curvatures and Orientation > Matrix: "
+          "Freeze Current Matrix) and run again";
+    else if (r.stop_reason == "locked")
       why =
           "every pair still short has only locked (selected) or capped vertices: deselect "
           "some, raise the max displacement, or lower tau";
