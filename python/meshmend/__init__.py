@@ -1,0 +1,447 @@
+"""MeshMend's geometry core on NumPy arrays.
+
+Every function takes a mesh as ``vertices`` (an ``(n, 3)`` array of real
+coordinates) and ``faces`` (an ``(m, 3)`` array of integer vertex indices),
+and returns new arrays plus ``report``: a dict with the keys the MeshLab
+filters write to their ``report_file``. Options are keyword arguments named
+as the fields of the core's ``XxxOptions`` structs, with the same defaults
+(``help(meshmend.fill_holes)`` lists them). The inputs are never modified.
+
+Bad input raises ``InvalidInputError`` (a ``ValueError``) or
+``TopologyError`` (also a ``ValueError``) with a message saying what to fix;
+a wrong option type raises ``TypeError``. Long operations release the GIL
+and stop on Ctrl-C; ``progress=callable(percent, stage)`` reports progress,
+and returning ``False`` from it stops the operation (``CancelledError``).
+
+Output arrays: vertices float64 ``(n, 3)``, faces and indices int32.
+"""
+
+import importlib.machinery
+import importlib.util
+import inspect as _inspect
+import os
+import sys
+from typing import Any, Dict, List, NamedTuple, Optional, Tuple
+
+
+def _import_numpy():
+    try:
+        import numpy
+
+        return numpy
+    except ImportError:
+        pass
+    # The module is built for Debian's python3; Debian's NumPy (python3-numpy)
+    # is built for the same Python version and loads into any interpreter of
+    # that version that lacks its own NumPy.
+    debian = "/usr/lib/python3/dist-packages/numpy"
+    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
+    if os.path.isfile(os.path.join(debian, "core", "_multiarray_umath" + suffix)):
+        spec = importlib.util.spec_from_file_location(
+            "numpy", os.path.join(debian, "__init__.py"), submodule_search_locations=[debian])
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["numpy"] = module
+        try:
+            spec.loader.exec_module(module)
+        except Exception:
+            del sys.modules["numpy"]
+            raise
+        return module
+    raise ImportError(
+        "meshmend needs NumPy: install Debian's python3-numpy (and use /usr/bin/python3), or "
+        "NumPy for " + sys.executable)
+
+
+np = _import_numpy()
+
+from . import _core  # noqa: E402  (needs NumPy first)
+
+Error = _core.Error
+InvalidInputError = _core.InvalidInputError
+TopologyError = _core.TopologyError
+CancelledError = _core.CancelledError
+FACE_DEFECTS: Dict[str, int] = dict(_core.FACE_DEFECTS)
+VERTEX_DEFECTS: Dict[str, int] = dict(_core.VERTEX_DEFECTS)
+
+Arrays = Tuple[Any, Any]  # (vertices, faces)
+
+
+# ---------------------------------------------------------------- results
+
+
+class SplitResult(NamedTuple):
+    meshes: List[Arrays]  # per input mesh, with the curves inserted (separate_meshes)
+    curve_edges: List[Any]  # per input mesh: (k, 2) vertex pairs along the curves
+    merged: Arrays  # all meshes in one, welded along the curves
+    merged_curve_edges: Any  # (k, 2) vertex pairs of `merged`
+    merged_part: Any  # per face of `merged`: the input mesh it came from
+    report: Dict[str, Any]
+
+
+class FindResult(NamedTuple):
+    pairs: Any  # (k, 4): mesh_a, face_a, mesh_b, face_b
+    segments: Optional[Arrays]  # (points, edges) with contacts=True, else None
+    report: Dict[str, Any]
+
+
+class SelfIntersectionResult(NamedTuple):
+    vertices: Any
+    faces: Any
+    face_origin: Any  # per output face: the input face it was cut from
+    removed: Optional[Arrays]  # the faces left out (keep_removed=True), else None
+    report: Dict[str, Any]
+
+
+class FillHolesResult(NamedTuple):
+    vertices: Any  # input vertices first, in their order, then the new ones
+    faces: Any  # input faces first (split ones keep their index for one half)
+    new_faces: Any
+    new_vertices: Any
+    report: Dict[str, Any]
+
+
+class TrimResult(NamedTuple):
+    vertices: Any
+    faces: Any
+    vertex_index: Any  # per input vertex: its index in the output, -1 if dropped
+    loop: Any  # the loop used, input vertex indices, in its direction
+    removed: Arrays  # the removed faces and their vertices
+    report: Dict[str, Any]
+
+
+class StitchResult(NamedTuple):
+    vertices: Any  # input vertices first, then the new ones (subdivision)
+    faces: Any  # input faces first, then the new ones
+    new_faces: Any
+    new_vertices: Any
+    report: Dict[str, Any]
+
+
+class CloseGapsResult(NamedTuple):
+    vertices: Any
+    faces: Any
+    vertex_index: Any  # per input vertex: its index in the output
+    report: Dict[str, Any]
+
+
+class MeasureClearanceResult(NamedTuple):
+    vertex_clearance: List[Any]  # per mesh, per vertex: local clearance (capped at local_max)
+    faces_below_tau: List[Any]  # per mesh, per face: closer than tau to some face
+    report: Dict[str, Any]
+
+
+class EnforceClearanceResult(NamedTuple):
+    meshes: List[Arrays]  # per mesh: moved vertices, faces as given
+    report: Dict[str, Any]
+
+
+class PaintResult(NamedTuple):
+    patch_of_face: Any  # per face: its patch id (report['patch_list'] describes each)
+    report: Dict[str, Any]
+
+
+class PatchesResult(NamedTuple):
+    vertices: Any
+    faces: Any
+    face_origin: Any  # per output face: the input face it copies
+    report: Dict[str, Any]
+
+
+# ---------------------------------------------------------------- signatures
+
+
+def _with_options(core_name: str, exclude: Tuple[str, ...] = ()):
+    """Gives a function the keyword options of the core function `core_name`
+    (names, defaults and descriptions from _core.OPTIONS) in its signature
+    and docstring."""
+
+    def decorate(function):
+        signature = _inspect.signature(function)
+        fixed = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
+        options = [o for o in _core.OPTIONS[core_name] if o[0] not in exclude]
+        parameters = fixed + [
+            _inspect.Parameter(name, _inspect.Parameter.KEYWORD_ONLY, default=default)
+            for name, default, _ in options
+        ]
+        parameters.append(
+            _inspect.Parameter("progress", _inspect.Parameter.KEYWORD_ONLY, default=None))
+        function.__signature__ = signature.replace(parameters=parameters)
+        lines = [f"    {name} = {default!r}: {doc}" for name, default, doc in options]
+        lines.append("    progress = None: callable(percent, stage); returning False stops")
+        function.__doc__ = (function.__doc__ or "").rstrip() + "\n\n    Options:\n" + "\n".join(lines)
+        return function
+
+    return decorate
+
+
+def _pairs(meshes) -> List[Arrays]:
+    return [tuple(mesh) for mesh in meshes]
+
+
+# ---------------------------------------------------------------- inspection
+
+
+@_with_options("inspect")
+def inspect(vertices, faces, **options) -> Dict[str, Any]:
+    """Defect counts with the keys and definitions of the checker meshcheck
+    (vertices, faces, border_edges, non_manifold_edges, is_closed, volume,
+    genus, ...; self_intersecting_pairs with self_intersections=True).
+    Non-finite coordinates are counted (non_finite_vertices), not refused."""
+    return _core.inspect(vertices, faces, **options)
+
+
+def count_self_intersections(vertices, faces) -> int:
+    """Number of self-intersecting face pairs, exactly (the rule of CGAL's
+    self_intersections: faces sharing a vertex or an edge count only when
+    they meet beyond it)."""
+    return _core.count_self_intersections(vertices, faces)
+
+
+@_with_options("find_intersections")
+def find_intersections(vertices1, faces1, vertices2=None, faces2=None, **options) -> FindResult:
+    """Intersecting face pairs of one mesh (self) or of two (self and cross).
+    pairs rows are (mesh_a, face_a, mesh_b, face_b), meshes numbered from 0."""
+    meshes = [(vertices1, faces1)]
+    if vertices2 is not None or faces2 is not None:
+        meshes.append((vertices2, faces2))
+    return FindResult(*_core.find_intersections(meshes, **options))
+
+
+# ---------------------------------------------------------------- intersect and split
+
+
+def _split(meshes, options) -> SplitResult:
+    out = _core.intersect_and_split(meshes, **options)
+    return SplitResult(
+        meshes=_pairs(out["meshes"]), curve_edges=list(out["curve_edges"]),
+        merged=tuple(out["merged"]), merged_curve_edges=out["merged_curve_edges"],
+        merged_part=out["merged_part"], report=out["report"])
+
+
+@_with_options("intersect_and_split")
+def intersect_and_split(vertices1, faces1, vertices2, faces2, **options) -> SplitResult:
+    """Inserts the exact intersection curves of two meshes into both: only
+    crossed faces are re-triangulated, every other face stays as it was.
+    report['remaining_intersecting_pairs'] (verify=True) counts the pairs
+    still intersecting in `merged` (faces meeting only along a shared curve
+    edge or vertex do not count)."""
+    return _split([(vertices1, faces1), (vertices2, faces2)], options)
+
+
+@_with_options("intersect_and_split")
+def intersect_and_split_meshes(meshes, **options) -> SplitResult:
+    """intersect_and_split for any number of meshes, given as a list of
+    (vertices, faces) pairs."""
+    return _split(list(meshes), options)
+
+
+@_with_options("intersect_and_split", exclude=("between_meshes", "self"))
+def split_self_intersections(vertices, faces, **options) -> SplitResult:
+    """Inserts a mesh's own self-intersection curves into it (the 'within
+    the current layer' mode of Intersect and Split Layers)."""
+    for name in ("between_meshes", "self"):
+        if name in options:
+            raise TypeError(f"split_self_intersections() sets {name} itself")
+    return _split([(vertices, faces)], dict(options, between_meshes=False, self=True))
+
+
+@_with_options("remove_self_intersections")
+def remove_self_intersections(vertices, faces, **options) -> SelfIntersectionResult:
+    """Keeps the part of a consistently oriented mesh that is outside with
+    respect to its orientation (TransforMesh): cut along the exact
+    self-intersection curves, grown from seed faces, stitched manifold."""
+    out = _core.remove_self_intersections(vertices, faces, **options)
+    removed = out["removed"]
+    return SelfIntersectionResult(*out["mesh"], out["face_origin"],
+                                  None if removed is None else tuple(removed), out["report"])
+
+
+# ---------------------------------------------------------------- holes, trimming, stitching
+
+
+@_with_options("fill_holes")
+def fill_holes(vertices, faces, **options) -> FillHolesResult:
+    """Closes the holes with patches that follow the surface around them
+    (advancing front, then a Poisson solve with learned Laplacians). A hole
+    whose patch would intersect falls back to a flatter shape or stays open,
+    with its reason in report['holes']."""
+    out = _core.fill_holes(vertices, faces, **options)
+    return FillHolesResult(*out["mesh"], out["new_faces"], out["new_vertices"], out["report"])
+
+
+@_with_options("trim_along_loop")
+def trim_along_loop(vertices, faces, **options) -> TrimResult:
+    """Removes the faces on one side of a closed loop of vertices (loop,
+    picked_vertices or selected_vertices), keeping the side of keep_face
+    (or the left of the loop's direction). No vertex is added or moved."""
+    out = _core.trim_along_loop(vertices, faces, **options)
+    return TrimResult(*out["mesh"], out["vertex_index"], out["loop"], tuple(out["removed"]),
+                      out["report"])
+
+
+@_with_options("stitch_boundaries")
+def stitch_boundaries(vertices, faces, a, b, **options) -> StitchResult:
+    """Joins border paths a and b (vertex indices in order along a border)
+    with a strip of faces oriented like the faces they join. For two meshes,
+    concatenate them first (offset the second's indices by len(vertices1))."""
+    out = _core.stitch_boundaries(vertices, faces, a, b, **options)
+    return StitchResult(*out["mesh"], out["new_faces"], out["new_vertices"], out["report"])
+
+
+@_with_options("stitch_sequence")
+def stitch_sequence(vertices, faces, paths, pairs=None, **options) -> StitchResult:
+    """Stitches border paths pairwise in the order of `pairs` (default
+    (0, 1), (2, 3), ...), concatenating the leftovers at junctions so that a
+    later stitch covers them."""
+    out = _core.stitch_sequence(vertices, faces, paths, pairs, **options)
+    return StitchResult(*out["mesh"], out["new_faces"], out["new_vertices"], out["report"])
+
+
+def border_paths(vertices, faces, selected_vertices) -> List[Tuple[Any, bool]]:
+    """The runs of selected border vertices (a mask or indices) along the
+    borders, as [(vertex indices in the border's direction, closed)]."""
+    return [(path, bool(closed))
+            for path, closed in _core.border_paths(vertices, faces, selected_vertices)]
+
+
+@_with_options("close_gaps")
+def close_gaps(vertices, faces, **options) -> CloseGapsResult:
+    """Merges border edges whose ends coincide within merge_tolerance, then
+    stitches borders facing each other within max_gap, never making an edge
+    non-manifold or breaking the orientation."""
+    out = _core.close_gaps(vertices, faces, **options)
+    return CloseGapsResult(*out["mesh"], out["vertex_index"], out["report"])
+
+
+# ---------------------------------------------------------------- clearance
+
+
+def _meshes(vertices, faces, vertices2, faces2) -> List[Arrays]:
+    meshes = [(vertices, faces)]
+    if vertices2 is not None or faces2 is not None:
+        meshes.append((vertices2, faces2))
+    return meshes
+
+
+@_with_options("measure_clearance")
+def measure_clearance(vertices, faces, vertices2=None, faces2=None,
+                      **options) -> MeasureClearanceResult:
+    """The smallest distance between faces sharing no vertex, within a mesh
+    and (with a second mesh) between the two; per-vertex local clearances,
+    the faces closer than tau and a histogram."""
+    out = _core.measure_clearance(_meshes(vertices, faces, vertices2, faces2), **options)
+    return MeasureClearanceResult(list(out["vertex_clearance"]), list(out["faces_below_tau"]),
+                                  out["report"])
+
+
+@_with_options("enforce_clearance")
+def enforce_clearance(vertices, faces, vertices2=None, faces2=None,
+                      **options) -> EnforceClearanceResult:
+    """Moves vertices as little as possible until every face pair in scope
+    is at least tau apart (Gauss-Newton steps, a line search that never lets
+    the surfaces cross). Faces are never changed. When locked vertices, the
+    cap or the shape stop it short, report['reached'] is False and
+    report['stop_reason'] says why."""
+    out = _core.enforce_clearance(_meshes(vertices, faces, vertices2, faces2), **options)
+    return EnforceClearanceResult(_pairs(out["meshes"]), out["report"])
+
+
+# ---------------------------------------------------------------- patches
+
+
+@_with_options("paint_patches")
+def paint_patches(vertices, faces, **options) -> PaintResult:
+    """Flood-fills the faces into patches bounded by the intersection curves,
+    borders and non-manifold edges, and classifies each against every part
+    with generalized winding numbers (report['patch_list'])."""
+    out = _core.paint_patches(vertices, faces, **options)
+    return PaintResult(out["patch_of_face"], out["report"])
+
+
+@_with_options("remove_patches")
+def remove_patches(vertices, faces, **options) -> PatchesResult:
+    """Removes the patches `remove` (ids), or keeps a boolean result
+    (keep='union', 'intersection' or 'difference'), and welds what is left."""
+    out = _core.remove_patches(vertices, faces, **options)
+    return PatchesResult(*out["mesh"], out["face_origin"], out["report"])
+
+
+def boolean(vertices1, faces1, vertices2, faces2, operation="union",
+            snap_tolerance=0.0, progress=None) -> PatchesResult:
+    """The union, intersection or difference (first minus second) of two
+    closed meshes: intersect_and_split (merged), then remove_patches(keep=
+    operation). report['split'] holds the split's report."""
+    split = intersect_and_split(vertices1, faces1, vertices2, faces2, separate_meshes=False,
+                                snap_tolerance=snap_tolerance, progress=progress)
+    merged_vertices, merged_faces = split.merged
+    result = remove_patches(merged_vertices, merged_faces, part=split.merged_part,
+                            curve_edges=split.merged_curve_edges, keep=operation,
+                            progress=progress)
+    result.report["split"] = split.report
+    return result
+
+
+# ---------------------------------------------------------------- files and other libraries
+
+
+def read_mesh(path) -> Arrays:
+    """(vertices, faces) of an OFF, PLY, STL or OBJ file, vertices as stored
+    (an STL has three per facet), polygons fan-triangulated."""
+    return tuple(_core.read_mesh(os.fspath(path)))
+
+
+def write_mesh(path, vertices, faces) -> None:
+    """Writes OFF or binary PLY (by the extension), coordinates in double."""
+    _core.write_mesh(os.fspath(path), vertices, faces)
+
+
+def as_arrays(mesh) -> Arrays:
+    """(vertices, faces) arrays of a pymeshlab.Mesh, of a trimesh-style object
+    (.vertices, .faces) or of a (vertices, faces) pair; dtypes as given (every
+    function checks them)."""
+    if hasattr(mesh, "vertex_matrix") and hasattr(mesh, "face_matrix"):
+        return from_pymeshlab(mesh)
+    if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        return np.asarray(mesh[0]), np.asarray(mesh[1])
+    raise TypeError(
+        f"as_arrays() takes a pymeshlab.Mesh, an object with .vertices and .faces (trimesh) or a "
+        f"(vertices, faces) pair, not {type(mesh).__name__}")
+
+
+def from_pymeshlab(mesh) -> Arrays:
+    """(vertices, faces) of a pymeshlab.Mesh (vertex_matrix(), face_matrix())."""
+    return (np.array(mesh.vertex_matrix(), dtype=np.float64),
+            np.array(mesh.face_matrix(), dtype=np.int32))
+
+
+def to_pymeshlab(vertices, faces):
+    """A pymeshlab.Mesh of the arrays (needs pymeshlab)."""
+    try:
+        import pymeshlab
+    except ImportError as e:
+        raise ImportError("to_pymeshlab needs pymeshlab (pip install pymeshlab)") from e
+    return pymeshlab.Mesh(vertex_matrix=np.ascontiguousarray(vertices, dtype=np.float64),
+                          face_matrix=np.ascontiguousarray(faces, dtype=np.int32))
+
+
+def to_trimesh(vertices, faces):
+    """A trimesh.Trimesh of the arrays, taken as they are (process=False; needs trimesh)."""
+    try:
+        import trimesh
+    except ImportError as e:
+        raise ImportError("to_trimesh needs trimesh (pip install trimesh)") from e
+    return trimesh.Trimesh(vertices=np.asarray(vertices, dtype=np.float64),
+                           faces=np.asarray(faces), process=False)
+
+
+__all__ = [
+    "Error", "InvalidInputError", "TopologyError", "CancelledError", "FACE_DEFECTS",
+    "VERTEX_DEFECTS", "inspect", "count_self_intersections", "find_intersections",
+    "intersect_and_split", "intersect_and_split_meshes", "split_self_intersections",
+    "remove_self_intersections", "fill_holes", "trim_along_loop", "stitch_boundaries",
+    "stitch_sequence", "border_paths", "close_gaps", "measure_clearance", "enforce_clearance",
+    "paint_patches", "remove_patches", "boolean", "read_mesh", "write_mesh", "as_arrays",
+    "from_pymeshlab", "to_pymeshlab", "to_trimesh",
+]
