@@ -52,9 +52,23 @@ def _import_numpy():
         "NumPy for " + sys.executable)
 
 
-np = _import_numpy()
+def _import_core():
+    try:
+        from . import _core
 
-from . import _core  # noqa: E402  (needs NumPy first)
+        return _core
+    except ImportError as e:
+        here = os.path.dirname(os.path.abspath(__file__))
+        built = sorted(f for f in os.listdir(here) if f.startswith("_core."))
+        raise ImportError(
+            f"meshmend's compiled part ({', '.join(built) or 'missing'} in {here}) does not load "
+            f"into Python {sys.version.split()[0]} ({sys.executable}): it is built for Debian's "
+            f"/usr/bin/python3; use that, or build MeshMend with "
+            f"-DPython_EXECUTABLE={sys.executable}") from e
+
+
+_core = _import_core()
+np = _import_numpy()
 
 Error = _core.Error
 InvalidInputError = _core.InvalidInputError
