@@ -213,10 +213,6 @@ py::dict removeSelfIntersectionsArrays(py::handle vertices, py::handle faces, py
       selfTable().parse("remove_self_intersections", kwargs, {mesh.vert.size(), mesh.face.size()});
   options.progress = call.progress();
   SelfIntersectionResult r = call([&] { return removeSelfIntersections(mesh, options); });
-  if (r.mesh.fn == 0)
-    throw TopologyError(
-        "no face of the mesh is outside with respect to its orientation, so nothing would be "
-        "kept: check the orientation (faces[:, ::-1] turns every face over) and try again");
   py::dict out;
   out["mesh"] = meshTuple(r.mesh);
   out["face_origin"] = faceOriginsOf(r.mesh);
