@@ -41,6 +41,58 @@ Box boxOf(const Point3& a, const Point3& b, const Point3& c) {
   return box;
 }
 
+BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kCells, 0) {
+  if (boxes.empty()) return;
+  bounds_ = boxes[0];
+  for (const Box& b : boxes)
+    for (int k = 0; k < 3; ++k) {
+      bounds_.lo[k] = std::min(bounds_.lo[k], b.lo[k]);
+      bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
+    }
+  for (int k = 0; k < 3; ++k)
+    cellSize_[k] = std::max((bounds_.hi[k] - bounds_.lo[k]) / kCells, 1e-30f);
+  for (const Box& b : boxes) {
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z) occupied_[(x * kCells + y) * kCells + z] = 1;
+  }
+}
+
+bool BoxGrid::inside(const Box& b) const {
+  for (int k = 0; k < 3; ++k)
+    if (!(b.lo[k] >= bounds_.lo[k] && b.hi[k] <= bounds_.hi[k])) return false;
+  return true;
+}
+
+void BoxGrid::cellRange(const Box& b, int k, int& lo, int& hi) const {
+  lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) / cellSize_[k]), 0, kCells - 1);
+  hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) / cellSize_[k]), 0, kCells - 1);
+}
+
+bool BoxGrid::touches(const Box& b) const {
+  if (!overlap(b, bounds_)) return false;
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        if (occupied(x, y, z)) return true;
+  return false;
+}
+
+bool BoxGrid::covers(const Box& b) const {
+  if (!inside(b)) return false;
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        if (!occupied(x, y, z)) return false;
+  return true;
+}
+
 BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
     : boxes_(std::move(boxes)), order_(boxes_.size()) {
   std::iota(order_.begin(), order_.end(), 0u);

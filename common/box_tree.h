@@ -28,6 +28,30 @@ inline bool overlap(const Box& x, const Box& y) {
          x.lo[2] <= y.hi[2] && y.lo[2] <= x.hi[2];
 }
 
+// A coarse occupancy grid over the cells that some boxes touch: it turns
+// away, cheaply, the boxes far from all of them (most of a large mesh), so
+// that only the rest go into a tree or a search.
+class BoxGrid {
+ public:
+  explicit BoxGrid(const std::vector<Box>& boxes);
+  // Does `b` touch a cell that one of the boxes touches? (Never false for a
+  // box that overlaps one of them.)
+  bool touches(const Box& b) const;
+  // Does every cell that `b` touches hold one of the boxes, b inside the
+  // grid? Then every box that overlaps `b` touches an occupied cell.
+  bool covers(const Box& b) const;
+
+ private:
+  static constexpr int kCells = 64;
+  bool inside(const Box& b) const;
+  void cellRange(const Box& b, int k, int& lo, int& hi) const;
+  bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
+
+  Box bounds_{{1, 1, 1}, {0, 0, 0}};
+  float cellSize_[3] = {1, 1, 1};
+  std::vector<char> occupied_;
+};
+
 class BoxTree {
  public:
   // How the hierarchy is built (both are measured in benchmarks/):

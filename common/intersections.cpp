@@ -75,8 +75,10 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
       if (strictlyBeside(s, f, s, g) || strictlyBeside(s, g, s, f)) return false;
       break;
     case 1:
-      // The edge opposite the shared corner, in either face, must meet the other.
-      if (!edgeMayMeet(s, f, (c.ia + 1) % 3, (c.ia + 2) % 3, g) &&
+      // When either face's edge opposite the shared corner lies strictly on
+      // one side of the other's plane, that face meets the plane only at the
+      // shared corner: nothing beyond it. Both edges must reach the plane.
+      if (!edgeMayMeet(s, f, (c.ia + 1) % 3, (c.ia + 2) % 3, g) ||
           !edgeMayMeet(s, g, (c.ib + 1) % 3, (c.ib + 2) % 3, f))
         return false;
       break;
@@ -279,41 +281,13 @@ std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
     }
   if (changedFaces.empty()) return {};
   const BoxTree tree(changedBoxes);
-  // A coarse grid of the cells that changed boxes touch turns away, cheaply,
-  // the faces far from every changed face (most of a large mesh).
-  const Box& bounds = tree.bounds();
-  constexpr int kCells = 64;
-  float cellSize[3];
-  for (int k = 0; k < 3; ++k)
-    cellSize[k] = std::max((bounds.hi[k] - bounds.lo[k]) / kCells, 1e-30f);
-  auto cellRange = [&](const Box& b, int k, int& lo, int& hi) {
-    lo = std::clamp(int((b.lo[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
-    hi = std::clamp(int((b.hi[k] - bounds.lo[k]) / cellSize[k]), 0, kCells - 1);
-  };
-  std::vector<char> occupied(kCells * kCells * kCells, 0);
-  for (const Box& b : changedBoxes) {
-    int lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
-    for (int x = lo[0]; x <= hi[0]; ++x)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z) occupied[(x * kCells + y) * kCells + z] = 1;
-  }
-  auto nearChanged = [&](const Box& b) {
-    if (!overlap(b, bounds)) return false;
-    int lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
-    for (int x = lo[0]; x <= hi[0]; ++x)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z)
-          if (occupied[(x * kCells + y) * kCells + z]) return true;
-    return false;
-  };
+  const BoxGrid nearChanged(changedBoxes);
   std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
   parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
     for (std::size_t g = begin; g < end; ++g) {
       const Box b = changedIndex[g] >= 0 ? changedBoxes[changedIndex[g]]
                                          : boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
-      if (!nearChanged(b)) continue;
+      if (!nearChanged.touches(b)) continue;
       tree.query(b, worker, [&](std::uint32_t i, unsigned) {
         const std::uint32_t f = changedFaces[i];
         // A pair of two changed faces is found from both sides: keep one.

@@ -98,8 +98,15 @@ std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
       const int a = triangles[f][i], b = triangles[f][(i + 1) % 3];
       uses[next[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), int(f), i};
     }
+  // Within a vertex's uses, faces are already in order: a stable insertion
+  // sort by the other vertex completes the order of EdgeUse::operator<.
   for (int v = 0; v < vertexCount; ++v)
-    std::sort(uses.begin() + start[v], uses.begin() + start[v + 1]);
+    for (int k = start[v] + 1; k < start[v + 1]; ++k) {
+      const EdgeUse use = uses[k];
+      int j = k;
+      for (; j > start[v] && uses[j - 1].v > use.v; --j) uses[j] = uses[j - 1];
+      uses[j] = use;
+    }
   return uses;
 }
 

@@ -49,6 +49,7 @@ struct Edges {
   explicit Edges(const std::vector<Triangle>& T) {
     uses = edgeUses(T);
     edge_of_use.resize(uses.size());
+    first.reserve(uses.size() / 2 + 2);
     for (std::size_t k = 0; k < uses.size(); ++k) {
       if (k == 0 || uses[k].u != uses[k - 1].u || uses[k].v != uses[k - 1].v)
         first.push_back(int(k));
@@ -81,9 +82,9 @@ struct TopologyCounts {
   int genus = -1;
 };
 
-TopologyCounts topologyOf(const std::vector<Triangle>& T, std::size_t vertexCount) {
+TopologyCounts topologyOf(const Edges& edges, const std::vector<Triangle>& T,
+                          std::size_t vertexCount) {
   TopologyCounts c;
-  const Edges edges(T);
   std::vector<int> parent(T.size());
   std::iota(parent.begin(), parent.end(), 0);
   for (std::size_t e = 0; e < edges.count(); ++e) {
@@ -391,12 +392,16 @@ int signOf(const mpq_class& x) {
 // sign det(n_a, n_b, q - p), n = a triangle's normal.
 int signNormalsDet(const TrianglePoints& a, const TrianglePoints& b, const Point3& p,
                    const Point3& q) {
+  // Pieces of one cut triangle meet at its curves all the time: their
+  // normals are equal, the determinant is exactly 0 (no interval decides it).
+  if (a == b) return 0;
   if (const int s = signOf(normalsDet<Interval>(a, b, p, q))) return s;
   return signOf(normalsDet<mpq_class>(a, b, p, q));
 }
 
 // sign (n_a . n_b).
 int signNormalsDot(const TrianglePoints& a, const TrianglePoints& b) {
+  if (a == b && !collinear(a[0], a[1], a[2])) return 1;  // a normal with itself
   if (const int s = signOf(normalsDot<Interval>(a, b))) return s;
   return signOf(normalsDot<mpq_class>(a, b));
 }
@@ -733,8 +738,7 @@ class ValidRegionGrowing {
 // Two or more faces on an edge, all running it the same way: some faces are
 // turned over (the usual inconsistent orientation). Other unbalanced edges
 // (a fin: three faces on an edge) are left to the growing, as borders.
-void requireConsistentOrientation(const std::vector<Triangle>& T) {
-  const Edges edges(T);
+void requireConsistentOrientation(const Edges& edges, const std::vector<Triangle>& T) {
   std::size_t bad = 0;
   int example = -1;
   for (std::size_t e = 0; e < edges.count(); ++e) {
@@ -970,15 +974,10 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   std::vector<Triangle>& T = arrays.triangles;
   r.duplicate_faces_removed = removeDuplicateFaces(T, faceOrigin);
   if (T.empty()) throw InvalidInputError("the mesh has no faces left after welding");
-  requireConsistentOrientation(T);
-  // A closed mesh with negative volume is inside out: the region growing
-  // keeps what is outside with respect to the orientation, which would be
-  // nothing. It runs on the mesh turned over, and the result is turned back.
-  r.inside_out = signedVolume(P, T) < 0;
-  if (r.inside_out)
-    for (Triangle& t : T) std::swap(t[1], t[2]);
   {
-    const TopologyCounts before = topologyOf(T, P.size());
+    const Edges edges(T);
+    requireConsistentOrientation(edges, T);
+    const TopologyCounts before = topologyOf(edges, T, P.size());
     r.components_before = before.components;
     r.genus_before = before.genus;
     r.border_edges_before = before.border_edges;
@@ -986,6 +985,12 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
     r.fin_edges_before = before.fin_edges;
     r.input_closed = before.border_edges == 0;
   }
+  // A closed mesh with negative volume is inside out: the region growing
+  // keeps what is outside with respect to the orientation, which would be
+  // nothing. It runs on the mesh turned over, and the result is turned back.
+  r.inside_out = signedVolume(P, T) < 0;
+  if (r.inside_out)
+    for (Triangle& t : T) std::swap(t[1], t[2]);
 
   // §2.1 Pre-treatment.
   elapsed();
@@ -1108,7 +1113,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
     for (std::size_t f = 0; f < faces.size(); ++f) fo[f] = inputFace(faces[f]);
   }
 
-  const TopologyCounts after = topologyOf(outTriangles, outPoints.size());
+  const TopologyCounts after = topologyOf(Edges(outTriangles), outTriangles, outPoints.size());
   r.components_after = outTriangles.empty() ? 0 : after.components;
   r.genus_after = after.genus;
   r.border_edges_after = after.border_edges;

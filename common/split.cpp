@@ -406,6 +406,42 @@ class MeshSplitter {
 // degenerates, the smallest angle there gets larger, and no face it touches
 // crosses more faces than before (exact test). The curves stay shared by
 // the meshes they separate.
+// The faces around each vertex: one array for all vertices, built by
+// counting; a vertex whose faces change gets a list of its own.
+class FacesAroundVertices {
+ public:
+  FacesAroundVertices(const std::vector<Triangle>& T, std::size_t vertexCount)
+      : first_(vertexCount + 1, 0), faces_(3 * T.size()) {
+    for (const Triangle& t : T)
+      for (int v : t) ++first_[v + 1];
+    for (std::size_t v = 0; v < vertexCount; ++v) first_[v + 1] += first_[v];
+    std::vector<std::uint32_t> next(first_.begin(), first_.end() - 1);
+    for (std::size_t f = 0; f < T.size(); ++f)
+      for (int v : T[f]) faces_[next[v]++] = std::uint32_t(f);
+  }
+
+  struct Range {
+    const std::uint32_t *b, *e;
+    const std::uint32_t* begin() const { return b; }
+    const std::uint32_t* end() const { return e; }
+  };
+  Range operator[](int v) const {
+    const auto own = changed_.find(v);
+    if (own != changed_.end()) return {own->second.data(), own->second.data() + own->second.size()};
+    return {faces_.data() + first_[v], faces_.data() + first_[v + 1]};
+  }
+  // The list of `v`, to change.
+  std::vector<std::uint32_t>& edit(int v) {
+    auto [own, added] = changed_.try_emplace(v);
+    if (added) own->second.assign(faces_.begin() + first_[v], faces_.begin() + first_[v + 1]);
+    return own->second;
+  }
+
+ private:
+  std::vector<std::uint32_t> first_, faces_;
+  std::unordered_map<int, std::vector<std::uint32_t>> changed_;
+};
+
 class CurveSnapper {
  public:
   CurveSnapper(OutputArrays& mesh, std::set<std::array<int, 2>>& curves, std::vector<char>& newFace,
@@ -418,19 +454,36 @@ class CurveSnapper {
         newFace_(newFace),
         tolerance_(tolerance),
         alive_(T_.size(), 1),
-        around_(P_.size()),
+        around_(T_, P_.size()),
         snappedTo_(P_.size(), -1),
         fixed_(P_.size(), 0) {
-    for (std::size_t f = 0; f < T_.size(); ++f)
-      for (int v : T_[f]) around_[v].push_back(std::uint32_t(f));
     for (const auto& e : curves_) {
       curveNeighbours_[e[0]].push_back(e[1]);
       curveNeighbours_[e[1]].push_back(e[0]);
     }
-    std::vector<Box> boxes(T_.size());
+    // Snapping reshapes only faces around new vertices, by moves shorter
+    // than the tolerance times their longest edge: only faces near the new
+    // faces go into the tree. A query that reaches past them (covers())
+    // puts every face in.
+    double longest = 0;
+    std::vector<Box> near;
     for (std::size_t f = 0; f < T_.size(); ++f)
-      boxes[f] = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
+      if (newFace_[f]) {
+        near.push_back(boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]));
+        for (int i = 0; i < 3; ++i)
+          longest = std::max(longest, Distance(P_[T_[f][i]], P_[T_[f][(i + 1) % 3]]));
+      }
+    for (Box& b : near) b = grown(b, 2 * tolerance_ * longest);
+    grid_ = std::make_unique<BoxGrid>(near);
+    std::vector<Box> boxes;
+    for (std::size_t f = 0; f < T_.size(); ++f) {
+      const Box b = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
+      if (!grid_->touches(b)) continue;
+      boxes.push_back(b);
+      treeFace_.push_back(std::uint32_t(f));
+    }
     tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
+    indexed_ = T_.size();
   }
 
   // Merges new vertices into nearby input vertices; returns how many.
@@ -541,15 +594,34 @@ class CurveSnapper {
 
   static Point3 normalOf(const TrianglePoints& t) { return (t[1] - t[0]) ^ (t[2] - t[0]); }
 
+  // `b` grown by `d` on every side, rounded outward.
+  static Box grown(Box b, double d) {
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = std::nextafter(float(double(b.lo[k]) - d), -INFINITY);
+      b.hi[k] = std::nextafter(float(double(b.hi[k]) + d), INFINITY);
+    }
+    return b;
+  }
+
+  // The tree over every face, as they are now.
+  void indexEveryFace() {
+    std::vector<Box> boxes(T_.size());
+    treeFace_.resize(T_.size());
+    for (std::size_t f = 0; f < T_.size(); ++f) {
+      boxes[f] = boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]);
+      treeFace_[f] = std::uint32_t(f);
+    }
+    tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
+    indexed_ = T_.size();
+    grid_.reset();
+  }
+
   // How many faces the triangle `t` (the new shape of face `self`) crosses,
   // leaving out the faces `ignore` (sorted).
   std::size_t crossings(const Triangle& t, std::uint32_t self,
                         const std::vector<std::uint32_t>& ignore) {
-    Box b = boxOf(P_[t[0]], P_[t[1]], P_[t[2]]);
-    for (int k = 0; k < 3; ++k) {
-      b.lo[k] = std::nextafter(float(double(b.lo[k]) - reach_), -INFINITY);
-      b.hi[k] = std::nextafter(float(double(b.hi[k]) + reach_), INFINITY);
-    }
+    const Box b = grown(boxOf(P_[t[0]], P_[t[1]], P_[t[2]]), reach_);
+    if (grid_ && !grid_->covers(b)) indexEveryFace();
     std::size_t n = 0;
     const TrianglePoints a = at(t);
     auto test = [&](std::uint32_t g) {
@@ -558,8 +630,8 @@ class CurveSnapper {
       const SharedCorners c = sharedCorners(t, T_[g]);
       n += intersectBeyondShared(a, at(T_[g]), c.count, c.ia, c.ib);
     };
-    tree_->query(b, 0, [&](std::uint32_t g, unsigned) { test(g); });
-    for (std::size_t g = tree_->size(); g < T_.size(); ++g) {
+    tree_->query(b, 0, [&](std::uint32_t i, unsigned) { test(treeFace_[i]); });
+    for (std::size_t g = indexed_; g < T_.size(); ++g) {
       const Box gb = boxOf(P_[T_[g][0]], P_[T_[g][1]], P_[T_[g][2]]);
       if (overlap(b, gb)) test(std::uint32_t(g));
     }
@@ -686,9 +758,9 @@ class CurveSnapper {
     for (std::size_t i = 0; i < moved.size(); ++i) {
       T_[moved[i]] = after[i];
       newFace_[moved[i]] = 1;
-      around_[w].push_back(moved[i]);
+      around_.edit(w).push_back(moved[i]);
     }
-    around_[v].clear();
+    around_.edit(v).clear();
     const auto curve = curveNeighbours_.find(v);
     if (curve != curveNeighbours_.end()) {
       for (int x : curve->second) {
@@ -749,8 +821,8 @@ class CurveSnapper {
     faceOrigin_.push_back(faceOrigin_[g]);
     newFace_.push_back(1);
     newFace_[g] = 1;
-    for (int x : {v, a, c}) around_[x].push_back(added);
-    around_[v].push_back(g);
+    for (int x : {v, a, c}) around_.edit(x).push_back(added);
+    around_.edit(v).push_back(g);
     return true;
   }
 
@@ -762,11 +834,14 @@ class CurveSnapper {
   std::vector<char>& newFace_;
   double tolerance_;
   std::vector<char> alive_;
-  std::vector<std::vector<std::uint32_t>> around_;
+  FacesAroundVertices around_;
   std::vector<int> snappedTo_;
   std::vector<char> fixed_;  // snapping targets
   std::unordered_map<int, std::vector<int>> curveNeighbours_;
-  std::unique_ptr<BoxTree> tree_;
+  std::unique_ptr<BoxGrid> grid_;        // where the tree holds every face (null: everywhere)
+  std::unique_ptr<BoxTree> tree_;        // over the faces treeFace_ as they were when built
+  std::vector<std::uint32_t> treeFace_;  // tree primitive -> face
+  std::size_t indexed_ = 0;              // faces from here on were added later: tested one by one
   double reach_ = 0;  // the largest distance a vertex moved: boxes grow by at most this
 };
 

@@ -104,9 +104,16 @@ bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int
   switch (shared) {
     case 0:
       return trianglesIntersect(a, b);
-    case 1:
-      return segmentIntersectsTriangle(a[(ia + 1) % 3], a[(ia + 2) % 3], b) ||
-             segmentIntersectsTriangle(b[(ib + 1) % 3], b[(ib + 2) % 3], a);
+    case 1: {
+      // A face whose edge opposite the shared corner lies strictly on one
+      // side of the other's plane meets that plane only at the corner.
+      const Point3 &a1 = a[(ia + 1) % 3], &a2 = a[(ia + 2) % 3];
+      const Point3 &b1 = b[(ib + 1) % 3], &b2 = b[(ib + 2) % 3];
+      if (orient3d(b[0], b[1], b[2], a1) * orient3d(b[0], b[1], b[2], a2) > 0 ||
+          orient3d(a[0], a[1], a[2], b1) * orient3d(a[0], a[1], a[2], b2) > 0)
+        return false;
+      return segmentIntersectsTriangle(a1, a2, b) || segmentIntersectsTriangle(b1, b2, a);
+    }
     case 2: {
       const Point3 &p = a[(ia + 1) % 3], &q = a[(ia + 2) % 3];
       if (orient3d(p, q, a[ia], b[ib]) != 0) return false;
