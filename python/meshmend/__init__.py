@@ -380,17 +380,19 @@ def remove_patches(vertices, faces, **options) -> PatchesResult:
     return PatchesResult(*out["mesh"], out["face_origin"], out["report"])
 
 
-def boolean(vertices1, faces1, vertices2, faces2, operation="union",
-            snap_tolerance=0.0, progress=None) -> PatchesResult:
+@_with_options("intersect_and_split", exclude=("separate_meshes",))
+def boolean(vertices1, faces1, vertices2, faces2, operation="union", **options) -> PatchesResult:
     """The union, intersection or difference (first minus second) of two
-    closed meshes: intersect_and_split (merged), then remove_patches(keep=
-    operation). report['split'] holds the split's report."""
-    split = intersect_and_split(vertices1, faces1, vertices2, faces2, separate_meshes=False,
-                                snap_tolerance=snap_tolerance, progress=progress)
+    closed meshes: intersect_and_split (merged; its options), then
+    remove_patches(keep=operation). report['split'] holds the split's report.
+    Meshes that intersect themselves need self=True (scans: also
+    weld_duplicates=True, remove_duplicate_faces=True)."""
+    split = intersect_and_split(vertices1, faces1, vertices2, faces2,
+                                **dict(options, separate_meshes=False))
     merged_vertices, merged_faces = split.merged
     result = remove_patches(merged_vertices, merged_faces, part=split.merged_part,
                             curve_edges=split.merged_curve_edges, keep=operation,
-                            progress=progress)
+                            progress=options.get("progress"))
     result.report["split"] = split.report
     return result
 
