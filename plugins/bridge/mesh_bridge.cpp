@@ -2,6 +2,7 @@
 
 #include "common/errors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -132,6 +133,20 @@ vcg::Color4b mix(const vcg::Color4b c[3], const vcg::Point3d& w) {
   return out;
 }
 
+// What an output face is to the inputs: a copy of its origin face (the same
+// three input corners), a piece cut from it, or new (no origin face).
+unsigned char faceChange(const Mesh& core, const Face& face, VertexOriginHandle& vo,
+                         const FaceOrigin& o, const LayerAttributes* in) {
+  if (!in || o.face < 0 || o.face >= int(in->faces.size())) return kFaceNew;
+  const std::array<int, 3>& corners = in->faces[o.face];
+  for (int k = 0; k < 3; ++k) {
+    const VertexOrigin& v = vo[vcg::tri::Index(core, face.cV(k))];
+    if (v.layer != o.layer || std::find(corners.begin(), corners.end(), v.vertex) == corners.end())
+      return kFaceCut;
+  }
+  return kFaceKept;
+}
+
 }  // namespace
 
 void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, MeshModel& out) {
@@ -220,11 +235,14 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
   }
 
   auto fi = vcg::tri::Allocator<CMeshO>::AddFaces(cm, core.face.size());
+  auto change =
+      vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(cm, kFaceChangeAttribute);
   for (std::size_t f = 0; f < core.face.size(); ++f, ++fi) {
     const Face& face = core.face[f];
     for (int k = 0; k < 3; ++k) fi->V(k) = &cm.vert[vcg::tri::Index(core, face.cV(k))];
     const FaceOrigin& o = fo[f];
     const LayerAttributes* in = layerOf(o.layer);
+    change[f] = faceChange(core, face, vo, o, in);
     if (!in || o.face < 0 || o.face >= int(in->faces.size())) continue;
     if (in->face_selected[o.face]) fi->SetS();
     if (in->face_color) fi->C() = in->face_colors[o.face];

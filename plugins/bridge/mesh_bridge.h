@@ -53,4 +53,11 @@ LayerAttributes snapshot(const MeshModel& model);
 // coexist. Enables the components any input had; updates box and normals.
 void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, MeshModel& out);
 
+// writeMesh also records in the output, per face, what the face is to the
+// inputs (the shader meshmend_new_faces shows it): a copy of an input face,
+// a piece cut from one, or new (no input face under it: hole patches,
+// stitches). Each filter that rebuilds a layer through writeMesh replaces it.
+inline constexpr const char* kFaceChangeAttribute = "meshmend_face_change";  // unsigned char
+enum FaceChange : unsigned char { kFaceKept = 0, kFaceCut = 1, kFaceNew = 2 };
+
 }  // namespace meshmend::bridge
