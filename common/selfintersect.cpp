@@ -455,10 +455,15 @@ class ValidRegionGrowing {
   ValidRegionGrowing(const std::vector<Point3>& P, const std::vector<Triangle>& T,
                      const std::vector<char>& newFace, std::vector<TrianglePoints> births)
       : P_(P), T_(T), newFace_(newFace), births_(std::move(births)), edges_(T) {
-    std::vector<Box> boxes(T.size());
-    for (std::size_t f = 0; f < T.size(); ++f) boxes[f] = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
-    tree_ = std::make_unique<BoxTree>(std::move(boxes), BoxTree::Layout::kMorton);
-    bounds_ = tree_->bounds();
+    boxes_.resize(T.size());
+    bounds_ = boxes_.empty() ? Box{} : boxOf(P[T[0][0]], P[T[0][1]], P[T[0][2]]);
+    for (std::size_t f = 0; f < T.size(); ++f) {
+      boxes_[f] = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+      for (int k = 0; k < 3; ++k) {
+        bounds_.lo[k] = std::min(bounds_.lo[k], boxes_[f].lo[k]);
+        bounds_.hi[k] = std::max(bounds_.hi[k], boxes_[f].hi[k]);
+      }
+    }
     // Regions the growing crosses freely (through manifold edges): a region
     // is kept or removed as a whole, so a seed test that proves one face of
     // it inside settles the others.
@@ -673,6 +678,20 @@ class ValidRegionGrowing {
     }
   }
 
+  // Calls visit(face) for every face whose box overlaps `query`. Most
+  // meshes need a few rays: those scan the boxes; many rays get a tree.
+  template <class Visit>
+  void facesOverlapping(const Box& query, Visit&& visit) const {
+    if (!tree_ && ++scans_ > kRaysBeforeTree)
+      tree_ = std::make_unique<BoxTree>(boxes_, BoxTree::Layout::kMorton);
+    if (tree_) {
+      tree_->query(query, 0, [&](std::uint32_t h, unsigned) { visit(h); });
+      return;
+    }
+    for (std::size_t h = 0; h < boxes_.size(); ++h)
+      if (overlap(query, boxes_[h])) visit(std::uint32_t(h));
+  }
+
   // Seed test (§2.3): is the space just in front of face f outside the
   // surface? A ray from f's centroid along the coordinate axis closest to
   // its normal (so it leaves f on its front) is tested exactly against
@@ -694,7 +713,7 @@ class ValidRegionGrowing {
     end[k] = n[k] > 0 ? double(bounds_.hi[k]) + extent : double(bounds_.lo[k]) - extent;
     int winding = 0, hits = 0;
     bool undecided = false;
-    tree_->query(boxOf(o, end, end), 0, [&](std::uint32_t h, unsigned) {
+    facesOverlapping(boxOf(o, end, end), [&](std::uint32_t h) {
       if (undecided || int(h) == f) return;
       const Triangle& s = T_[h];
       const Point3 &a = P_[s[0]], &b = P_[s[1]], &c = P_[s[2]];
@@ -725,8 +744,11 @@ class ValidRegionGrowing {
   const std::vector<char>& newFace_;
   std::vector<TrianglePoints> births_;
   Edges edges_;
-  std::unique_ptr<BoxTree> tree_;
+  std::vector<Box> boxes_;  // per face
   Box bounds_;
+  static constexpr int kRaysBeforeTree = 8;
+  mutable int scans_ = 0;
+  mutable std::unique_ptr<BoxTree> tree_;  // over boxes_, once the rays are many
   std::vector<int> region_;
   std::vector<char> valid_;
   std::vector<char> alternate_;  // per edge: stitch across the material (see stitch())
@@ -1001,7 +1023,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
       reportProgress(options.progress, 5, "removing degenerate faces");
       pre.run(r.collapses, r.flips);
     }
-    r.degenerate_faces_left = pre.countDegenerate();
+    r.degenerate_faces_left = r.degenerate_faces_before > 0 ? pre.countDegenerate() : 0;
   }
   r.stage_ms.pretreat = elapsed();
 
