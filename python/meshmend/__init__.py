@@ -60,10 +60,13 @@ def _import_core():
     except ImportError as e:
         here = os.path.dirname(os.path.abspath(__file__))
         built = sorted(f for f in os.listdir(here) if f.startswith("_core."))
+        if any(f.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES)) for f in built):
+            raise ImportError(f"meshmend's compiled part in {here} fails to load ({e}): "
+                              f"rebuild MeshMend (scripts/setup)") from e
         raise ImportError(
-            f"meshmend's compiled part ({', '.join(built) or 'missing'} in {here}) does not load "
-            f"into Python {sys.version.split()[0]} ({sys.executable}): it is built for Debian's "
-            f"/usr/bin/python3; use that, or build MeshMend with "
+            f"meshmend's compiled part ({', '.join(built) or 'missing'} in {here}) is not built "
+            f"for Python {sys.version.split()[0]} ({sys.executable}) but for Debian's "
+            f"/usr/bin/python3: use that, or build MeshMend with "
             f"-DPython_EXECUTABLE={sys.executable}") from e
 
 
