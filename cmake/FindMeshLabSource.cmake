@@ -20,7 +20,12 @@ set(MESHLAB_SOURCE_DIR "${MESHLAB_SOURCE_DIR}" CACHE PATH "Unpacked MeshLab sour
 if(MESHLAB_SOURCE_DIR AND EXISTS "${MESHLAB_SOURCE_DIR}/ML_VERSION")
   file(READ "${MESHLAB_SOURCE_DIR}/ML_VERSION" MESHLAB_VERSION)
   string(STRIP "${MESHLAB_VERSION}" MESHLAB_VERSION)
-  set(VCGLIB_DIR "${MESHLAB_SOURCE_DIR}/vcglib")
+  # vcglib sits beside src/ in Debian's 2020.09 tree, inside it in upstream 2022.02.
+  foreach(_vcg "${MESHLAB_SOURCE_DIR}/vcglib" "${MESHLAB_SOURCE_DIR}/src/vcglib")
+    if(NOT VCGLIB_DIR AND IS_DIRECTORY "${_vcg}/vcg")
+      set(VCGLIB_DIR "${_vcg}")
+    endif()
+  endforeach()
 endif()
 
 include(FindPackageHandleStandardArgs)

@@ -8,13 +8,12 @@
 #include <string>
 #include <vector>
 
-#include <common/interfaces.h>
-#include <common/meshmodel.h>
 #include <QString>
 
 #include "common/errors.h"
 #include "common/json.h"
 #include "common/progress.h"
+#include "plugins/bridge/meshlab_host.h"
 
 namespace meshmend::bridge {
 
@@ -33,7 +32,7 @@ inline std::string layerName(const MeshModel& m) {
 // The default "second layer" of a two-layer filter: the first layer that
 // is not the current one (the current one when it is alone).
 inline MeshModel* layerOtherThanCurrent(MeshDocument& md) {
-  for (MeshModel* m : md.meshList)
+  for (MeshModel* m : layersOf(md))
     if (m != md.mm()) return m;
   return md.mm();
 }
@@ -66,12 +65,14 @@ bool guarded(QString& errorMessage, Body&& body, Log&& log) {
   return false;
 }
 
+#if MESHMEND_MESHLAB_API == 2020
 // The plugin-side form: logs into the plugin's MeshLab log.
 template <class Body>
 bool guarded(MeshCommonInterface& plugin, QString& errorMessage, Body&& body) {
   return guarded(errorMessage, std::forward<Body>(body),
                  [&plugin](const std::string& m) { plugin.Log(m); });
 }
+#endif
 
 // Writes `report` to `path` when it is not empty (throws InvalidInputError
 // with the path when it cannot be written).

@@ -80,7 +80,7 @@ LayerAttributes snapshot(const MeshModel& model) {
   for (std::size_t i = 0; i < nv; ++i) {
     const CVertexO& v = cm.vert[i];
     a.positions[i] = vcg::Point3d::Construct(v.cP());
-    a.vertex_normals[i] = vcg::Point3f::Construct(v.cN());
+    a.vertex_normals[i] = v.cN();
     a.vertex_selected[i] = !v.IsD() && v.IsS();
     if (a.vertex_color) a.vertex_colors[i] = v.cC();
     if (a.vertex_quality) a.vertex_qualities[i] = v.cQ();
@@ -170,7 +170,7 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
   }
 
   CMeshO& cm = out.cm;
-  const vcg::Matrix44f keepTr = cm.Tr;
+  const Matrix44m keepTr = cm.Tr;
   cm.Clear();
   cm.Tr = keepTr;
   int mask = 0;
@@ -190,7 +190,7 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
 
   auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(cm, core.vert.size());
   for (std::size_t i = 0; i < core.vert.size(); ++i, ++vi) {
-    vi->P() = vcg::Point3f::Construct(core.vert[i].cP());
+    vi->P() = HostPoint::Construct(core.vert[i].cP());
     const VertexOrigin& o = vo[i];
     const LayerAttributes* in = layerOf(o.layer);
     if (!in) continue;
@@ -207,8 +207,8 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
     } else if (o.face >= 0 && o.face < int(in->faces.size())) {
       const std::array<int, 3>& c = in->faces[o.face];
       const vcg::Point3d& w = o.barycentric;
-      vcg::Point3f n(0, 0, 0);
-      for (int k = 0; k < 3; ++k) n += in->vertex_normals[c[k]] * float(w[k]);
+      HostPoint n(0, 0, 0);
+      for (int k = 0; k < 3; ++k) n += in->vertex_normals[c[k]] * HostScalar(w[k]);
       vi->N() = n.Normalize();
       if (in->vertex_color) {
         const vcg::Color4b cols[3] = {in->vertex_colors[c[0]], in->vertex_colors[c[1]],
@@ -218,7 +218,7 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
       if (in->vertex_quality) {
         double q = 0;
         for (int k = 0; k < 3; ++k) q += w[k] * in->vertex_qualities[c[k]];
-        vi->Q() = float(q);
+        vi->Q() = HostScalar(q);
       }
       if (in->vertex_texcoord) {
         vcg::TexCoord2f t;

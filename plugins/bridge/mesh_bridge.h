@@ -1,14 +1,13 @@
-// Conversion between MeshLab's CMeshO (float, optional components) and the
-// core mesh (double, geometry + provenance). Attributes never enter the core:
+// Conversion between MeshLab's CMeshO (float in 2020.09, double in 2022.02;
+// optional components) and the core mesh (double, geometry + provenance). Attributes never enter the core:
 // they are snapshotted from the input layers and carried to the output through
 // the provenance every output element records (DESIGN §3).
 #pragma once
 
 #include <vector>
 
-#include <common/meshmodel.h>
-
 #include "common/mesh.h"
+#include "plugins/bridge/meshlab_host.h"
 
 namespace meshmend::bridge {
 
@@ -31,12 +30,12 @@ struct LayerAttributes {
   std::vector<vcg::Point3d> positions;    // to compute barycentric coordinates
   std::vector<std::array<int, 3>> faces;  // corner vertex indices
   std::vector<vcg::Color4b> vertex_colors;
-  std::vector<float> vertex_qualities;
-  std::vector<vcg::Point3f> vertex_normals;
+  std::vector<HostScalar> vertex_qualities;
+  std::vector<HostPoint> vertex_normals;
   std::vector<vcg::TexCoord2f> vertex_texcoords;
   std::vector<bool> vertex_selected, face_selected;
   std::vector<vcg::Color4b> face_colors;
-  std::vector<float> face_qualities;
+  std::vector<HostScalar> face_qualities;
   std::vector<std::array<vcg::TexCoord2f, 3>> wedge_texcoords;
   std::vector<std::string> textures;  // texture file names (cm.textures)
 };
