@@ -1,12 +1,12 @@
 // "MeshMend: Inspect Mesh Defects": the defect report of the current layer.
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class InspectPlugin : public QObject, public MeshFilterInterface {
+class InspectPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { INSPECT_DEFECTS };
@@ -14,12 +14,13 @@ class InspectPlugin : public QObject, public MeshFilterInterface {
   InspectPlugin();
   QString pluginName() const override { return "MeshMendInspect"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction*) override { return MeshFilterInterface::Measure; }
-  FILTER_ARITY filterArity(QAction*) const override { return SINGLE_MESH; }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction*) const override;
-  void initParameterSet(QAction*, MeshModel& m, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  FilterClass filterClass(QAction*) const override { return Measure; }
+  Arity arity(QAction*) const override { return SINGLE_MESH; }
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction*) const override;
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 };
