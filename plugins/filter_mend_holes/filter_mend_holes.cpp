@@ -16,12 +16,15 @@ const HoleFairing kFairings[] = {HoleFairing::LaplacianRegression, HoleFairing::
 }  // namespace
 
 HolesPlugin::HolesPlugin() {
-  typeList << FILL_HOLES;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {FILL_HOLES});
 }
 
 QString HolesPlugin::filterName(FilterIDType) const {
   return "MeshMend: Fill Holes (Feature Preserving)";
+}
+
+QString HolesPlugin::pythonFilterName(FilterIDType) const {
+  return "meshmend_fill_holes";
 }
 
 QString HolesPlugin::filterInfo(FilterIDType) const {
@@ -38,7 +41,7 @@ QString HolesPlugin::filterInfo(FilterIDType) const {
          "faces keep their indices; new ones are appended.";
 }
 
-void HolesPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& parameters) {
+void HolesPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& parameters) {
   const HoleFillOptions defaults;
   parameters.addParam(
       RichInt("max_boundary_edges", 0, "Max hole size (border edges)",
@@ -91,79 +94,77 @@ void HolesPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& para
       "remaining_intersecting_pairs, time_ms, holes, ...)."));
 }
 
-bool HolesPlugin::applyFilter(QAction*, MeshDocument& md, const RichParameterList& parameters,
-                              vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    MeshModel* model = md.mm();
-    if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
-    HoleFillOptions options;
-    const int maxEdges = parameters.getInt("max_boundary_edges");
-    if (maxEdges < 0) throw InvalidInputError("the max hole size must be 0 (no limit) or more");
-    options.max_boundary_edges = std::size_t(maxEdges);
-    options.max_diameter = parameters.getFloat("max_diameter");
-    const int fairing = parameters.getEnum("fairing");
-    if (fairing < 0 || fairing >= int(std::size(kFairings)))
-      throw InvalidInputError("unknown patch shape " + std::to_string(fairing) +
-                              ": use 0 (feature preserving) to 3 (flat)");
-    options.fairing = kFairings[fairing];
-    options.regression_rings = parameters.getInt("regression_rings");
-    options.long_edge_factor = parameters.getFloat("long_edge_factor");
-    options.check_intersections = parameters.getBool("check_intersections");
-    options.verify = parameters.getBool("verify");
-    options.round_to_float = true;  // MeshLab stores float: check what it will store
-    options.progress = progressFrom(cb);
+void HolesPlugin::apply(QAction*, MeshDocument& md, const RichParameterList& parameters,
+                        vcg::CallBackPos* cb) {
+  MeshModel* model = md.mm();
+  if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
+  HoleFillOptions options;
+  const int maxEdges = parameters.getInt("max_boundary_edges");
+  if (maxEdges < 0) throw InvalidInputError("the max hole size must be 0 (no limit) or more");
+  options.max_boundary_edges = std::size_t(maxEdges);
+  options.max_diameter = parameters.getFloat("max_diameter");
+  const int fairing = parameters.getEnum("fairing");
+  if (fairing < 0 || fairing >= int(std::size(kFairings)))
+    throw InvalidInputError("unknown patch shape " + std::to_string(fairing) +
+                            ": use 0 (feature preserving) to 3 (flat)");
+  options.fairing = kFairings[fairing];
+  options.regression_rings = parameters.getInt("regression_rings");
+  options.long_edge_factor = parameters.getFloat("long_edge_factor");
+  options.check_intersections = parameters.getBool("check_intersections");
+  options.verify = parameters.getBool("verify");
+  options.round_to_float = kHostStoresFloat;  // check what MeshLab will store
+  options.progress = progressFrom(cb);
 
-    reportProgress(options.progress, 0, "MeshMend: reading the layer");
-    Mesh core = toCore(model->cm);
-    if (parameters.getBool("selected_only")) {
-      VertexOriginHandle origin = vertexOrigins(core);
-      options.selected_vertices.assign(core.vert.size(), false);
-      bool any = false;
-      for (std::size_t v = 0; v < core.vert.size(); ++v) {
-        const bool selected = model->cm.vert[origin[v].vertex].IsS();
-        options.selected_vertices[v] = selected;
-        any |= selected;
-      }
-      if (!any)
-        throw InvalidInputError(
-            "'Only holes touching the selection' is on but no vertex is selected: select the "
-            "border of the holes to fill (Filters > Selection > Select Border) or turn it off");
+  reportProgress(options.progress, 0, "MeshMend: reading the layer");
+  Mesh core = toCore(model->cm);
+  if (parameters.getBool("selected_only")) {
+    VertexOriginHandle origin = vertexOrigins(core);
+    options.selected_vertices.assign(core.vert.size(), false);
+    bool any = false;
+    for (std::size_t v = 0; v < core.vert.size(); ++v) {
+      const bool selected = model->cm.vert[origin[v].vertex].IsS();
+      options.selected_vertices[v] = selected;
+      any |= selected;
     }
-    const HoleFillResult r = fillHoles(core, options);
+    if (!any)
+      throw InvalidInputError(
+          "'Only holes touching the selection' is on but no vertex is selected: select the "
+          "border of the holes to fill (Filters > Selection > Select Border) or turn it off");
+  }
+  const HoleFillResult r = fillHoles(core, options);
 
-    JsonObject report = toJson(r);
-    report.set("layer", toStd(model->label()));
-    writeReport(parameters.getString("report_file"), report);
+  JsonObject report = toJson(r);
+  report.set("layer", toStd(model->label()));
+  publishReport(parameters, report);
 
-    Log("MeshMend: %zu holes found in %s, %zu filled, %zu left open; %zu faces added, %.0f ms",
-        r.holes_found, layerName(*model).c_str(), r.holes_filled, r.holes_skipped, r.faces_added,
-        r.time_ms);
-    for (std::size_t i = 0; i < r.holes.size(); ++i) {
-      const HoleReport& h = r.holes[i];
-      if (h.filled)
-        Log("  hole %zu: %zu border edges, %zu faces added, %s, residual %.3g, %.1f ms%s%s", i,
-            h.boundary_edges, h.faces_added, toString(h.fairing), h.fairing_residual, h.time_ms,
-            h.reason.empty() ? "" : "; ", h.reason.c_str());
-      else
-        Log("  hole %zu: %zu border edges, left open: %s", i, h.boundary_edges, h.reason.c_str());
-    }
-    if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
-    if (r.holes_found == 0) {
-      Log("MeshMend: the mesh has no holes (no border edges); nothing to do");
-      return;  // the layer stays exactly as it was
-    }
-    if (r.holes_filled == 0) return;
+  Log("MeshMend: %zu holes found in %s, %zu filled, %zu left open; %zu faces added, %.0f ms",
+      r.holes_found, layerName(*model).c_str(), r.holes_filled, r.holes_skipped, r.faces_added,
+      r.time_ms);
+  for (std::size_t i = 0; i < r.holes.size(); ++i) {
+    const HoleReport& h = r.holes[i];
+    if (h.filled)
+      Log("  hole %zu: %zu border edges, %zu faces added, %s, residual %.3g, %.1f ms%s%s", i,
+          h.boundary_edges, h.faces_added, toString(h.fairing), h.fairing_residual, h.time_ms,
+          h.reason.empty() ? "" : "; ", h.reason.c_str());
+    else
+      Log("  hole %zu: %zu border edges, left open: %s", i, h.boundary_edges, h.reason.c_str());
+  }
+  if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
+  if (r.holes_found == 0) {
+    Log("MeshMend: the mesh has no holes (no border edges); nothing to do");
+    return;  // the layer stays exactly as it was
+  }
+  if (r.holes_filled == 0) return;
 
-    // The only change to the document, made last.
-    const std::vector<LayerAttributes> attributes{snapshot(*model)};
-    writeMesh(core, attributes, *model);
-    if (parameters.getBool("select_new_faces")) {
-      for (CFaceO& f : model->cm.face) f.ClearS();
-      for (CVertexO& v : model->cm.vert) v.ClearS();
-      for (int f : r.new_faces) model->cm.face[f].SetS();
-    }
-    reportProgress(options.progress, 100, "MeshMend: done");
-  });
+  // The only change to the document, made last.
+  const std::vector<LayerAttributes> attributes{snapshot(*model)};
+  writeMesh(core, attributes, *model);
+  if (parameters.getBool("select_new_faces")) {
+    for (CFaceO& f : model->cm.face) f.ClearS();
+    for (CVertexO& v : model->cm.vert) v.ClearS();
+    for (int f : r.new_faces) model->cm.face[f].SetS();
+  }
+  reportProgress(options.progress, 100, "MeshMend: done");
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(HolesPlugin)
