@@ -8,12 +8,15 @@ using namespace meshmend;
 using namespace meshmend::bridge;
 
 SelfIntersectPlugin::SelfIntersectPlugin() {
-  typeList << REMOVE_SELF_INTERSECTIONS;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {REMOVE_SELF_INTERSECTIONS});
 }
 
 QString SelfIntersectPlugin::filterName(FilterIDType) const {
   return "MeshMend: Remove Self-Intersections";
+}
+
+QString SelfIntersectPlugin::pythonFilterName(FilterIDType) const {
+  return "meshmend_remove_self_intersections";
 }
 
 QString SelfIntersectPlugin::filterInfo(FilterIDType) const {
@@ -32,7 +35,7 @@ QString SelfIntersectPlugin::filterInfo(FilterIDType) const {
          "vertex, moved apart by 1/1000 of the local edge length.";
 }
 
-void SelfIntersectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterList& parameters) {
+void SelfIntersectPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& parameters) {
   const SelfIntersectionOptions defaults;
   parameters.addParam(RichBool(
       "pretreat", defaults.pretreat, "Remove degenerate faces first",
@@ -73,65 +76,63 @@ void SelfIntersectPlugin::initParameterSet(QAction*, MeshModel&, RichParameterLi
       "genus_after, remaining_intersecting_pairs, time_ms, ...)."));
 }
 
-bool SelfIntersectPlugin::applyFilter(QAction*, MeshDocument& md,
-                                      const RichParameterList& parameters, vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    MeshModel* model = md.mm();
-    if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
-    SelfIntersectionOptions options;
-    options.pretreat = parameters.getBool("pretreat");
-    options.degenerate_angle_deg = parameters.getFloat("degenerate_angle_deg");
-    options.weld_duplicates = parameters.getBool("weld_duplicates");
-    options.snap_tolerance = parameters.getFloat("snap_tolerance");
-    options.separate_touching = parameters.getBool("separate_touching");
-    options.keep_removed = parameters.getBool("removed_to_layer");
-    options.verify = parameters.getBool("verify");
-    options.round_to_float = true;  // MeshLab stores float: decide on what it will store
-    options.progress = progressFrom(cb);
+void SelfIntersectPlugin::apply(QAction*, MeshDocument& md, const RichParameterList& parameters,
+                                vcg::CallBackPos* cb) {
+  MeshModel* model = md.mm();
+  if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
+  SelfIntersectionOptions options;
+  options.pretreat = parameters.getBool("pretreat");
+  options.degenerate_angle_deg = parameters.getFloat("degenerate_angle_deg");
+  options.weld_duplicates = parameters.getBool("weld_duplicates");
+  options.snap_tolerance = parameters.getFloat("snap_tolerance");
+  options.separate_touching = parameters.getBool("separate_touching");
+  options.keep_removed = parameters.getBool("removed_to_layer");
+  options.verify = parameters.getBool("verify");
+  options.round_to_float = kHostStoresFloat;  // decide on what MeshLab will store
+  options.progress = progressFrom(cb);
 
-    reportProgress(options.progress, 0, "MeshMend: reading the layer");
-    const Mesh core = toCore(model->cm);
-    const SelfIntersectionResult r = removeSelfIntersections(core, options);
-    if (r.mesh.fn == 0)
-      throw TopologyError(
-          "no face of the mesh is outside with respect to its orientation, so nothing would be "
-          "kept: check the orientation (Filters > Normals > Invert Faces Orientation) and try "
-          "again; the layer is unchanged");
+  reportProgress(options.progress, 0, "MeshMend: reading the layer");
+  const Mesh core = toCore(model->cm);
+  const SelfIntersectionResult r = removeSelfIntersections(core, options);
+  if (r.mesh.fn == 0)
+    throw TopologyError(
+        "no face of the mesh is outside with respect to its orientation, so nothing would be "
+        "kept: check the orientation (Filters > Normals > Invert Faces Orientation) and try "
+        "again; the layer is unchanged");
 
-    JsonObject report = toJson(r);
-    report.set("layer", toStd(model->label()));
-    writeReport(parameters.getString("report_file"), report);
+  JsonObject report = toJson(r);
+  report.set("layer", toStd(model->label()));
+  publishReport(parameters, report);
 
-    // The only changes to the document, made last.
-    const std::vector<LayerAttributes> attributes{snapshot(*model)};
-    if (options.keep_removed && r.removed.fn > 0) {
-      MeshModel* rest = md.addNewMesh("", "removed parts", false);
-      writeMesh(r.removed, attributes, *rest);
-    }
-    writeMesh(r.mesh, attributes, *model);
+  // The only changes to the document, made last.
+  const std::vector<LayerAttributes> attributes{snapshot(*model)};
+  if (options.keep_removed && r.removed.fn > 0) {
+    MeshModel* rest = md.addNewMesh("", "removed parts", false);
+    writeMesh(r.removed, attributes, *rest);
+  }
+  writeMesh(r.mesh, attributes, *model);
 
-    Log("MeshMend: removed self-intersections of %s in %.0f ms", layerName(*model).c_str(),
-        r.time_ms);
-    Log("  %zu intersecting pairs cut %zu faces; faces kept %zu, removed %zu",
-        r.intersecting_pairs_before, r.faces_split, r.faces_kept, r.faces_removed);
-    Log("  components %d -> %d; genus %s -> %s", r.components_before, r.components_after,
-        r.genus_before >= 0 ? std::to_string(r.genus_before).c_str() : "n/a",
-        r.genus_after >= 0 ? std::to_string(r.genus_after).c_str() : "n/a");
-    Log("  pre-treatment: %zu degenerate faces, %zu collapses, %zu flips, %zu left",
-        r.degenerate_faces_before, r.collapses, r.flips, r.degenerate_faces_left);
-    Log("  stitching: %zu vertices and %zu edges duplicated, %zu copies moved apart",
-        r.vertices_duplicated, r.edges_duplicated, r.vertices_separated);
-    Log("  result: %s, %zu border edges, %zu non-manifold edges",
-        r.output_closed ? "closed" : "open", r.border_edges_after, r.non_manifold_edges_after);
-    if (!r.input_closed)
-      Log("  note: the mesh has borders: seeds were faces with nothing in front of them, and "
-          "borders stay borders");
-    if (r.inside_out)
-      Log("  note: the mesh is closed and inside out (negative volume); it stays so: run "
-          "Filters > Normals > Invert Faces Orientation if that is not intended");
-    if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
-    reportProgress(options.progress, 100, "MeshMend: done");
-  });
+  Log("MeshMend: removed self-intersections of %s in %.0f ms", layerName(*model).c_str(),
+      r.time_ms);
+  Log("  %zu intersecting pairs cut %zu faces; faces kept %zu, removed %zu",
+      r.intersecting_pairs_before, r.faces_split, r.faces_kept, r.faces_removed);
+  Log("  components %d -> %d; genus %s -> %s", r.components_before, r.components_after,
+      r.genus_before >= 0 ? std::to_string(r.genus_before).c_str() : "n/a",
+      r.genus_after >= 0 ? std::to_string(r.genus_after).c_str() : "n/a");
+  Log("  pre-treatment: %zu degenerate faces, %zu collapses, %zu flips, %zu left",
+      r.degenerate_faces_before, r.collapses, r.flips, r.degenerate_faces_left);
+  Log("  stitching: %zu vertices and %zu edges duplicated, %zu copies moved apart",
+      r.vertices_duplicated, r.edges_duplicated, r.vertices_separated);
+  Log("  result: %s, %zu border edges, %zu non-manifold edges", r.output_closed ? "closed" : "open",
+      r.border_edges_after, r.non_manifold_edges_after);
+  if (!r.input_closed)
+    Log("  note: the mesh has borders: seeds were faces with nothing in front of them, and "
+        "borders stay borders");
+  if (r.inside_out)
+    Log("  note: the mesh is closed and inside out (negative volume); it stays so: run "
+        "Filters > Normals > Invert Faces Orientation if that is not intended");
+  if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
+  reportProgress(options.progress, 100, "MeshMend: done");
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(SelfIntersectPlugin)

@@ -2,12 +2,12 @@
 // folds through itself (common/selfintersect.h), in place.
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class SelfIntersectPlugin : public QObject, public MeshFilterInterface {
+class SelfIntersectPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { REMOVE_SELF_INTERSECTIONS };
@@ -15,12 +15,13 @@ class SelfIntersectPlugin : public QObject, public MeshFilterInterface {
   SelfIntersectPlugin();
   QString pluginName() const override { return "MeshMendSelfIntersect"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction*) override { return MeshFilterInterface::Cleaning; }
-  FILTER_ARITY filterArity(QAction*) const override { return SINGLE_MESH; }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction*) const override { return MeshModel::MM_ALL; }
-  void initParameterSet(QAction*, MeshModel& m, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  FilterClass filterClass(QAction*) const override { return Cleaning; }
+  Arity arity(QAction*) const override { return SINGLE_MESH; }
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction*) const override { return MeshModel::MM_ALL; }
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 };
