@@ -20,13 +20,21 @@ enum Mode { kWithinCurrent, kBetweenTwo, kAllVisible };
 }  // namespace
 
 IntersectPlugin::IntersectPlugin() {
-  typeList << SELECT_INTERSECTING << INTERSECT_AND_SPLIT;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {SELECT_INTERSECTING, INTERSECT_AND_SPLIT});
 }
 
 QString IntersectPlugin::filterName(FilterIDType id) const {
   return id == SELECT_INTERSECTING ? "MeshMend: Select Intersecting Faces"
                                    : "MeshMend: Intersect and Split Layers";
+}
+
+QString IntersectPlugin::pythonFilterName(FilterIDType filter) const {
+  switch (filter) {
+    case SELECT_INTERSECTING:
+      return "meshmend_select_intersecting_faces";
+    default:
+      return "meshmend_intersect_and_split";
+  }
 }
 
 QString IntersectPlugin::filterInfo(FilterIDType id) const {
@@ -60,8 +68,7 @@ QString IntersectPlugin::filterInfo(FilterIDType id) const {
          "exact instead of tolerance-based decisions.";
 }
 
-void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
-                                       RichParameterList& parameters) {
+void IntersectPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   MeshModel* current = md.mm();
   MeshModel* other = layerOtherThanCurrent(md);
   parameters.addParam(RichEnum(
@@ -73,10 +80,10 @@ void IntersectPlugin::initParameterSet(QAction* a, MeshDocument& md,
       "Within the current layer: its self-intersections. Between two chosen layers: faces of "
       "the first that meet faces of the second (layer matrices applied). Among all visible "
       "layers: both, for every visible layer and every two of them."));
-  parameters.addParam(RichMesh("first_layer", current, &md, "First layer",
-                               "First layer of the 'between two chosen layers' mode."));
-  parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
-                               "Second layer of the 'between two chosen layers' mode."));
+  parameters.addParam(layerParameter("first_layer", current, md, "First layer",
+                                     "First layer of the 'between two chosen layers' mode."));
+  parameters.addParam(layerParameter("second_layer", other, md, "Second layer",
+                                     "Second layer of the 'between two chosen layers' mode."));
   if (ID(a) == INTERSECT_AND_SPLIT) {
     parameters.addParam(RichBool(
         "split_self_intersections", false, "Also split self-intersections",
@@ -146,8 +153,8 @@ std::vector<MeshModel*> chosenLayers(MeshDocument& md, const RichParameterList& 
     return {md.mm()};
   }
   if (mode == kBetweenTwo) {
-    MeshModel* a = parameters.getMesh("first_layer");
-    MeshModel* b = parameters.getMesh("second_layer");
+    MeshModel* a = layerFrom(parameters, md, "first_layer");
+    MeshModel* b = layerFrom(parameters, md, "second_layer");
     if (!a || !b) throw InvalidInputError("choose the two layers to intersect");
     if (a == b)
       throw InvalidInputError("the same layer (" + layerName(*a) +
@@ -156,7 +163,7 @@ std::vector<MeshModel*> chosenLayers(MeshDocument& md, const RichParameterList& 
     return {a, b};
   }
   std::vector<MeshModel*> layers;
-  for (MeshModel* m : md.meshList)
+  for (MeshModel* m : layersOf(md))
     if (m->isVisible() && m->cm.fn > 0) layers.push_back(m);
   if (layers.empty()) throw InvalidInputError("no visible layer has faces");
   return layers;
@@ -183,14 +190,12 @@ Inputs inputsOf(MeshDocument& md, const RichParameterList& parameters) {
 
 }  // namespace
 
-bool IntersectPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
-                                  vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    if (ID(a) == SELECT_INTERSECTING)
-      selectIntersecting(md, parameters, cb);
-    else
-      intersectAndSplit(md, parameters, cb);
-  });
+void IntersectPlugin::apply(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                            vcg::CallBackPos* cb) {
+  if (ID(a) == SELECT_INTERSECTING)
+    selectIntersecting(md, parameters, cb);
+  else
+    intersectAndSplit(md, parameters, cb);
 }
 
 void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterList& parameters,
@@ -209,7 +214,7 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names);
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The document changes only from here on.
   std::size_t selected = 0;
@@ -228,7 +233,7 @@ void IntersectPlugin::selectIntersecting(MeshDocument& md, const RichParameterLi
     MeshModel* seg = md.addNewMesh("", "intersection segments", false);
     auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(seg->cm, soup.points.size());
     for (std::size_t i = 0; i < soup.points.size(); ++i, ++vi)
-      vi->P() = vcg::Point3f::Construct(soup.points[i]);
+      vi->P() = HostPoint::Construct(soup.points[i]);
     for (const auto& e : soup.edges) vcg::tri::Allocator<CMeshO>::AddEdge(seg->cm, e[0], e[1]);
     vcg::tri::UpdateBounding<CMeshO>::Box(seg->cm);
     Log("  created layer 'intersection segments': %zu segments", soup.edges.size());
@@ -295,13 +300,18 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
                                 ? layerName(*layers[0]) +
                                       " does not intersect itself: nothing to split"
                                 : "the chosen layers do not intersect: nothing to split");
-  // MeshLab stores float: round, re-rounding curve points where that keeps
-  // faces that meet along a curve from crossing.
-  reportProgress(progressFrom(cb), 95, "Rounding to float");
+  // A float host (2020.09) gets the result rounded here, re-rounding curve
+  // points where that keeps faces that meet along a curve from crossing; a
+  // double host (2022.02) stores it as computed and is checked whole.
   const auto roundStart = std::chrono::steady_clock::now();
-  std::size_t remaining = roundToFloat(r);
+  std::size_t remaining = 0;
+  const bool checkWhole = !kHostStoresFloat || !r.complete;
+  if (kHostStoresFloat) {
+    reportProgress(progressFrom(cb), 95, "Rounding to float");
+    remaining = roundToFloat(r);
+  }
   const bool verify = parameters.getBool("verify");
-  if (verify && !r.complete) {  // some input intersections were not split: check everything
+  if (verify && checkWhole) {  // rounding did not count every pair: check everything
     reportProgress(progressFrom(cb), 97, "Checking the result");
     FindIntersectionsOptions o;  // on all layers together, welded along the curves
     o.cross = false;
@@ -311,14 +321,15 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - roundStart)
           .count();
   if (verify)
-    Log("  check of the float result: %zu intersecting pairs remain%s", remaining,
-        r.complete ? " (all with a new face: the others are input faces as they were)" : "");
+    Log("  check of the %s result: %zu intersecting pairs remain%s",
+        kHostStoresFloat ? "float" : "double", remaining,
+        checkWhole ? "" : " (all with a new face: the others are input faces as they were)");
   JsonObject report = toJson(r);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names).set("output", merge ? "merged" : "separate");
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The document changes only from here on.
   std::vector<LayerAttributes> attributes;
@@ -342,7 +353,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     const Mesh& merged = r.merged;
     auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(curves->cm, merged.vert.size());
     for (std::size_t v = 0; v < merged.vert.size(); ++v, ++vi)
-      vi->P() = vcg::Point3f::Construct(merged.vert[v].cP());
+      vi->P() = HostPoint::Construct(merged.vert[v].cP());
     for (const auto& e : r.merged_curve_edges)
       vcg::tri::Allocator<CMeshO>::AddEdge(curves->cm, e[0], e[1]);
     vcg::tri::Clean<CMeshO>::RemoveUnreferencedVertex(curves->cm);

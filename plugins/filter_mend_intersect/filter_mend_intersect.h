@@ -2,12 +2,12 @@
 // Faces" and "MeshMend: Intersect and Split Layers".
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class IntersectPlugin : public QObject, public MeshFilterInterface {
+class IntersectPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { SELECT_INTERSECTING, INTERSECT_AND_SPLIT };
@@ -15,20 +15,20 @@ class IntersectPlugin : public QObject, public MeshFilterInterface {
   IntersectPlugin();
   QString pluginName() const override { return "MeshMendIntersect"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction* a) override {
-    return ID(a) == SELECT_INTERSECTING ? MeshFilterInterface::Selection
-                                        : MeshFilterInterface::Remeshing;
+  FilterClass filterClass(QAction* a) const override {
+    return ID(a) == SELECT_INTERSECTING ? Selection : Remeshing;
   }
-  FILTER_ARITY filterArity(QAction*) const override { return VARIABLE; }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction* a) const override {
+  Arity arity(QAction*) const override { return VARIABLE; }
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction* a) const override {
     return ID(a) == SELECT_INTERSECTING ? int(MeshModel::MM_FACEFLAGSELECT)
                                         : int(MeshModel::MM_ALL);
   }
-  void initParameterSet(QAction*, MeshDocument& md, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 
  private:
   void selectIntersecting(MeshDocument& md, const RichParameterList& parameters,
