@@ -64,7 +64,7 @@ Assembly assemble(MeshDocument& md, int which) {
     if (!md.mm()) throw InvalidInputError("there is no current layer: open a mesh first");
     a.layers = {md.mm()};
   } else {
-    for (MeshModel* m : md.meshList)
+    for (MeshModel* m : layersOf(md))
       if (m->isVisible() && m->cm.fn > 0) a.layers.push_back(m);
     if (a.layers.empty()) throw InvalidInputError("no visible layer has faces");
   }
@@ -166,8 +166,7 @@ std::vector<int> parseIds(const std::string& text, std::size_t patches) {
 }  // namespace
 
 PatchesPlugin::PatchesPlugin() {
-  typeList << PAINT_PATCHES << SELECT_PATCHES << REMOVE_PATCHES;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {PAINT_PATCHES, SELECT_PATCHES, REMOVE_PATCHES});
 }
 
 QString PatchesPlugin::filterName(FilterIDType id) const {
@@ -178,6 +177,17 @@ QString PatchesPlugin::filterName(FilterIDType id) const {
       return "MeshMend: Select Patches";
     default:
       return "MeshMend: Remove Patches";
+  }
+}
+
+QString PatchesPlugin::pythonFilterName(FilterIDType filter) const {
+  switch (filter) {
+    case PAINT_PATCHES:
+      return "meshmend_paint_patches";
+    case SELECT_PATCHES:
+      return "meshmend_select_patches";
+    default:
+      return "meshmend_remove_patches";
   }
 }
 
@@ -214,18 +224,18 @@ QString PatchesPlugin::filterInfo(FilterIDType id) const {
   }
 }
 
-MeshFilterInterface::FilterClass PatchesPlugin::getClass(QAction* a) {
+PatchesPlugin::FilterClass PatchesPlugin::filterClass(QAction* a) const {
   switch (ID(a)) {
     case PAINT_PATCHES:
-      return MeshFilterInterface::FaceColoring;
+      return FaceColoring;
     case SELECT_PATCHES:
-      return MeshFilterInterface::Selection;
+      return Selection;
     default:
-      return MeshFilterInterface::Cleaning;
+      return Cleaning;
   }
 }
 
-int PatchesPlugin::postCondition(QAction* a) const {
+int PatchesPlugin::postconditions(QAction* a) const {
   switch (ID(a)) {
     case PAINT_PATCHES:
       return MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY;
@@ -236,7 +246,7 @@ int PatchesPlugin::postCondition(QAction* a) const {
   }
 }
 
-void PatchesPlugin::initParameterSet(QAction* a, MeshDocument&, RichParameterList& parameters) {
+void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList& parameters) {
   parameters.addParam(RichEnum(
       "layers", kCurrentLayer,
       QStringList() << "The current layer"
@@ -305,21 +315,19 @@ void PatchesPlugin::initParameterSet(QAction* a, MeshDocument&, RichParameterLis
             "numbers) and time_ms."));
 }
 
-bool PatchesPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
-                                vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    switch (ID(a)) {
-      case PAINT_PATCHES:
-        paint(md, parameters, cb);
-        break;
-      case SELECT_PATCHES:
-        select(md, parameters, cb);
-        break;
-      default:
-        remove(md, parameters, cb);
-        break;
-    }
-  });
+void PatchesPlugin::apply(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                          vcg::CallBackPos* cb) {
+  switch (ID(a)) {
+    case PAINT_PATCHES:
+      paint(md, parameters, cb);
+      break;
+    case SELECT_PATCHES:
+      select(md, parameters, cb);
+      break;
+    default:
+      remove(md, parameters, cb);
+      break;
+  }
 }
 
 void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
@@ -343,7 +351,7 @@ void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   JsonObject report = toJson(p);
   report.set("time_ms", ms);
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The document changes only from here on.
   for (std::size_t i = 0; i < a.layers.size(); ++i) {
@@ -506,7 +514,7 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
   }
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   report.set("time_ms", ms);
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The document changes only from here on.
   std::vector<LayerAttributes> attributes;
@@ -522,7 +530,7 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
     rest->cm.Tr.SetIdentity();
   }
   if (which == kAllVisible)
-    for (MeshModel* m : a.layers) m->visible = false;
+    for (MeshModel* m : a.layers) setLayerVisible(*m, false);
   Log("MeshMend: kept %zu of %zu patches: %d faces (%.0f ms)%s", kept, p.patches.size(), out->cm.fn,
       ms, toLayer ? "; the removed ones are in layer 'removed patches'" : "");
   if (verify)

@@ -2,12 +2,12 @@
 // Patches", "MeshMend: Select Patches" and "MeshMend: Remove Patches".
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class PatchesPlugin : public QObject, public MeshFilterInterface {
+class PatchesPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { PAINT_PATCHES, SELECT_PATCHES, REMOVE_PATCHES };
@@ -15,14 +15,15 @@ class PatchesPlugin : public QObject, public MeshFilterInterface {
   PatchesPlugin();
   QString pluginName() const override { return "MeshMendPatches"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction* a) override;
-  FILTER_ARITY filterArity(QAction*) const override { return VARIABLE; }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction* a) const override;
-  void initParameterSet(QAction*, MeshDocument& md, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  FilterClass filterClass(QAction* a) const override;
+  Arity arity(QAction*) const override { return VARIABLE; }
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction* a) const override;
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 
  private:
   void paint(MeshDocument& md, const RichParameterList& parameters, vcg::CallBackPos* cb);
