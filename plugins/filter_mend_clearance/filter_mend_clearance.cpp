@@ -27,13 +27,21 @@ double msSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 ClearancePlugin::ClearancePlugin() {
-  typeList << MEASURE_CLEARANCE << ENFORCE_CLEARANCE;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {MEASURE_CLEARANCE, ENFORCE_CLEARANCE});
 }
 
 QString ClearancePlugin::filterName(FilterIDType id) const {
   return id == MEASURE_CLEARANCE ? "MeshMend: Measure Clearance"
                                  : "MeshMend: Enforce Minimum Clearance";
+}
+
+QString ClearancePlugin::pythonFilterName(FilterIDType filter) const {
+  switch (filter) {
+    case MEASURE_CLEARANCE:
+      return "meshmend_measure_clearance";
+    default:
+      return "meshmend_enforce_minimum_clearance";
+  }
 }
 
 QString ClearancePlugin::filterInfo(FilterIDType id) const {
@@ -70,8 +78,7 @@ QString ClearancePlugin::filterInfo(FilterIDType id) const {
          "SVD), and a backtracking line search that also keeps the surfaces from crossing.";
 }
 
-void ClearancePlugin::initParameterSet(QAction* a, MeshDocument& md,
-                                       RichParameterList& parameters) {
+void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   MeshModel* current = md.mm();
   MeshModel* other = layerOtherThanCurrent(md);
   // Percentages of tau and the cap are of the diagonal of all layers (as
@@ -98,12 +105,14 @@ void ClearancePlugin::initParameterSet(QAction* a, MeshDocument& md,
       "and outer skin of a shell, a fold). Between two chosen layers: faces of the first against "
       "faces of the second (layer matrices applied). Both: the two chosen layers, within each "
       "and between them."));
-  parameters.addParam(RichMesh("first_layer", current, &md, "First layer",
-                               "First of the two chosen layers (scopes 'between' and 'both'); "
-                               "in a script, the layer's index in loading order."));
-  parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
-                               "Second of the two chosen layers (scopes 'between' and 'both'); "
-                               "in a script, the layer's index in loading order."));
+  parameters.addParam(
+      layerParameter("first_layer", current, md, "First layer",
+                     "First of the two chosen layers (scopes 'between' and 'both'); "
+                     "in a script, the layer's index in loading order."));
+  parameters.addParam(
+      layerParameter("second_layer", other, md, "Second layer",
+                     "Second of the two chosen layers (scopes 'between' and 'both'); "
+                     "in a script, the layer's index in loading order."));
   parameters.addParam(RichInt(
       "exclusion_rings", 1, "Adjacent within (rings)",
       "Faces of one layer within this many vertex rings of each other are neighbours and never "
@@ -155,8 +164,8 @@ Chosen chosenLayers(MeshDocument& md, const RichParameterList& parameters) {
   if (scope != kBetweenTwo && scope != kBothOfTwo)
     throw InvalidInputError("unknown scope " + std::to_string(scope) +
                             ": use 0 (within), 1 (between) or 2 (both)");
-  MeshModel* a = parameters.getMesh("first_layer");
-  MeshModel* b = parameters.getMesh("second_layer");
+  MeshModel* a = layerFrom(parameters, md, "first_layer");
+  MeshModel* b = layerFrom(parameters, md, "second_layer");
   if (!a || !b) throw InvalidInputError("choose the two layers");
   if (a == b)
     throw InvalidInputError("the same layer (" + layerName(*a) +
@@ -248,14 +257,12 @@ double distanceParameter(const RichParameterList& parameters, const char* name, 
 
 }  // namespace
 
-bool ClearancePlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
-                                  vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    if (ID(a) == MEASURE_CLEARANCE)
-      measure(md, parameters, cb);
-    else
-      enforce(md, parameters, cb);
-  });
+void ClearancePlugin::apply(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                            vcg::CallBackPos* cb) {
+  if (ID(a) == MEASURE_CLEARANCE)
+    measure(md, parameters, cb);
+  else
+    enforce(md, parameters, cb);
 }
 
 void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& parameters,
@@ -277,7 +284,7 @@ void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& paramet
   report.set("scope", toString(options.scope)).set("layers", labels(layers));
   if (r.found) report.set("closest", pairsJson({r.closest}, in.cores).front());
   report.set("shortest", pairsJson(r.shortest, in.cores));
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The document changes only from here on: quality and selection, no geometry.
   for (std::size_t l = 0; l < layers.size(); ++l) {
@@ -332,7 +339,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   options.max_iterations = parameters.getInt("max_iterations");
   if (options.max_iterations < 1) throw InvalidInputError("max iterations must be at least 1");
   options.exclusion_rings = parameters.getInt("exclusion_rings");
-  options.round_to_float = true;  // MeshLab stores float: reach tau in what it will store
+  options.round_to_float = kHostStoresFloat;  // reach tau in what MeshLab will store
   options.progress = progressFrom(cb);
 
   Inputs in;
@@ -373,13 +380,14 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   if (anyMatrix) exactBefore = measureClearance(constCores, check);
 
   // Where each vertex was in the common frame, exactly and as the core takes
-  // it (rounded to float): a vertex it did not move comes back as the latter.
+  // it (rounded to float for a float host): a vertex it did not move comes
+  // back as the latter.
   std::vector<std::vector<Point3>> exact(layers.size()), rounded(layers.size());
   for (std::size_t l = 0; l < layers.size(); ++l)
     for (const Vertex& v : in.cores[l].vert) {
       const Point3& p = v.cP();
       exact[l].push_back(p);
-      rounded[l].push_back(roundedToFloat(p));
+      rounded[l].push_back(kHostStoresFloat ? roundedToFloat(p) : p);
     }
   double ownMs = msSince(measureStart);
 
@@ -396,7 +404,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   // moved vertices go back through the inverse matrix; the others keep their
   // stored coordinates bit for bit.
   const auto writeStart = std::chrono::steady_clock::now();
-  std::vector<std::vector<std::pair<int, vcg::Point3f>>> moves(layers.size());
+  std::vector<std::vector<std::pair<int, HostPoint>>> moves(layers.size());
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const CMeshO& cm = layers[l]->cm;
     const bool identity = cm.Tr == Matrix44m::Identity();
@@ -405,8 +413,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
     for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
       const Point3& p = in.cores[l].vert[v].cP();
       if (p == rounded[l][v]) continue;
-      moves[l].emplace_back(vo[v].vertex,
-                            vcg::Point3f::Construct(identity ? p : Point3(inverse * p)));
+      moves[l].emplace_back(vo[v].vertex, HostPoint::Construct(identity ? p : Point3(inverse * p)));
     }
   }
 
@@ -478,7 +485,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
                           .set("violating_pairs_after", r.violating_pairs_after)
                           .set("max_displacement", r.max_displacement));
   }
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The only change to the document, made last: positions of moved vertices.
   for (std::size_t l = 0; l < layers.size(); ++l) {
