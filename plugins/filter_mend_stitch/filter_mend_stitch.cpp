@@ -156,8 +156,7 @@ void selectOnly(CMeshO& cm, const std::vector<int>& faces) {
 }  // namespace
 
 StitchPlugin::StitchPlugin() {
-  typeList << TRIM_ALONG_LOOP << STITCH_BOUNDARIES << CLOSE_GAPS;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {TRIM_ALONG_LOOP, STITCH_BOUNDARIES, CLOSE_GAPS});
 }
 
 QString StitchPlugin::filterName(FilterIDType id) const {
@@ -168,6 +167,17 @@ QString StitchPlugin::filterName(FilterIDType id) const {
       return "MeshMend: Stitch Boundaries";
     default:
       return "MeshMend: Close Gaps Between Borders";
+  }
+}
+
+QString StitchPlugin::pythonFilterName(FilterIDType filter) const {
+  switch (filter) {
+    case TRIM_ALONG_LOOP:
+      return "meshmend_trim_along_vertex_loop";
+    case STITCH_BOUNDARIES:
+      return "meshmend_stitch_boundaries";
+    default:
+      return "meshmend_close_gaps";
   }
 }
 
@@ -226,7 +236,7 @@ QString StitchPlugin::filterInfo(FilterIDType id) const {
          paper;
 }
 
-void StitchPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& parameters) {
+void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   const QString report =
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
       "border_edges_before, border_edges_after, faces_added, vertices_merged, time_ms, ...).";
@@ -275,10 +285,12 @@ void StitchPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterL
         "second (or one run of selected border vertices on each). Several paths in sequence: "
         "'paths' (or every run of selected border vertices) stitched pairwise as "
         "'stitch_pairs' says, leftover paths concatenated at junctions."));
-    parameters.addParam(RichMesh("first_layer", current, &md, "First layer",
-                                 "First layer of the 'one path on each of two layers' mode."));
-    parameters.addParam(RichMesh("second_layer", other, &md, "Second layer",
-                                 "Second layer of the 'one path on each of two layers' mode."));
+    parameters.addParam(
+        layerParameter("first_layer", current, md, "First layer",
+                       "First layer of the 'one path on each of two layers' mode."));
+    parameters.addParam(
+        layerParameter("second_layer", other, md, "Second layer",
+                       "Second layer of the 'one path on each of two layers' mode."));
     parameters.addParam(RichString(
         "path_a", "", "Path A (vertex indices)",
         "Border vertex indices in order along the border, separated by spaces; repeat the "
@@ -354,20 +366,18 @@ void StitchPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterL
   parameters.addParam(RichString("report_file", "", "Report file (JSON)", report));
 }
 
-bool StitchPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& parameters,
-                               vcg::CallBackPos* cb) {
-  return guarded(*this, errorMessage, [&] {
-    switch (ID(a)) {
-      case TRIM_ALONG_LOOP:
-        trim(md, parameters, cb);
-        break;
-      case STITCH_BOUNDARIES:
-        stitch(md, parameters, cb);
-        break;
-      default:
-        closeGaps(md, parameters, cb);
-    }
-  });
+void StitchPlugin::apply(QAction* a, MeshDocument& md, const RichParameterList& parameters,
+                         vcg::CallBackPos* cb) {
+  switch (ID(a)) {
+    case TRIM_ALONG_LOOP:
+      trim(md, parameters, cb);
+      break;
+    case STITCH_BOUNDARIES:
+      stitch(md, parameters, cb);
+      break;
+    default:
+      closeGaps(md, parameters, cb);
+  }
 }
 
 // ------------------------------------------------------------------ trim
@@ -459,7 +469,7 @@ void StitchPlugin::trim(MeshDocument& md, const RichParameterList& parameters,
 
   JsonObject report = toJson(r);
   report.set("layer", toStd(model->label())).set("loop_from", source);
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The only changes to the document, made last.
   const std::vector<LayerAttributes> attributes{snapshot(*model)};
@@ -498,8 +508,8 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
   std::vector<MeshModel*> layers;
   std::unique_ptr<Mesh> core;  // a Mesh cannot move: built in place
   if (mode == kOnePathPerLayer) {
-    MeshModel* first = parameters.getMesh("first_layer");
-    MeshModel* second = parameters.getMesh("second_layer");
+    MeshModel* first = layerFrom(parameters, md, "first_layer");
+    MeshModel* second = layerFrom(parameters, md, "second_layer");
     if (!first || !second) throw InvalidInputError("choose the two layers to stitch");
     if (first == second)
       throw InvalidInputError("the same layer (" + layerName(*first) +
@@ -620,7 +630,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
   report.set("layers", names);
   if (layers.size() == 2)
     report.set("output", output == kIntoFirstLayer ? "first layer" : "new layer");
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   // The only changes to the document, made last.
   std::vector<LayerAttributes> attributes;
@@ -630,7 +640,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
     if (output == kIntoFirstLayer) {
       writeMesh(*core, attributes, current);
       current.cm.Tr.SetIdentity();  // the geometry is in the common frame now
-      md.delMesh(layers[1]);
+      deleteLayer(md, layers[1]);
       md.setCurrent(&current);
       Log("  the result is in %s; the second layer was merged into it and removed",
           layerName(current).c_str());
@@ -638,7 +648,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
       target = md.addNewMesh("", "stitched", true);
       writeMesh(*core, attributes, *target);
       target->cm.Tr.SetIdentity();
-      for (MeshModel* m : layers) m->visible = false;
+      for (MeshModel* m : layers) setLayerVisible(*m, false);
       Log("  the result is the new layer 'stitched'; the inputs are hidden, unchanged");
     }
   } else {
@@ -669,7 +679,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   std::unique_ptr<Mesh> core = std::make_unique<Mesh>();
   reportProgress(options.progress, 0, "MeshMend: reading the layers");
   if (allVisible) {
-    for (MeshModel* m : md.meshList)
+    for (MeshModel* m : layersOf(md))
       if (m->isVisible() && m->cm.fn > 0) layers.push_back(m);
     if (layers.empty()) throw InvalidInputError("no visible layer has faces");
     toCore(layers[0]->cm, *core, {0, true});
@@ -699,7 +709,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names);
-  writeReport(parameters.getString("report_file"), report);
+  publishReport(parameters, report);
 
   Log("MeshMend: closed gaps in %s: border edges %zu -> %zu after merging (%zu vertices, %zu "
       "edge pairs merged, %zu refused) -> %zu after stitching %zu of %zu facing pairs (%zu "
@@ -728,7 +738,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
     target = md.addNewMesh("", "gaps closed", true);
     writeMesh(*core, attributes, *target);
     target->cm.Tr.SetIdentity();
-    for (MeshModel* m : layers) m->visible = false;
+    for (MeshModel* m : layers) setLayerVisible(*m, false);
   } else {
     writeMesh(*core, attributes, *target);
   }

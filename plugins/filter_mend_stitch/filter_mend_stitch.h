@@ -3,12 +3,12 @@
 // Borders".
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class StitchPlugin : public QObject, public MeshFilterInterface {
+class StitchPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { TRIM_ALONG_LOOP, STITCH_BOUNDARIES, CLOSE_GAPS };
@@ -16,19 +16,19 @@ class StitchPlugin : public QObject, public MeshFilterInterface {
   StitchPlugin();
   QString pluginName() const override { return "MeshMendStitch"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction* a) override {
-    return ID(a) == STITCH_BOUNDARIES ? MeshFilterInterface::Remeshing
-                                      : MeshFilterInterface::Cleaning;
+  FilterClass filterClass(QAction* a) const override {
+    return ID(a) == STITCH_BOUNDARIES ? Remeshing : Cleaning;
   }
-  FILTER_ARITY filterArity(QAction* a) const override {
+  Arity arity(QAction* a) const override {
     return ID(a) == TRIM_ALONG_LOOP ? SINGLE_MESH : VARIABLE;
   }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction*) const override { return MeshModel::MM_ALL; }
-  void initParameterSet(QAction*, MeshDocument& md, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction*) const override { return MeshModel::MM_ALL; }
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 
  private:
   void trim(MeshDocument& md, const RichParameterList& parameters, vcg::CallBackPos* cb);
