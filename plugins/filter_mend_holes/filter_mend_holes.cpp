@@ -1,5 +1,7 @@
 #include "filter_mend_holes.h"
 
+#include <algorithm>
+
 #include "common/holes.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
@@ -31,10 +33,12 @@ QString HolesPlugin::filterInfo(FilterIDType) const {
   return "Fills the holes of a mesh with patches that follow the shape around them (Xu, Li and "
          "Tan, feature based hole filling). Each hole's long border edges are split first; the "
          "hole is covered by an advancing front whose triangles take the size of the border "
-         "edges around them; the patch vertices are then placed by a Poisson solve whose target "
-         "Laplacians are learned (LS-SVM regression) from the rings of vertices around the hole, "
-         "so curvature and features continue into the patch. Simpler shapes (biharmonic: "
-         "smoothest, tangent to the surface; harmonic: a membrane; flat) are options.<br>"
+         "edges around them (over the hole's plane, or a disk where the plane would squeeze "
+         "it); the patch vertices are then placed by a least-squares Poisson solve, by default "
+         "the biharmonic one (smoothest, tangent to the surface: on the project's fidelity "
+         "benchmark the closest to the removed surface). The paper's shape, whose target "
+         "Laplacians are learned (LS-SVM regression) from the rings of vertices around the "
+         "hole, a membrane (harmonic) and the flat patch are options.<br>"
          "Every patch is checked exactly against itself and the surface around it; one that "
          "would intersect falls back to a flatter shape, or is left out with a reason in the "
          "log. Holes at a non-manifold border vertex are split there. Existing vertices and "
@@ -54,15 +58,18 @@ void HolesPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& par
       "selected_only", false, "Only holes touching the selection",
       "Fills only the holes with at least one selected border vertex (select them, e.g. with "
       "Filters > Selection > Select Border, then deselect what to keep open)."));
+  const int defaultFairing =
+      int(std::find(std::begin(kFairings), std::end(kFairings), defaults.fairing) -
+          std::begin(kFairings));
   parameters.addParam(RichEnum(
-      "fairing", 0,
+      "fairing", defaultFairing,
       QStringList() << "Feature preserving (learned Laplacians)"
                     << "Biharmonic (smoothest)"
                     << "Harmonic (membrane)"
                     << "Flat (no fairing)",
       "Patch shape",
       "Feature preserving: the paper's Poisson solve with Laplacians predicted from the rings "
-      "around the hole (follows curvature and features). Biharmonic: minimal curvature, "
+      "around the hole (continues their curvature). Biharmonic (default): minimal curvature, "
       "tangent to the surface. Harmonic: a membrane spanning the border. Flat: the "
       "triangulation as the front built it."));
   parameters.addParam(RichInt(
