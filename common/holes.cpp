@@ -19,6 +19,7 @@
 #include "common/box_tree.h"
 #include "common/errors.h"
 #include "common/intersections.h"
+#include "common/parallel.h"
 #include "common/predicates.h"
 #include "common/triangle_intersection.h"
 
@@ -78,6 +79,11 @@ class VertexFaces {
       for (int v : triangles[f]) faces_[fill[v]++] = int(f);
   }
 
+  // The faces of the table at v, as built (before any add or change).
+  std::pair<const int*, const int*> initial(int v) const {
+    return {faces_.data() + start_[v], faces_.data() + start_[v + 1]};
+  }
+
   // Face f is new, or has v as a new corner.
   void add(int v, int f) { extra_[v].push_back(f); }
 
@@ -122,6 +128,7 @@ class VertexFaces {
 
 struct BorderLoop {
   std::vector<int> vertices;  // mesh direction: a face runs vertices[i] -> vertices[i+1]
+  std::vector<int> faces;     // faces[i]: the face of border edge vertices[i] -> vertices[i+1]
   bool closed = true;
   int brokenAt = -1;  // open loops: a vertex where the border cannot be followed
 };
@@ -137,6 +144,13 @@ struct BorderLoops {
 
 Point3 faceNormal(const std::vector<Point3>& P, const Triangle& t) {
   return (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
+}
+
+// Two unit vectors u, v with (u, v, n) right-handed and orthonormal, for a unit n.
+std::pair<Point3, Point3> tangentFrame(const Point3& n) {
+  Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
+  u.Normalize();
+  return {u, n ^ u};
 }
 
 // At a boundary vertex with several fans of faces (a bow-tie), decides which
@@ -186,9 +200,7 @@ bool pairAtPinch(int v, const std::vector<Point3>& P, const std::vector<Triangle
   for (int f : faces) n += faceNormal(P, T[f]);
   if (n.Norm() == 0) n = Point3(0, 0, 1);
   n.Normalize();
-  Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
-  u.Normalize();
-  const Point3 w = n ^ u;
+  const auto [u, w] = tangentFrame(n);
   auto angle = [&](int other) {
     const Point3 d = P[other] - P[v];
     return std::atan2(d * w, d * u);
@@ -209,42 +221,65 @@ bool pairAtPinch(int v, const std::vector<Point3>& P, const std::vector<Triangle
 }
 
 // A closed walk that passes a vertex twice is cut there into simple loops.
-std::vector<std::vector<int>> simpleLoops(const std::vector<int>& walk) {
-  std::vector<std::vector<int>> out;
-  std::vector<int> stack;
+std::vector<BorderLoop> simpleLoops(const BorderLoop& walk) {
+  std::vector<BorderLoop> out;
+  BorderLoop stack;
   std::unordered_map<int, std::size_t> at;
-  for (int v : walk) {
+  for (std::size_t i = 0; i < walk.vertices.size(); ++i) {
+    const int v = walk.vertices[i];
     const auto it = at.find(v);
     if (it != at.end()) {
       const std::size_t k = it->second;
-      out.emplace_back(stack.begin() + std::ptrdiff_t(k), stack.end());
-      for (std::size_t j = k + 1; j < stack.size(); ++j) at.erase(stack[j]);
-      stack.resize(k + 1);
+      BorderLoop part;
+      part.vertices.assign(stack.vertices.begin() + std::ptrdiff_t(k), stack.vertices.end());
+      part.faces.assign(stack.faces.begin() + std::ptrdiff_t(k), stack.faces.end());
+      out.push_back(std::move(part));
+      for (std::size_t j = k + 1; j < stack.vertices.size(); ++j) at.erase(stack.vertices[j]);
+      stack.vertices.resize(k + 1);
+      stack.faces.resize(k + 1);
+      stack.faces[k] = walk.faces[i];  // the walk goes on from v along this edge
       continue;
     }
-    at[v] = stack.size();
-    stack.push_back(v);
+    at[v] = stack.vertices.size();
+    stack.vertices.push_back(v);
+    stack.faces.push_back(walk.faces[i]);
   }
-  out.push_back(stack);
+  out.push_back(std::move(stack));
   return out;
 }
 
 BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Triangle>& T,
                             const VertexFaces& adjacency) {
   BorderLoops result;
-  std::vector<BorderEdge> edges;
-  {
-    const std::vector<EdgeUse> uses = edgeUses(T);
-    for (std::size_t i = 0; i < uses.size();) {
-      std::size_t j = i + 1;
-      while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-      if (j - i == 1) {
-        const Triangle& t = T[uses[i].face];
-        edges.push_back({t[uses[i].corner], t[(uses[i].corner + 1) % 3], uses[i].face});
+  // An edge used by one face only: at its start vertex v, its end is the
+  // next corner of that face and no other face at v has it as a corner.
+  // Per vertex, over its own faces (a fan of a few): linear in the mesh,
+  // no sorting, in parallel.
+  std::vector<std::vector<BorderEdge>> found(workerCount());
+  parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    std::vector<int> next, previous;
+    for (std::size_t v = begin; v < end; ++v) {
+      const auto [first, last] = adjacency.initial(int(v));
+      const std::size_t count = std::size_t(last - first);
+      next.resize(count);
+      previous.resize(count);
+      for (std::size_t i = 0; i < count; ++i) {
+        const Triangle& t = T[first[i]];
+        const int k = t[0] == int(v) ? 0 : t[1] == int(v) ? 1 : 2;
+        next[i] = t[k == 2 ? 0 : k + 1];
+        previous[i] = t[k == 0 ? 2 : k - 1];
       }
-      i = j;
+      for (std::size_t i = 0; i < count; ++i) {
+        const int b = next[i];
+        // Inside a consistently oriented surface the twin face has b before v.
+        bool once = std::find(previous.begin(), previous.end(), b) == previous.end();
+        for (std::size_t j = 0; once && j < count; ++j) once = j == i || next[j] != b;
+        if (once) found[worker].push_back({int(v), b, first[i]});
+      }
     }
-  }
+  });
+  std::vector<BorderEdge> edges;
+  for (const auto& part : found) edges.insert(edges.end(), part.begin(), part.end());
   if (edges.empty()) return result;
   std::unordered_map<int, std::vector<int>> outOf, inTo;
   for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -292,6 +327,7 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
     while (true) {
       visited[e] = 1;
       loop.vertices.push_back(edges[e].from);
+      loop.faces.push_back(edges[e].face);
       const int n = next[e];
       if (n == start) break;
       if (n < 0 || visited[n]) {
@@ -306,11 +342,7 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
       result.loops.push_back(std::move(loop));
       continue;
     }
-    for (std::vector<int>& part : simpleLoops(loop.vertices)) {
-      BorderLoop simple;
-      simple.vertices = std::move(part);
-      result.loops.push_back(std::move(simple));
-    }
+    for (BorderLoop& part : simpleLoops(loop)) result.loops.push_back(std::move(part));
   }
   return result;
 }
@@ -937,9 +969,7 @@ struct Domain {
 
 bool projectOnPlane(const std::vector<Point3>& pts, Point3 origin, Point3 normal, Domain& d) {
   normal.Normalize();
-  Point3 u = std::abs(normal[0]) < 0.9 ? Point3(1, 0, 0) ^ normal : Point3(0, 1, 0) ^ normal;
-  u.Normalize();
-  Point3 v = normal ^ u;
+  auto [u, v] = tangentFrame(normal);
   d.uv.clear();
   d.height.clear();
   for (const Point3& p : pts) {
@@ -1013,9 +1043,7 @@ std::vector<Domain> domainsOf(const std::vector<Point3>& pts, const Point3& mean
   for (const Point3& axis : {area, meanFaceNormal, fitted}) {
     if (!(axis.Norm() > 0)) continue;
     const Point3 n = axis / axis.Norm();
-    Point3 u = std::abs(n[0]) < 0.9 ? Point3(1, 0, 0) ^ n : Point3(0, 1, 0) ^ n;
-    u.Normalize();
-    const Point3 v = n ^ u;
+    const auto [u, v] = tangentFrame(n);
     for (double tilt : {15.0, 30.0, 45.0, 60.0})
       for (int k = 0; k < 8; ++k) {
         const double t = tilt * M_PI / 180, a = k * M_PI / 4;
@@ -1028,6 +1056,7 @@ std::vector<Domain> domainsOf(const std::vector<Point3>& pts, const Point3& mean
 
 // ---- Cotangent Laplacian rows --------------------------------------------------
 
+// Cotangents of the angles at a, b and c (0 for a degenerate triangle).
 std::array<double, 3> cotangents(const Point3& a, const Point3& b, const Point3& c) {
   auto cot = [](const Point3& u, const Point3& v) {
     const double s = (u ^ v).Norm();
@@ -1036,9 +1065,13 @@ std::array<double, 3> cotangents(const Point3& a, const Point3& b, const Point3&
   return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
 }
 
-// Edge weights below this are raised to it: obtuse triangles give negative
-// cotangent sums, which would make the systems indefinite.
-constexpr double kMinimumWeight = 0.05;
+// The membrane (harmonic) system raises edge weights below this to it:
+// obtuse triangles give negative cotangent sums, which would make its
+// matrix indefinite. The least-squares systems (biharmonic, regression)
+// are positive semi-definite whatever the signs and keep the true weights:
+// raising them would bend a flat fan whose triangles are slivers (CAD
+// meshes), where the true weights give it a zero Laplacian.
+constexpr double kMembraneMinimumWeight = 0.05;
 
 // One vertex's Laplacian: neighbours (keys) with cotangent weights w_ij (Eq. 2-3).
 struct LaplacianRow {
@@ -1054,9 +1087,10 @@ struct LaplacianRow {
       }
     weights.push_back({key, omega});
   }
-  void finish() {
+  // Sums the weights, raising those below `floor` to it first.
+  void finish(double floor = -INFINITY) {
     total = 0;
-    for (auto& [k, w] : weights) total += (w = std::max(w, kMinimumWeight));
+    for (auto& [k, w] : weights) total += (w = std::max(w, floor));
   }
 };
 
@@ -1291,147 +1325,100 @@ std::size_t splitLongEdges(Surface& s, std::vector<int>& loop, double factor, Ch
 
 // ---- Exact check of a patch ----------------------------------------------------------
 
-// Exact, sufficient for "the faces meet at most in corners they share":
-// in the projection dropping `axis`, a line through an edge of one face
-// (which projects one-to-one) has the other face strictly on its far side,
-// but for shared corners on the line. Coplanar neighbours, where the
-// plane-side tests below cannot decide, are settled here with 2-D tests.
-bool separatedInProjection(const Triangle& a, const TrianglePoints& pa, const Triangle& b,
-                           const TrianglePoints& pb, int axis) {
-  for (int pass = 0; pass < 2; ++pass) {
-    const Triangle& t = pass == 0 ? a : b;
-    const TrianglePoints& p = pass == 0 ? pa : pb;
-    const Triangle& other = pass == 0 ? b : a;
-    const TrianglePoints& q = pass == 0 ? pb : pa;
-    if (orient2dDropping(p[0], p[1], p[2], axis) == 0) continue;
-    for (int e = 0; e < 3; ++e) {
-      const int u = e, w = (e + 1) % 3, o = (e + 2) % 3;
-      const int inside = orient2dDropping(p[u], p[w], p[o], axis);
-      bool separated = true;
-      for (int k = 0; k < 3 && separated; ++k) {
-        if (other[k] == t[u] || other[k] == t[w]) continue;
-        separated = orient2dDropping(p[u], p[w], q[k], axis) == -inside;
-      }
-      if (separated) return true;
-    }
-  }
-  return false;
-}
-
-// The self-intersection rule for two faces of one mesh (vertex identity =
-// index; see triangle_intersection.h), with cheap exact plane-side tests
-// first: they settle almost every pair of neighbours.
-bool facesIntersect(const Triangle& a, const TrianglePoints& pa, const Triangle& b,
-                    const TrianglePoints& pb) {
-  const SharedCorners c = sharedCorners(a, b);
-  if (c.count < 3) {
-    const Point3 n = (pa[1] - pa[0]) ^ (pa[2] - pa[0]);
-    const int axis = std::abs(n[0]) >= std::abs(n[1]) && std::abs(n[0]) >= std::abs(n[2]) ? 0
-                     : std::abs(n[1]) >= std::abs(n[2])                                   ? 1
-                                                                                          : 2;
-    if (separatedInProjection(a, pa, b, pb, axis)) return false;
-  }
-  auto side = [](const TrianglePoints& t, const Point3& p) {
-    return orient3d(t[0], t[1], t[2], p);
-  };
-  auto beside = [&](const TrianglePoints& t, const TrianglePoints& u) {
-    const int s0 = side(t, u[0]);
-    return s0 != 0 && side(t, u[1]) == s0 && side(t, u[2]) == s0;
-  };
-  auto edgeMayMeet = [&](const TrianglePoints& t, int corner, const TrianglePoints& u) {
-    return side(u, t[(corner + 1) % 3]) * side(u, t[(corner + 2) % 3]) <= 0;
-  };
-  switch (c.count) {
-    case 0:
-      if (beside(pa, pb) || beside(pb, pa)) return false;
-      break;
-    case 1:  // the edge opposite the shared corner, in either face, must meet the other
-      if (!edgeMayMeet(pa, c.ia, pb) && !edgeMayMeet(pb, c.ib, pa)) return false;
-      break;
-    case 2:  // only coplanar faces folded onto each other meet beyond their edge
-      if (side(pa, pb[c.ib]) != 0) return false;
-      break;
-    default:
-      return true;
-  }
-  return intersectBeyondShared(pa, pb, c.count, c.ia, c.ib);
-}
-
 // Counts the pairs of faces that intersect (the self-intersection rule,
-// vertex identity = index) that involve the patch or `own` (the faces the
-// hole's pre-treatment split, already in the surface), among themselves or
-// with the rest of the surface. The patch's new vertices are numbered from
-// s.points.size() on, at `added`. A patch face without area counts as a pair.
+// vertex identity = index; facesIntersect of intersections.h) that involve
+// the patch or `own` (the faces the hole's pre-treatment split, already in
+// the surface), among themselves or with the rest of the surface. The
+// patch's new vertices are numbered from s.points.size() on: they are
+// positions[firstNew...]. The patch is appended to the surface for the
+// check and taken out again. A patch face without area counts as a pair.
 std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
-                               const std::vector<Point3>& added, const std::vector<int>& own) {
-  const std::size_t base = s.points.size();
-  auto at = [&](int v) -> const Point3& {
-    return std::size_t(v) < base ? s.points[v] : added[std::size_t(v) - base];
-  };
-  auto pointsOf = [&](const Triangle& t) { return TrianglePoints{at(t[0]), at(t[1]), at(t[2])}; };
-  auto degenerate = [&](const Triangle& t) { return collinear(at(t[0]), at(t[1]), at(t[2])); };
-  std::vector<Triangle> checked;
+                               const std::vector<Point3>& positions, std::size_t firstNew,
+                               const std::vector<int>& own) {
+  const std::size_t points = s.points.size(), faces = s.triangles.size();
+  s.points.insert(s.points.end(), positions.begin() + std::ptrdiff_t(firstNew), positions.end());
+  s.triangles.insert(s.triangles.end(), patch.begin(), patch.end());
+  struct Undo {
+    Surface& s;
+    std::size_t points, faces;
+    ~Undo() {
+      s.points.resize(points);
+      s.triangles.resize(faces);
+    }
+  } undo{s, points, faces};
+  const std::vector<Point3>& P = s.points;
+  const std::vector<Triangle>& T = s.triangles;
+  auto degenerate = [&](int f) { return collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]); };
+  auto boxOfFace = [&](int f) { return boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]); };
+  std::vector<int> checked;  // patch faces, then the split ones
   checked.reserve(patch.size() + own.size());
-  for (const Triangle& t : patch) {
-    if (degenerate(t)) return 1;
-    checked.push_back(t);
+  for (std::size_t f = faces; f < T.size(); ++f) {
+    if (degenerate(int(f))) return 1;
+    checked.push_back(int(f));
   }
   std::unordered_set<int> ownSet;
   for (int f : own)
-    if (ownSet.insert(f).second && !degenerate(s.triangles[f])) checked.push_back(s.triangles[f]);
+    if (ownSet.insert(f).second && !degenerate(f)) checked.push_back(f);
   std::vector<Box> boxes;
   boxes.reserve(checked.size());
   Box bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-  for (const Triangle& t : checked) {
-    boxes.push_back(boxOf(at(t[0]), at(t[1]), at(t[2])));
+  for (int f : checked) {
+    boxes.push_back(boxOfFace(f));
     for (int k = 0; k < 3; ++k) {
       bounds.lo[k] = std::min(bounds.lo[k], boxes.back().lo[k]);
       bounds.hi[k] = std::max(bounds.hi[k], boxes.back().hi[k]);
     }
   }
-  auto intersect = [&](const Triangle& a, const Triangle& b) {
-    return facesIntersect(a, pointsOf(a), b, pointsOf(b));
+  auto intersect = [&](int f, int g) {
+    return facesIntersect(P, T, std::uint32_t(f), std::uint32_t(g));
   };
   const BoxTree tree(boxes);
   std::atomic<std::size_t> pairs{0};
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
     if (intersect(checked[i], checked[j])) ++pairs;
   });
+  // Boxes of the input faces as they came (a split face's halves lie
+  // within it, the later half being checked below), made once.
   if (s.inputBoxes.size() != s.inputFaces) {
     s.inputBoxes.resize(s.inputFaces);
-    for (std::size_t f = 0; f < s.inputFaces; ++f) {
-      const Triangle t = s.originalCorners(int(f));
-      s.inputBoxes[f] = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
-    }
+    parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const Triangle t = s.inputCorners.empty() ? T[f] : s.originalCorners(int(f));
+        s.inputBoxes[f] = boxOf(P[t[0]], P[t[1]], P[t[2]]);
+      }
+    });
   }
   // A few holes scan the input faces' boxes; many pay for a hierarchy once.
   if (!s.inputTree && ++s.checks > 8) s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
-  auto other = [&](int f) {  // a non-degenerate face of the rest of the surface
-    if (ownSet.count(f)) return false;
-    const Triangle& t = s.triangles[f];
-    return !collinear(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
-  };
-  // Input faces (the boxes of split ones still hold their halves), then later faces.
+  // The rest of the surface: faces before the patch that are not split ones
+  // (facesIntersect skips degenerate faces).
+  auto other = [&](std::size_t f) { return !ownSet.count(int(f)); };
+  // Input faces, then later faces.
   if (s.inputTree) {
-    for (std::size_t i = 0; i < checked.size(); ++i)
-      s.inputTree->query(boxes[i], 0, [&](std::uint32_t f, unsigned) {
-        if (other(int(f)) && intersect(checked[i], s.triangles[f])) ++pairs;
-      });
+    parallelChunks(
+        checked.size(),
+        [&](std::size_t begin, std::size_t end, unsigned worker) {
+          for (std::size_t i = begin; i < end; ++i)
+            s.inputTree->query(boxes[i], worker, [&](std::uint32_t f, unsigned) {
+              if (other(f) && intersect(checked[i], int(f))) ++pairs;
+            });
+        },
+        64);
   } else {
-    for (std::size_t f = 0; f < s.inputFaces; ++f) {
-      if (!overlap(s.inputBoxes[f], bounds) || !other(int(f))) continue;
-      const Triangle& t = s.triangles[f];
-      tree.query(s.inputBoxes[f], 0, [&](std::uint32_t i, unsigned) {
-        if (intersect(checked[i], t)) ++pairs;
-      });
-    }
+    parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
+      for (std::size_t f = begin; f < end; ++f) {
+        if (!overlap(s.inputBoxes[f], bounds) || !other(f)) continue;
+        tree.query(s.inputBoxes[f], worker, [&](std::uint32_t i, unsigned) {
+          if (intersect(checked[i], int(f))) ++pairs;
+        });
+      }
+    });
   }
-  for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f) {
-    const Triangle& t = s.triangles[f];
-    const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
-    if (!overlap(box, bounds) || !other(int(f))) continue;
+  for (std::size_t f = s.inputFaces; f < faces; ++f) {
+    const Box box = boxOfFace(int(f));
+    if (!overlap(box, bounds) || !other(f)) continue;
     tree.query(box, 0, [&](std::uint32_t i, unsigned) {
-      if (intersect(checked[i], t)) ++pairs;
+      if (intersect(checked[i], int(f))) ++pairs;
     });
   }
   return pairs;
@@ -1474,31 +1461,122 @@ class HoleFiller {
       return false;
     }
 
+    std::vector<HoleFairing> modes;
+    for (HoleFairing m :
+         {options_.fairing, HoleFairing::Biharmonic, HoleFairing::Harmonic, HoleFairing::Flat})
+      if (int(m) <= int(options_.fairing) &&
+          std::find(modes.begin(), modes.end(), m) == modes.end())
+        modes.push_back(m);
+    // Each domain's patch, shaped in the first mode. The plane's is kept
+    // when its triangles come out round in space; where the plane squeezes
+    // part of the hole (the surface turns away from it), the disk's patch
+    // competes and the rounder of the two is tried first.
     std::string problems;
-    for (const Domain& domain : domainsOf(boundary, faceNormals))
-      if (fillOver(domain, splitFaces, report, problems)) return true;
-    report.reason = problems;
+    std::vector<Candidate> candidates;
+    for (const Domain& domain : domainsOf(boundary, faceNormals)) {
+      Candidate c;
+      c.domain = domain;
+      report.reason.clear();
+      if (!prepare(domain, report, c.flat)) {
+        problems += (problems.empty() ? "" : "; ") + where(domain) + report.reason;
+        continue;
+      }
+      c.first.positions = c.flat;
+      c.first.fairing = modes[0];
+      const auto clock = Clock::now();
+      c.firstShaped = modes[0] == HoleFairing::Flat || fair(modes[0], c.first, report);
+      times_.fair += msSince(clock);
+      c.quality = c.firstShaped ? meanShapeQuality(c.first.positions) : -1;
+      c.trainingSamples = report.training_samples;
+      c.firstNote = report.reason;
+      swapState(c.state);
+      candidates.push_back(std::move(c));
+      if (domain.planar && candidates.back().quality >= kRoundPatchQuality) break;
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.quality > b.quality; });
+    // A smoother shape over either domain before a flatter one.
+    std::string failed;
+    for (HoleFairing mode : modes)
+      for (Candidate& c : candidates) {
+        swapState(c.state);
+        const bool filled = fillAs(mode, modes[0], c, splitFaces, report, failed);
+        swapState(c.state);
+        if (!filled) continue;
+        if (!problems.empty()) failed = problems + (failed.empty() ? "" : "; ") + failed;
+        if (mode != options_.fairing || !problems.empty())
+          report.reason = "fell back: " + failed;
+        else if (report.fairing != mode)
+          report.reason = "fell back to biharmonic: " + report.reason;
+        else
+          report.reason.clear();
+        return true;
+      }
+    report.reason = problems + (problems.empty() || failed.empty() ? "" : "; ") + failed;
     return false;
   }
 
  private:
-  // One attempt over `domain`; what went wrong is added to `problems`.
-  bool fillOver(const Domain& domain, const std::vector<int>& splitFaces, HoleReport& report,
-                std::string& problems) {
-    auto note = [&](const std::string& what) {
-      problems += (problems.empty() ? "" : "; ") +
-                  std::string(domain.planar ? "over its plane: " : "over a disk: ") + what;
-    };
-    report.planar_domain = domain.planar;
-    report.reason.clear();
+  // A patch of at least this mean shape quality (1 = equilateral triangles)
+  // over the hole's plane is used without trying the disk.
+  static constexpr double kRoundPatchQuality = 0.85;
+
+  // The triangulated patch over one domain (what prepare() leaves in the members).
+  struct PatchState {
+    std::vector<Vec2> uv;
+    std::vector<double> height;
+    std::vector<Triangle> localTriangles, patchTriangles;
+    std::vector<std::vector<int>> localAround;
+    std::vector<int> rowVertex;
+    std::vector<LaplacianRow> outsideRows;
+    std::vector<char> hasOutsideRow;
+  };
+  struct Candidate {
+    Domain domain;
+    PatchState state;
+    std::vector<Point3> flat;
+    PatchShape first;  // shaped in the first mode
+    bool firstShaped = false;
+    double quality = -1;
+    std::size_t trainingSamples = 0;
+    std::string firstNote;  // what shaping in the first mode reported
+  };
+
+  void swapState(PatchState& p) {
+    uv_.swap(p.uv);
+    height_.swap(p.height);
+    localTriangles_.swap(p.localTriangles);
+    patchTriangles_.swap(p.patchTriangles);
+    localAround_.swap(p.localAround);
+    rowVertex_.swap(p.rowVertex);
+    outsideRows_.swap(p.outsideRows);
+    hasOutsideRow_.swap(p.hasOutsideRow);
+  }
+
+  static std::string where(const Domain& domain) {
+    return domain.planar ? "over its plane: " : "over a disk: ";
+  }
+
+  // Mean over the patch's triangles of 4 sqrt(3) area / (sum of squared
+  // edge lengths): 1 for equilateral ones, 0 for slivers.
+  double meanShapeQuality(const std::vector<Point3>& x) const {
+    if (localTriangles_.empty()) return 0;
+    double sum = 0;
+    for (const Triangle& t : localTriangles_) {
+      const Point3 &a = x[t[0]], &b = x[t[1]], &c = x[t[2]];
+      const double squares = (b - a).SquaredNorm() + (c - b).SquaredNorm() + (a - c).SquaredNorm();
+      if (squares > 0) sum += 2 * std::sqrt(3.0) * ((b - a) ^ (c - a)).Norm() / squares;
+    }
+    return sum / double(localTriangles_.size());
+  }
+
+  // Triangulates the hole over `domain` into the members; `flat` gets the
+  // flat placement. False (reason in the report) when it cannot.
+  bool prepare(const Domain& domain, HoleReport& report, std::vector<Point3>& flat) {
     auto clock = Clock::now();
     const bool covered = triangulate(domain, report);
     times_.triangulate += msSince(clock);
-    if (!covered) {
-      note(report.reason);
-      return false;
-    }
-
+    if (!covered) return false;
     // Patch faces in mesh numbering; new vertices follow the surface's.
     const std::size_t base = s_.points.size();
     patchTriangles_.clear();
@@ -1508,50 +1586,51 @@ class HoleFiller {
         g[k] = std::size_t(t[k]) < n_ ? front_[t[k]] : int(base + std::size_t(t[k]) - n_);
       patchTriangles_.push_back(g);
     }
-
     buildRows();
-    const std::vector<Point3> flat = flatPositions(domain);
-    std::vector<HoleFairing> modes;
-    for (HoleFairing m : {HoleFairing::LaplacianRegression, HoleFairing::Biharmonic,
-                          HoleFairing::Harmonic, HoleFairing::Flat})
-      if (int(m) <= int(options_.fairing)) modes.push_back(m);
-    std::string failed;
-    for (HoleFairing mode : modes) {
-      PatchShape shape;
-      shape.positions = flat;
+    clock = Clock::now();
+    const bool placed = flatPositions(domain, flat);
+    times_.fair += msSince(clock);
+    if (!placed) report.reason = "the membrane over the disk could not be solved";
+    return placed;
+  }
+
+  // Shapes the candidate's patch (its state swapped in) in `mode` and
+  // commits it when it passes the exact check; else says why in `failed`.
+  bool fillAs(HoleFairing mode, HoleFairing firstMode, Candidate& c,
+              const std::vector<int>& splitFaces, HoleReport& report, std::string& failed) {
+    auto fail = [&](const std::string& why) {
+      failed += (failed.empty() ? "" : "; ") + where(c.domain) + toString(mode) + why;
+      return false;
+    };
+    PatchShape shape;
+    bool faired = true;
+    if (mode == firstMode) {
+      shape = c.first;
+      faired = c.firstShaped;
+      report.reason = c.firstNote;
+      report.training_samples = c.trainingSamples;
+    } else {
+      shape.positions = c.flat;
       shape.fairing = mode;
-      clock = Clock::now();
-      const bool faired = mode == HoleFairing::Flat || fair(mode, shape, report);
+      const auto clock = Clock::now();
+      faired = mode == HoleFairing::Flat || fair(mode, shape, report);
       times_.fair += msSince(clock);
-      if (!faired) {
-        failed += std::string(failed.empty() ? "" : "; ") + toString(mode) + ": solver failed";
-        continue;
-      }
-      for (std::size_t v = n_; v < shape.positions.size(); ++v)
-        shape.positions[v] = s_.stored(shape.positions[v]);
-      if (options_.check_intersections) {
-        const std::vector<Point3> added(shape.positions.begin() + std::ptrdiff_t(n_),
-                                        shape.positions.end());
-        clock = Clock::now();
-        const std::size_t pairs = patchIntersections(s_, patchTriangles_, added, splitFaces);
-        times_.check += msSince(clock);
-        if (pairs > 0) {
-          failed += std::string(failed.empty() ? "" : "; ") + toString(mode) +
-                    " patch would intersect itself or the mesh (" + std::to_string(pairs) +
-                    " pairs)";
-          continue;
-        }
-      }
-      commit(shape, report);
-      if (!problems.empty()) failed = problems + (failed.empty() ? "" : "; ") + failed;
-      if (mode != options_.fairing || !problems.empty())
-        report.reason = "fell back: " + failed;
-      else if (shape.fairing != mode)
-        report.reason = "fell back to biharmonic: " + report.reason;
-      return true;
     }
-    note("no patch fits: " + failed);
-    return false;
+    if (!faired) return fail(": solver failed");
+    for (std::size_t v = n_; v < shape.positions.size(); ++v)
+      shape.positions[v] = s_.stored(shape.positions[v]);
+    if (options_.check_intersections) {
+      const auto clock = Clock::now();
+      const std::size_t pairs =
+          patchIntersections(s_, patchTriangles_, shape.positions, n_, splitFaces);
+      times_.check += msSince(clock);
+      if (pairs > 0)
+        return fail(" patch would intersect itself or the mesh (" + std::to_string(pairs) +
+                    " pairs)");
+    }
+    report.planar_domain = c.domain.planar;
+    commit(shape, report);
+    return true;
   }
 
   bool triangulate(const Domain& domain, HoleReport& report) {
@@ -1658,7 +1737,9 @@ class HoleFiller {
   }
 
   // The Laplacian row of local vertex v (into `row`, reusing its storage).
-  void rowOf(int v, const std::vector<TriangleWeights>& weights, LaplacianRow& row) const {
+  // Weights below `floor` are raised to it.
+  void rowOf(int v, const std::vector<TriangleWeights>& weights, LaplacianRow& row,
+             double floor = -INFINITY) const {
     row.weights.clear();
     row.area = 0;
     if (std::size_t(v) < n_ && hasOutsideRow_[v]) {
@@ -1672,45 +1753,21 @@ class HoleFiller {
       while (tri[corner] != v) ++corner;
       addTriangleToRow(row, {tri[0], tri[1], tri[2]}, weights[t], corner);
     }
-    row.finish();
+    row.finish(floor);
   }
 
   // Flat: the front's own placement (heights carried inward from the
   // boundary) over the plane, or a uniform membrane over a disk domain.
-  std::vector<Point3> flatPositions(const Domain& domain) const {
-    std::vector<Point3> x(uv_.size());
+  bool flatPositions(const Domain& domain, std::vector<Point3>& x) const {
+    x.assign(uv_.size(), Point3(0, 0, 0));
     for (std::size_t k = 0; k < n_; ++k) x[k] = s_.points[front_[k]];
     if (domain.planar) {
       for (std::size_t v = n_; v < uv_.size(); ++v)
         x[v] = domain.origin + domain.U * uv_[v].x + domain.V * uv_[v].y + domain.N * height_[v];
-      return x;
+      return true;
     }
-    const std::size_t unknowns = uv_.size() - n_;
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
-    for (std::size_t v = n_; v < uv_.size(); ++v) {
-      std::unordered_set<int> neighbours;
-      for (int t : localAround_[v])
-        for (int c : localTriangles_[t])
-          if (std::size_t(c) != v) neighbours.insert(c);
-      const Eigen::Index r = Eigen::Index(v - n_);
-      entries.push_back({int(r), int(r), double(neighbours.size())});
-      for (int c : neighbours) {
-        if (std::size_t(c) >= n_)
-          entries.push_back({int(r), int(std::size_t(c) - n_), -1.0});
-        else
-          for (int d = 0; d < 3; ++d) rhs(r, d) += x[c][d];
-      }
-    }
-    Eigen::SparseMatrix<double> M(static_cast<Eigen::Index>(unknowns),
-                                  static_cast<Eigen::Index>(unknowns));
-    M.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(M);
-    const Eigen::MatrixXd sol = solver.solve(rhs);
-    for (std::size_t v = n_; v < uv_.size(); ++v)
-      x[v] = Point3(sol(Eigen::Index(v - n_), 0), sol(Eigen::Index(v - n_), 1),
-                    sol(Eigen::Index(v - n_), 2));
-    return x;
+    double residual = 0;
+    return membrane(x, MembraneWeights::Uniform, residual);
   }
 
   // Normal (area weighted) and a third of the area of the faces around local vertex v.
@@ -1734,16 +1791,16 @@ class HoleFiller {
     return {twiceArea > 0 ? n / twiceArea : n, area};
   }
 
-  // Least squares over the rows: sum_r |(L x)_r - delta_r|^2 over the new
-  // vertices (unknowns), normal equations factorised once per weight set.
+  // Least squares over the rows: sum_r A_r |(L x)_r - delta_r|^2 over the
+  // new vertices (unknowns), with (L x)_r = (1 / 2 A_r) sum_j omega_rj (x_j -
+  // x_r) the cotangent Laplacian (Eq. 1-3 with Eq. 4's area): the sum
+  // discretises the integral of |Laplacian|^2 whatever the local triangle
+  // size. Normal equations factorised once per weight set.
   struct System {
-    Eigen::SparseMatrix<double> A;  // rows x unknowns (normalised Laplacian rows)
+    Eigen::SparseMatrix<double> A;  // rows x unknowns: sqrt(A_r) x the Laplacian rows
     Eigen::MatrixXd fixedPart;      // rows x 3: the fixed vertices' contribution
-    std::vector<double> rowTotal;   // sum of omega per row
-    // Row r counts with weight sqrt(A_r) x (the cotangent Laplacian's
-    // 1 / (2 A_r) scale), so that the sum of squares discretises the
-    // integral of |Laplacian|^2 whatever the local triangle size.
-    Eigen::VectorXd rowWeight;
+    Eigen::VectorXd rowWeight;      // 1 / (2 sqrt(A_r)): row r of A is omega_rj x this
+    std::vector<double> rowLength;  // sum_j |omega_rj|: turns a row's residual into a length
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
     bool analysed = false, ok = false;
   };
@@ -1753,15 +1810,14 @@ class HoleFiller {
     const std::size_t unknowns = uv_.size() - n_;
     std::vector<Eigen::Triplet<double>> entries;
     sys.fixedPart = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), 3);
-    sys.rowTotal.assign(rows.size(), 0);
+    sys.rowLength.assign(rows.size(), 0);
     sys.rowWeight.resize(Eigen::Index(rows.size()));
     const std::vector<TriangleWeights> weights = patchWeights(x, planarWeights);
     LaplacianRow row;
     for (std::size_t r = 0; r < rows.size(); ++r) {
       const int v = rows[r];
       rowOf(v, weights, row);
-      sys.rowTotal[r] = row.total;
-      const double weight = row.area > 0 ? row.total / (2 * std::sqrt(row.area)) : 1.0;
+      const double weight = row.area > 0 ? 1 / (2 * std::sqrt(row.area)) : 1.0;
       sys.rowWeight[Eigen::Index(r)] = weight;
       auto put = [&](int key, double coefficient) {
         coefficient *= weight;
@@ -1772,8 +1828,11 @@ class HoleFiller {
           for (int d = 0; d < 3; ++d) sys.fixedPart(Eigen::Index(r), d) += coefficient * p[d];
         }
       };
-      put(v, -1);
-      for (const auto& [key, w] : row.weights) put(key, w / row.total);
+      put(v, -row.total);
+      for (const auto& [key, w] : row.weights) {
+        put(key, w);
+        sys.rowLength[r] += std::abs(w);
+      }
     }
     sys.A.resize(Eigen::Index(rows.size()), Eigen::Index(unknowns));
     sys.A.setFromTriplets(entries.begin(), entries.end());
@@ -1788,8 +1847,8 @@ class HoleFiller {
     sys.ok = sys.solver.info() == Eigen::Success;
   }
 
-  // Solves for the new vertices given the target Laplacians delta (rows x 3);
-  // returns the RMS residual.
+  // Solves for the new vertices given the target Laplacians delta (rows x 3,
+  // sum_j omega_rj (x_j - x_r)); returns the RMS residual as a length, or -1.
   double solve(System& sys, const Eigen::MatrixXd& delta, std::vector<Point3>& x) const {
     const Eigen::MatrixXd weighted = sys.rowWeight.asDiagonal() * delta;
     const Eigen::MatrixXd rhs = Eigen::MatrixXd(sys.A.transpose() * (weighted - sys.fixedPart));
@@ -1797,28 +1856,53 @@ class HoleFiller {
     if (sys.solver.info() != Eigen::Success || !sol.allFinite()) return -1;
     for (std::size_t v = n_; v < uv_.size(); ++v)
       for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
-    // Unweighted: the rows' own residuals (lengths).
-    const Eigen::MatrixXd residual = sys.rowWeight.cwiseInverse().asDiagonal() *
-                                     Eigen::MatrixXd(sys.A * sol + sys.fixedPart - weighted);
-    return std::sqrt(residual.squaredNorm() / double(std::max<Eigen::Index>(1, residual.rows())));
+    const Eigen::MatrixXd residual = Eigen::MatrixXd(sys.A * sol + sys.fixedPart - weighted);
+    double sum = 0;
+    for (Eigen::Index r = 0; r < residual.rows(); ++r) {
+      const double length = sys.rowLength[std::size_t(r)] * sys.rowWeight[r];
+      if (length > 0) sum += residual.row(r).squaredNorm() / (length * length);
+    }
+    return std::sqrt(sum / double(std::max<Eigen::Index>(1, residual.rows())));
   }
 
-  // Harmonic: L x = 0 over the new vertices (symmetric cotangent form).
-  bool harmonic(std::vector<Point3>& x, bool planarWeights, double& residual) const {
-    std::vector<int> rows(rowVertex_.begin(), rowVertex_.begin() + std::ptrdiff_t(uv_.size() - n_));
-    const std::size_t unknowns = rows.size();
+  enum class MembraneWeights {
+    Uniform,  // every edge 1 (a Tutte embedding: where nothing better is known)
+    Domain,   // cotangents of the patch in its plane
+    Shape,    // cotangents of the patch at the positions given
+  };
+
+  // The membrane L x = 0 over the new vertices, boundary fixed (symmetric
+  // form, weights raised to kMembraneMinimumWeight): the harmonic shape, and
+  // the flat placement over a disk. Its rows are those of the new vertices
+  // alone: the membrane does not see the surface beyond the boundary.
+  bool membrane(std::vector<Point3>& x, MembraneWeights kind, double& residual) const {
+    const std::size_t unknowns = uv_.size() - n_;
+    if (unknowns == 0) return true;
     std::vector<Eigen::Triplet<double>> entries;
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
-    const std::vector<TriangleWeights> weights = patchWeights(x, planarWeights);
+    std::vector<TriangleWeights> weights;
+    if (kind != MembraneWeights::Uniform)
+      weights = patchWeights(x, kind == MembraneWeights::Domain);
     LaplacianRow row;
+    double diagonal = 0;
     for (std::size_t r = 0; r < unknowns; ++r) {
-      rowOf(rows[r], weights, row);
+      const int v = int(n_ + r);
+      if (kind == MembraneWeights::Uniform) {
+        row.weights.clear();
+        for (int t : localAround_[v])
+          for (int c : localTriangles_[t])
+            if (c != v) row.add(c, 0.5);  // each neighbour on two faces around v: 1
+        row.finish();
+      } else {
+        rowOf(v, weights, row, kMembraneMinimumWeight);
+      }
       entries.push_back({int(r), int(r), row.total});
+      diagonal += row.total;
       for (const auto& [key, w] : row.weights) {
         if (key >= int(n_))
           entries.push_back({int(r), key - int(n_), -w});
         else
-          for (int d = 0; d < 3; ++d) rhs(Eigen::Index(r), d) += w * fixedPosition(key, x)[d];
+          for (int d = 0; d < 3; ++d) rhs(Eigen::Index(r), d) += w * x[key][d];
       }
     }
     Eigen::SparseMatrix<double> M(static_cast<Eigen::Index>(unknowns),
@@ -1831,11 +1915,8 @@ class HoleFiller {
     for (std::size_t v = n_; v < uv_.size(); ++v)
       for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
     const Eigen::MatrixXd res = M * sol - rhs;
-    double scale = 0;
-    for (const auto& e : entries)
-      if (e.row() == e.col()) scale += e.value();
-    residual = std::sqrt(res.squaredNorm() / double(std::max<std::size_t>(1, unknowns))) /
-               std::max(1e-300, scale / double(std::max<std::size_t>(1, unknowns)));
+    residual = std::sqrt(res.squaredNorm() / double(unknowns)) /
+               std::max(1e-300, diagonal / double(unknowns));
     return true;
   }
 
@@ -1908,12 +1989,13 @@ class HoleFiller {
     if (uv_.size() == n_) return true;  // nothing to place
     if (mode == HoleFairing::Harmonic) {
       double residual = 0;
-      if (!harmonic(x, true, residual)) return false;
+      if (!membrane(x, MembraneWeights::Domain, residual)) return false;
       // Weights from the membrane's own shape, then solved again.
-      if (!harmonic(x, false, residual)) return false;
+      if (!membrane(x, MembraneWeights::Shape, residual)) return false;
       shape.residual = residual;
       return true;
     }
+    // First weights from the patch in its domain, then from the shape.
     System sys;
     assemble(sys, rowVertex_, x, true);
     if (!sys.ok) return false;
@@ -1943,7 +2025,7 @@ class HoleFiller {
         for (int iteration = 0; iteration < 3; ++iteration) {
           for (std::size_t r = 0; r < rowVertex_.size(); ++r) {
             const auto [n, area] = normalAndArea(rowVertex_[r], x);
-            const Point3 d = n * (-4 * area * curvature[r] / sys.rowTotal[r]);
+            const Point3 d = n * (-4 * area * curvature[r]);
             for (int k = 0; k < 3; ++k) delta(Eigen::Index(r), k) = d[k];
           }
           std::vector<Point3> trial = x;
@@ -2046,17 +2128,9 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   }
   for (const BorderLoop& loop : found.loops) {
     const std::size_t count = loop.vertices.size();
-    const std::size_t edges = loop.closed ? count : count - 1;
-    for (std::size_t i = 0; i < edges; ++i) {
-      const int a = loop.vertices[i], b = loop.vertices[(i + 1) % count];
-      s.adjacency->forEach(a, [&](int f) {
-        const Triangle& t = s.triangles[f];
-        for (int k = 0; k < 3; ++k)
-          if (t[k] == a && t[(k + 1) % 3] == b) s.borderOwner[directedKey(a, b)] = f;
-      });
-    }
+    for (std::size_t i = 0; i < loop.faces.size(); ++i)
+      s.borderOwner[directedKey(loop.vertices[i], loop.vertices[(i + 1) % count])] = loop.faces[i];
   }
-
   // Which holes to fill.
   Point3 lo = s.points[0], hi = s.points[0];
   for (const Point3& p : s.points)
@@ -2164,8 +2238,13 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     VertexOriginHandle vo = vertexOrigins(mesh);
     FaceOriginHandle fo = faceOrigins(mesh);
     const int layer = mesh.vert.empty() ? 0 : std::max(0, vo[0].layer);
-    std::vector<FaceOrigin> inputOrigins(s.inputFaces);
-    for (std::size_t f = 0; f < s.inputFaces; ++f) inputOrigins[f] = fo[f];
+    // Origins of the input faces that split vertices and faces come from,
+    // read before adding elements moves the attribute's storage.
+    std::unordered_map<int, FaceOrigin> inputOrigins;
+    for (const auto& [v, origin] : s.splitOrigins)
+      inputOrigins.emplace(origin.face, fo[origin.face]);
+    for (int f : s.inputFaceOf)
+      if (f >= 0) inputOrigins.emplace(f, fo[f]);
     const std::size_t newVertices = s.points.size() - s.inputVertices;
     const std::size_t newFaces = s.triangles.size() - s.inputFaces;
     if (newVertices > 0) {
@@ -2174,7 +2253,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         vi->P() = s.points[v];
         const auto split = s.splitOrigins.find(int(v));
         if (split != s.splitOrigins.end()) {
-          const FaceOrigin& of = inputOrigins[split->second.face];
+          const FaceOrigin& of = inputOrigins.at(split->second.face);
           vo[v] = VertexOrigin{of.layer, -1, of.face, split->second.barycentric};
         } else {
           vo[v] = VertexOrigin{layer, -1, -1, {0, 0, 0}};
@@ -2221,7 +2300,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f, ++fi) {
         for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[s.triangles[f][k]];
         const int from = s.inputFaceOf[f - s.inputFaces];
-        fo[f] = from >= 0 ? inputOrigins[from] : FaceOrigin{layer, -1};
+        fo[f] = from >= 0 ? inputOrigins.at(from) : FaceOrigin{layer, -1};
       }
     }
     result.new_faces = s.patchFaces;

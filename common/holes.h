@@ -21,15 +21,19 @@
 namespace meshmend {
 
 // How the patch vertices are placed once the patch is triangulated. The
-// smooth shapes minimise the squared cotangent Laplacians (Eq. 1-3) of the
-// new vertices and of the boundary vertices, whose outer neighbours stay
-// fixed: that is what joins the patch to the surface with a continuous
-// tangent plane.
+// smooth shapes minimise the squared cotangent Laplacians (Eq. 1-4, true
+// cotangent weights, each row weighted by its vertex's area) of the new
+// vertices and of the boundary vertices, whose outer neighbours stay fixed:
+// that is what joins the patch to the surface with a continuous tangent
+// plane. Biharmonic is the default: on the fidelity benchmark
+// (docs/BENCHMARKS.md) it is closer to the removed surface than the
+// paper's regression on most holes.
 enum class HoleFairing {
   Flat,        // no fairing: where the advancing front put them (a height field over the
                // hole's plane; a uniform membrane when the hole has no plane it projects to)
   Harmonic,    // membrane: L x = 0 with the boundary fixed (no tangent continuity)
-  Biharmonic,  // minimal curvature: target Laplacians 0 (L^2 x = 0 in the least-squares sense)
+  Biharmonic,  // minimal curvature (the default): target Laplacians 0 (L^2 x = 0 in the
+               // least-squares sense)
   // The paper's (§3.3-3.4): the mean curvature H of the vertices in the
   // rings around the hole, from their own Laplacians, is learnt by LS-SVM
   // regression over 3-D position; the Laplacian it implies at each patch
@@ -72,7 +76,7 @@ struct HoleFillOptions {
   double merge_distance = 0.6;
 
   // ---- Shape.
-  HoleFairing fairing = HoleFairing::LaplacianRegression;
+  HoleFairing fairing = HoleFairing::Biharmonic;
   // Rings of surface vertices around the hole whose Laplacians train the regression (§3.3).
   int regression_rings = 3;
   // LS-SVM regularisation gamma (Eq. 11): larger follows the samples more
@@ -84,7 +88,8 @@ struct HoleFillOptions {
   // ---- Checks. Exact test of every patch (with the faces its pre-treatment
   // split) against itself and the surface around it; a patch that
   // intersects is replaced by a flatter one (LaplacianRegression ->
-  // Biharmonic -> Harmonic -> Flat), or left out. Its counts make
+  // Biharmonic -> Harmonic -> Flat), or left out. Each shape is tried over
+  // both domains (plane, disk) that were triangulated before a flatter one. Its counts make
   // remaining_intersecting_pairs exact.
   bool check_intersections = true;
   // Recount, independently and exactly, the intersecting pairs that involve

@@ -646,7 +646,7 @@ TEST(HoleLarge, ThousandBorderVertexHoleIsFilled) {
   EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
   const HoleReport& hole = r.holes[0].filled ? r.holes[0] : r.holes[1];
   EXPECT_EQ(hole.boundary_edges, 1000u);
-  EXPECT_EQ(hole.fairing, HoleFairing::LaplacianRegression) << hole.reason;
+  EXPECT_EQ(hole.fairing, HoleFairing::Biharmonic) << hole.reason;
   expectSound(m, 1000);
   EXPECT_LT(maxSphereDeviation(m, r), 0.02);
   std::cout << "1000-edge hole: " << r.faces_added << " faces, " << hole.time_ms
