@@ -15,6 +15,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/border_loops.h"
+#include "common/box_tree.h"
 #include "common/errors.h"
 #include "common/intersections.h"
 #include "common/predicates.h"
@@ -475,9 +477,9 @@ class LocalEdges {
  public:
   struct Neighbour {
     int v;
-    int out;       // faces running (this -> v)
-    int in;        // faces running (v -> this)
-    int opposite;  // the third corner of a face on the edge
+    int opposite;      // the third corner of a face on the edge
+    std::int16_t out;  // faces running (this -> v)
+    std::int16_t in;   // faces running (v -> this)
   };
 
   // With `among`, only the edges between two of the vertices are kept (what
@@ -487,46 +489,49 @@ class LocalEdges {
     int slots = 0;
     for (int v : vertices)
       if (slot_[v] < 0) slot_[v] = slots++;
+    // Two passes over the faces: count the uses per vertex, then place them.
     start_.assign(std::size_t(slots) + 1, 0);
     const Vertex* base = mesh.vert.data();
     auto forEachUse = [&](auto&& visit) {
       for (const Face& f : mesh.face) {
         const int c[3] = {int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
-        if (slot_[c[0]] < 0 && slot_[c[1]] < 0 && slot_[c[2]] < 0) continue;
+        const int s[3] = {slot_[c[0]], slot_[c[1]], slot_[c[2]]};
+        if (s[0] < 0 && s[1] < 0 && s[2] < 0) continue;
         for (int k = 0; k < 3; ++k) {
-          const int a = c[k], b = c[(k + 1) % 3];
-          const int o = c[(k + 2) % 3];
-          if (among && (slot_[a] < 0 || slot_[b] < 0)) continue;
-          if (slot_[a] >= 0) visit(slot_[a], b, true, o);
-          if (slot_[b] >= 0) visit(slot_[b], a, false, o);
+          const int i = (k + 1) % 3, o = c[(k + 2) % 3];
+          if (among && (s[k] < 0 || s[i] < 0)) continue;
+          if (s[k] >= 0) visit(s[k], Neighbour{c[i], o, 1, 0});
+          if (s[i] >= 0) visit(s[i], Neighbour{c[k], o, 0, 1});
         }
       }
     };
-    forEachUse([&](int s, int, bool, int) { ++start_[s + 1]; });
+    forEachUse([&](int s, const Neighbour&) { ++start_[s + 1]; });
     for (int s = 0; s < slots; ++s) start_[s + 1] += start_[s];
     entries_.resize(start_.back());
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    forEachUse([&](int s, int w, bool out, int o) {
-      entries_[fill[s]++] = Neighbour{w, out ? 1 : 0, out ? 0 : 1, o};
-    });
-    // Merge the uses of one edge (a vertex has few).
-    std::vector<int> newStart(start_.size(), 0);
-    std::size_t write = 0;
-    for (int s = 0; s < slots; ++s) {
-      auto b = entries_.begin() + start_[s], e = entries_.begin() + start_[s + 1];
-      std::sort(b, e, [](const Neighbour& x, const Neighbour& y) { return x.v < y.v; });
-      newStart[s] = int(write);
-      for (auto it = b; it != e; ++it) {
-        if (write > std::size_t(newStart[s]) && entries_[write - 1].v == it->v) {
-          entries_[write - 1].out += it->out;
-          entries_[write - 1].in += it->in;
+    {
+      std::vector<int> fill(start_.begin(), start_.end() - 1);
+      forEachUse([&](int s, const Neighbour& n) { entries_[fill[s]++] = n; });
+    }
+    // Merge the uses of one edge (a vertex has few), in place.
+    int write = 0;
+    for (int s = 0, read = 0; s < slots; ++s) {
+      const int end = start_[s + 1];
+      auto b = entries_.begin() + read, e = entries_.begin() + end;
+      if (e - b > 1)
+        std::sort(b, e, [](const Neighbour& x, const Neighbour& y) { return x.v < y.v; });
+      start_[s] = write;
+      const int first = write;
+      for (; read < end; ++read) {
+        const Neighbour n = entries_[read];
+        if (write > first && entries_[write - 1].v == n.v) {
+          entries_[write - 1].out += n.out;
+          entries_[write - 1].in += n.in;
         } else {
-          entries_[write++] = *it;
+          entries_[write++] = n;
         }
       }
     }
-    newStart[slots] = int(write);
-    start_ = std::move(newStart);
+    start_[slots] = write;
     entries_.resize(write);
   }
 
@@ -573,27 +578,20 @@ double aspectRatio(const Point3& a, const Point3& b, const Point3& c) {
   return area2 > 0 ? l / area2 : INFINITY;
 }
 
-// Arc-length parametrised polyline, for comparing how two paths run.
+// Arc-length parametrised polyline (the rows of a subdivided strip).
 class Polyline {
  public:
   explicit Polyline(std::vector<Point3> points) : p_(std::move(points)), s_(p_.size(), 0) {
     for (std::size_t i = 1; i < p_.size(); ++i) s_[i] = s_[i - 1] + (p_[i] - p_[i - 1]).Norm();
   }
   double length() const { return s_.back(); }
-  // The point at arc length s (clamped), and the fractional vertex index.
-  Point3 at(double s, double* index = nullptr) const {
-    if (p_.size() == 1 || s <= 0) {
-      if (index) *index = 0;
-      return p_.front();
-    }
-    if (s >= s_.back()) {
-      if (index) *index = double(p_.size() - 1);
-      return p_.back();
-    }
+  // The point at arc length s (clamped).
+  Point3 at(double s) const {
+    if (p_.size() == 1 || s <= 0) return p_.front();
+    if (s >= s_.back()) return p_.back();
     const std::size_t i = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin() - 1;
     const double span = s_[i + 1] - s_[i];
     const double t = span > 0 ? (s - s_[i]) / span : 0;
-    if (index) *index = double(i) + t;
     return p_[i] * (1 - t) + p_[i + 1] * t;
   }
 
@@ -602,23 +600,45 @@ class Polyline {
   std::vector<double> s_;
 };
 
-// Sum of distances between points at the same arc-length fraction: small
-// when the two paths run side by side in the same direction.
-double correspondenceCost(const Polyline& a, const Polyline& b) {
+// A path of mesh vertices (closed: back to its first vertex) as an
+// arc-length parametrised polyline, its points read from the mesh.
+class PathLine {
+ public:
+  PathLine(const Mesh& mesh, const std::vector<int>& path, bool closed)
+      : mesh_(mesh), path_(path), s_(path.size() + (closed ? 1 : 0), 0) {
+    for (std::size_t i = 1; i < s_.size(); ++i)
+      s_[i] = s_[i - 1] + (point(i) - point(i - 1)).Norm();
+  }
+  double length() const { return s_.back(); }
+  // The point at arc length s (clamped).
+  Point3 at(double s) const {
+    if (s_.size() == 1 || s <= 0) return point(0);
+    if (s >= s_.back()) return point(s_.size() - 1);
+    const std::size_t i = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin() - 1;
+    const double span = s_[i + 1] - s_[i];
+    const double t = span > 0 ? (s - s_[i]) / span : 0;
+    return point(i) * (1 - t) + point(i + 1) * t;
+  }
+
+ private:
+  Point3 point(std::size_t i) const { return mesh_.vert[path_[i % path_.size()]].cP(); }
+  const Mesh& mesh_;
+  const std::vector<int>& path_;
+  std::vector<double> s_;
+};
+
+// Sum of distances between points at the same arc-length fraction (of b
+// run backwards when reversedB): small when the two paths run side by side
+// in the same direction. A closed path run backwards from its first vertex
+// is its forward run reversed, so one parametrisation serves both ways.
+double correspondenceCost(const PathLine& a, const PathLine& b, bool reversedB) {
   constexpr int kSamples = 32;
   double cost = 0;
   for (int k = 0; k <= kSamples; ++k) {
     const double t = double(k) / kSamples;
-    cost += (a.at(t * a.length()) - b.at(t * b.length())).Norm();
+    cost += (a.at(t * a.length()) - b.at((reversedB ? 1 - t : t) * b.length())).Norm();
   }
   return cost;
-}
-
-std::vector<Point3> pointsOf(const Mesh& mesh, const std::vector<int>& path) {
-  std::vector<Point3> out;
-  out.reserve(path.size());
-  for (int v : path) out.push_back(mesh.vert[v].cP());
-  return out;
 }
 
 // The merge-like triangulation (§2.2) of the strip between lists a and b
@@ -786,16 +806,9 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
   }
   // Which way b runs beside a: by geometry, and by orientation (a side
   // that runs along its border must meet one that runs against it).
-  auto traversal = [&](const PreparedPath& p, bool reversed) {
-    std::vector<int> v = p.v;
-    if (reversed) std::reverse(v.begin() + (p.closed ? 1 : 0), v.end());
-    if (p.closed) v.push_back(v.front());
-    return v;
-  };
-  const Polyline polyA(pointsOf(mesh, traversal(A, false)));
-  const double costSame = correspondenceCost(polyA, Polyline(pointsOf(mesh, traversal(B, false))));
-  const double costReversed =
-      correspondenceCost(polyA, Polyline(pointsOf(mesh, traversal(B, true))));
+  const PathLine lineA(mesh, A.v, A.closed), lineB(mesh, B.v, B.closed);
+  const double costSame = correspondenceCost(lineA, lineB, false);
+  const double costReversed = correspondenceCost(lineA, lineB, true);
   const bool geometrySame = costSame <= costReversed;
   bool same = geometrySame;
   if (A.sign != 0 && B.sign != 0) {
@@ -990,16 +1003,66 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
   return plan;
 }
 
-// Exact count of the intersecting pairs that involve a planned face.
+// Exact count of the intersecting pairs that involve a planned face. Only
+// the faces near the gap are looked at: the planned faces' boxes go into a
+// tree, every face of the mesh whose box meets the tree's bounds is looked
+// up in it, and the pairs found are decided on a small copy of the faces
+// concerned.
 std::size_t newIntersections(const Mesh& mesh, const StitchPlan& plan) {
-  std::vector<Point3> P = positionsOf(mesh);
-  P.insert(P.end(), plan.newPoints.begin(), plan.newPoints.end());
-  std::vector<Triangle> T = trianglesOf(mesh);
-  const std::size_t first = T.size();
-  T.insert(T.end(), plan.faces.begin(), plan.faces.end());
-  std::vector<char> changed(T.size(), 0);
-  std::fill(changed.begin() + first, changed.end(), 1);
-  return intersectingOf(P, T, pairsWithChangedFaces(P, T, changed)).size();
+  if (plan.faces.empty()) return 0;
+  const int n = int(mesh.vert.size());
+  const Vertex* base = mesh.vert.data();
+  auto point = [&](int v) -> Point3 { return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n]; };
+  std::vector<Box> boxes;
+  boxes.reserve(plan.faces.size());
+  for (const Triangle& t : plan.faces)
+    boxes.push_back(boxOf(point(t[0]), point(t[1]), point(t[2])));
+  const BoxTree tree(boxes);
+  const Box bounds = tree.bounds();
+  // Mesh faces whose boxes overlap a planned face's: (planned, mesh face).
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  parallelChunks(mesh.face.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t g = begin; g < end; ++g) {
+      const Face& f = mesh.face[g];
+      const Box b = boxOf(f.cV(0)->cP(), f.cV(1)->cP(), f.cV(2)->cP());
+      if (!overlap(b, bounds)) continue;
+      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
+        found[worker].push_back({i, std::uint32_t(g)});
+      });
+    }
+  });
+  // The faces concerned, renumbered: the planned ones first.
+  std::vector<Point3> P;
+  std::vector<Triangle> T;
+  std::vector<int> localVertex(n + plan.newPoints.size(), -1);
+  auto local = [&](int v) {
+    if (localVertex[v] < 0) {
+      localVertex[v] = int(P.size());
+      P.push_back(point(v));
+    }
+    return localVertex[v];
+  };
+  T.reserve(plan.faces.size());
+  for (const Triangle& t : plan.faces) T.push_back({local(t[0]), local(t[1]), local(t[2])});
+  std::vector<std::uint32_t> localFace(mesh.face.size(), 0);  // 0: not copied yet
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (const auto& list : found)
+    for (const auto& [i, g] : list) {
+      if (localFace[g] == 0) {
+        const Face& f = mesh.face[g];
+        localFace[g] = std::uint32_t(T.size());
+        T.push_back(
+            {local(int(f.cV(0) - base)), local(int(f.cV(1) - base)), local(int(f.cV(2) - base))});
+      }
+      pairs.push_back({i, localFace[g]});
+    }
+  // Planned faces among themselves (their local indices are their own).
+  for (auto& list : found) list.clear();
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
+    found[worker].push_back({i, j});
+  });
+  for (const auto& list : found) pairs.insert(pairs.end(), list.begin(), list.end());
+  return intersectingOf(P, T, pairs).size();
 }
 
 void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
@@ -1336,7 +1399,7 @@ class NearPoints {
 };
 
 struct BorderEdge {
-  int from, to;
+  int from, to, face;
 };
 
 std::vector<BorderEdge> borderEdgesDirected(const std::vector<Triangle>& T) {
@@ -1345,23 +1408,37 @@ std::vector<BorderEdge> borderEdgesDirected(const std::vector<Triangle>& T) {
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i + 1;
     while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-    if (j - i == 1)
-      out.push_back({T[uses[i].face][uses[i].corner], T[uses[i].face][(uses[i].corner + 1) % 3]});
+    if (j - i == 1) {
+      const Triangle& t = T[uses[i].face];
+      out.push_back({t[uses[i].corner], t[(uses[i].corner + 1) % 3], uses[i].face});
+    }
     i = j;
   }
   return out;
 }
 
-// Step 1: border edges that coincide (within the tolerance) and run
-// opposite ways become one edge, merge by merge, each kept only if it
-// leaves every edge it touches with at most two faces running it opposite
-// ways and no face with a repeated corner.
-void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
-                            std::vector<int>& target, double tolerance, CloseGapsResult& r) {
+// Union-find over indices, with path halving.
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  int root(int v) {
+    while (parent_[v] != v) v = parent_[v] = parent_[parent_[v]];
+    return v;
+  }
+  void join(int from, int into) { parent_[root(from)] = root(into); }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// Border vertices that coincide (exactly, or within the tolerance, through
+// chains of such pairs) share a class: classOf[v] is its representative,
+// v itself for a vertex on no border edge.
+std::vector<int> coincidenceClasses(const std::vector<Point3>& P,
+                                    const std::vector<BorderEdge>& border, double tolerance) {
   const int n = int(P.size());
-  target.resize(n);
-  std::iota(target.begin(), target.end(), 0);
-  const std::vector<BorderEdge> border = borderEdgesDirected(T);
   std::vector<int> borderVertices;
   {
     std::vector<char> on(n, 0);
@@ -1369,34 +1446,174 @@ void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
     for (int v = 0; v < n; ++v)
       if (on[v]) borderVertices.push_back(v);
   }
-  std::unordered_map<int, std::vector<int>> outEdges;  // vertex -> border edges leaving it
-  for (std::size_t k = 0; k < border.size(); ++k) outEdges[border[k].from].push_back(int(k));
+  DisjointSets sets(P.size());
   const NearPoints near(P, borderVertices, tolerance);
-  // Candidates of edge e = (a -> b): edges (c -> d) with c at b and d at a.
-  auto candidates = [&](int e) {
-    std::vector<int> out;
-    const BorderEdge& be = border[e];
-    near.near(P[be.to], [&](int c) {
-      const auto it = outEdges.find(c);
-      if (it == outEdges.end()) return;
-      for (int f : it->second) {
-        if (f == e) continue;
-        const int d = border[f].to;
-        const double t2 = tolerance * tolerance;
-        if (tolerance > 0 ? (P[d] - P[be.from]).SquaredNorm() <= t2 : P[d] == P[be.from])
-          out.push_back(f);
+  for (int v : borderVertices) near.near(P[v], [&](int w) { sets.join(w, v); });
+  std::vector<int> classOf(n);
+  for (int v = 0; v < n; ++v) classOf[v] = sets.root(v);
+  return classOf;
+}
+
+// Faces flipped so that faces meeting at an edge run it opposite ways,
+// where "meeting" counts coincident border vertices as one: the facets of a
+// soup whose neighbours face the other way (some CAD exports) can then be
+// merged. Only edges with exactly two faces propagate the orientation. A
+// connected part that needed no flip is left as it is; one that did keeps,
+// if it is closed (every edge has a second face), the orientation whose
+// signed volume is positive (outward), else the orientation of most of its
+// area as given.
+void orientConsistently(const std::vector<Point3>& P, std::vector<Triangle>& T,
+                        const std::vector<int>& classOf, CloseGapsResult& r) {
+  const std::size_t m = T.size();
+  std::vector<Triangle> G(m);
+  for (std::size_t f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) G[f][k] = classOf[T[f][k]];
+  const std::vector<EdgeUse> uses = edgeUses(G);
+  // Neighbours across two-face edges: (face, same direction?).
+  std::vector<int> start(m + 1, 0);
+  std::vector<char> open(m, 0);  // has an edge with one face
+  auto forEachPair = [&](auto&& visit) {
+    for (std::size_t i = 0; i < uses.size();) {
+      std::size_t j = i + 1;
+      while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+      if (uses[i].u != uses[i].v) {
+        if (j - i == 1) open[uses[i].face] = 1;
+        if (j - i == 2 && uses[i].face != uses[i + 1].face) {
+          const bool same = (G[uses[i].face][uses[i].corner] == uses[i].u) ==
+                            (G[uses[i + 1].face][uses[i + 1].corner] == uses[i + 1].u);
+          visit(uses[i].face, uses[i + 1].face, same);
+        }
       }
-    });
-    return out;
+      i = j;
+    }
   };
-  std::vector<std::array<int, 2>> matches;
-  for (std::size_t e = 0; e < border.size(); ++e) {
-    const std::vector<int> c = candidates(int(e));
-    if (c.size() != 1 || c[0] < int(e)) continue;
-    const std::vector<int> back = candidates(c[0]);
-    if (back.size() == 1 && back[0] == int(e)) matches.push_back({int(e), c[0]});
+  forEachPair([&](int f, int g, bool) { ++start[f + 1], ++start[g + 1]; });
+  for (std::size_t f = 0; f < m; ++f) start[f + 1] += start[f];
+  std::vector<std::pair<int, bool>> next(start.back());
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    forEachPair([&](int f, int g, bool same) {
+      next[fill[f]++] = {g, same};
+      next[fill[g]++] = {f, same};
+    });
   }
-  if (matches.empty()) return;
+  std::vector<char> flip(m, 0), seen(m, 0);
+  std::vector<int> part;
+  for (std::size_t seed = 0; seed < m; ++seed) {
+    if (seen[seed]) continue;
+    part.assign(1, int(seed));
+    seen[seed] = 1;
+    for (std::size_t k = 0; k < part.size(); ++k) {
+      const int f = part[k];
+      for (int i = start[f]; i < start[f + 1]; ++i) {
+        const auto [g, same] = next[i];
+        const char want = char(flip[f] ^ char(same));
+        if (!seen[g]) {
+          seen[g] = 1;
+          flip[g] = want;
+          part.push_back(g);
+        } else if (flip[g] != want && f < g) {
+          ++r.orientation_conflicts;
+        }
+      }
+    }
+    if (std::none_of(part.begin(), part.end(), [&](int f) { return flip[f]; })) continue;
+    bool closed = true;
+    double keptArea = 0, flippedArea = 0, volume = 0;
+    const Point3 centre = P[T[part[0]][0]];
+    for (int f : part) {
+      const Point3 a = P[T[f][0]] - centre, b = P[T[f][1]] - centre, c = P[T[f][2]] - centre;
+      const double area = ((b - a) ^ (c - a)).Norm();
+      (flip[f] ? flippedArea : keptArea) += area;
+      const double v = a * (b ^ c);
+      volume += flip[f] ? -v : v;
+      closed = closed && !open[f];
+    }
+    const bool turn = closed ? volume < 0 : flippedArea > keptArea;
+    for (int f : part) flip[f] ^= char(turn);
+  }
+  for (std::size_t f = 0; f < m; ++f)
+    if (flip[f]) {
+      std::swap(T[f][1], T[f][2]);
+      ++r.faces_flipped;
+    }
+}
+
+// Step 1: border edges that coincide (within the tolerance) and run
+// opposite ways become one edge, and border edges whose ends coincide
+// collapse (their face, of zero area within the tolerance, goes). Where
+// more than two border edges coincide (solids that touch along an edge),
+// each is paired with the next one around the edge behind its face, so
+// that each solid closes on its own. Merge by merge, each is kept only if
+// it leaves every edge it touches with at most two faces running it
+// opposite ways. Vertices merge only through these edges: coincident
+// vertices whose faces do not join stay apart (a vertex split).
+void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>& T,
+                            const std::vector<int>& classOf, std::vector<char>& removedFace,
+                            std::vector<int>& target, CloseGapsResult& r) {
+  const int n = int(P.size());
+  target.resize(n);
+  std::iota(target.begin(), target.end(), 0);
+  removedFace.assign(T.size(), 0);
+  const std::vector<BorderEdge> border = borderEdgesDirected(T);
+  // Requested merges: pairs of border edges, or one edge to collapse (e2 < 0).
+  std::vector<std::array<int, 2>> requests;
+  for (std::size_t e = 0; e < border.size(); ++e)
+    if (classOf[border[e].from] == classOf[border[e].to]) requests.push_back({int(e), -1});
+  {
+    std::vector<std::pair<std::uint64_t, int>> byKey;
+    for (std::size_t e = 0; e < border.size(); ++e) {
+      const int a = classOf[border[e].from], b = classOf[border[e].to];
+      if (a != b) byKey.push_back({undirectedKey(a, b), int(e)});
+    }
+    std::sort(byKey.begin(), byKey.end());
+    for (std::size_t i = 0; i < byKey.size();) {
+      std::size_t j = i + 1;
+      while (j < byKey.size() && byKey[j].first == byKey[i].first) ++j;
+      const std::size_t count = j - i;
+      if (count == 2) {
+        const BorderEdge &x = border[byKey[i].second], &y = border[byKey[i + 1].second];
+        if (classOf[x.from] == classOf[y.to])
+          requests.push_back({byKey[i].second, byKey[i + 1].second});
+      } else if (count > 2) {
+        // Around the edge from class lo to class hi: each use's face apex at
+        // an angle; a face running lo -> hi faces towards larger angles,
+        // so its inside is its predecessor, which must run hi -> lo.
+        const int lo = int(byKey[i].first >> 32);
+        const BorderEdge& first = border[byKey[i].second];
+        const Point3 origin = P[classOf[first.from] == lo ? first.from : first.to];
+        Point3 axis = P[classOf[first.from] == lo ? first.to : first.from] - origin;
+        axis.Normalize();
+        Point3 u = std::abs(axis[0]) < 0.9 ? Point3(1, 0, 0) ^ axis : Point3(0, 1, 0) ^ axis;
+        u.Normalize();
+        const Point3 w = axis ^ u;
+        struct Around {
+          double angle;
+          int edge;
+          bool forward;
+        };
+        std::vector<Around> around;
+        for (std::size_t k = i; k < j; ++k) {
+          const BorderEdge& e = border[byKey[k].second];
+          const Triangle& t = T[e.face];
+          const int apex = t[0] != e.from && t[0] != e.to   ? t[0]
+                           : t[1] != e.from && t[1] != e.to ? t[1]
+                                                            : t[2];
+          const Point3 d = P[apex] - origin;
+          around.push_back({std::atan2(d * w, d * u), byKey[k].second, classOf[e.from] == lo});
+        }
+        std::sort(around.begin(), around.end(),
+                  [](const Around& x, const Around& y) { return x.angle < y.angle; });
+        for (std::size_t k = 0; k < around.size(); ++k) {
+          const Around& behind = around[(k + around.size() - 1) % around.size()];
+          if (around[k].forward && !behind.forward)
+            requests.push_back({around[k].edge, behind.edge});
+        }
+      }
+      i = j;
+    }
+  }
+  if (requests.empty()) return;
 
   // Faces per vertex and directed edge counts, updated merge by merge.
   std::vector<std::vector<int>> facesOf(n);
@@ -1405,21 +1622,21 @@ void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
   std::unordered_map<std::uint64_t, int> directed;
   for (const Triangle& t : T)
     for (int k = 0; k < 3; ++k) ++directed[edgeKey(t[k], t[(k + 1) % 3])];
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& [e1, e2] : matches) {
-    // e1 = a -> b, e2 = c -> d: d joins a, c joins b.
-    const int a = root(border[e1].from), b = root(border[e1].to);
-    const int c = root(border[e2].from), d = root(border[e2].to);
+  DisjointSets sets(P.size());
+  for (const auto& [e1, e2] : requests) {
+    // e1 = a -> b, e2 = c -> d: d joins a, c joins b; a collapse: b joins a.
+    const int a = sets.root(border[e1].from), b = sets.root(border[e1].to);
     std::unordered_map<int, int> into;
-    if (d != a) into[d] = a;
-    if (c != b) into[c] = b;
-    if (into.empty()) {  // closed by the merges before
-      ++r.edges_merged;
+    if (e2 < 0) {
+      if (b != a) into[b] = a;
+    } else {
+      const int c = sets.root(border[e2].from), d = sets.root(border[e2].to);
+      if (d != a) into[d] = a;
+      if (c != b) into[c] = b;
+      if (into.size() == 2 && into.count(a) && into.count(b)) continue;  // crossed: a <-> b
+    }
+    if (into.empty()) {  // done by the merges before
+      if (e2 >= 0) ++r.edges_merged;
       continue;
     }
     auto mapped = [&](int v) {
@@ -1429,90 +1646,225 @@ void mergeCoincidentBorders(std::vector<Point3>& P, std::vector<Triangle>& T,
     std::vector<int> affected;
     for (const auto& [from, to] : into) {
       (void)to;
-      affected.insert(affected.end(), facesOf[from].begin(), facesOf[from].end());
+      for (int f : facesOf[from])
+        if (!removedFace[f]) affected.push_back(f);
     }
     std::sort(affected.begin(), affected.end());
     affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
-    bool ok = true;
     std::vector<Triangle> changed;
+    std::vector<char> collapses;
     for (int f : affected) {
       const Triangle t{mapped(T[f][0]), mapped(T[f][1]), mapped(T[f][2])};
-      if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) ok = false;
       changed.push_back(t);
+      collapses.push_back(t[0] == t[1] || t[1] == t[2] || t[2] == t[0]);
     }
+    auto count = [&](const Triangle& t, int by) {
+      for (int i = 0; i < 3; ++i) directed[edgeKey(t[i], t[(i + 1) % 3])] += by;
+    };
+    for (int f : affected) count(T[f], -1);
     std::vector<std::uint64_t> touched;
-    if (ok) {
-      for (std::size_t k = 0; k < affected.size(); ++k)
-        for (int i = 0; i < 3; ++i) {
-          const Triangle& t = T[affected[k]];
-          --directed[edgeKey(t[i], t[(i + 1) % 3])];
-        }
-      for (const Triangle& t : changed)
-        for (int i = 0; i < 3; ++i) {
-          ++directed[edgeKey(t[i], t[(i + 1) % 3])];
-          touched.push_back(edgeKey(t[i], t[(i + 1) % 3]));
-        }
-      for (std::uint64_t key : touched) {
-        const int u = int(key >> 32), v = int(key & 0xffffffffu);
-        const auto fwd = directed.find(edgeKey(u, v));
-        const auto bwd = directed.find(edgeKey(v, u));
-        const int nf = fwd == directed.end() ? 0 : fwd->second;
-        const int nb = bwd == directed.end() ? 0 : bwd->second;
-        if (nf > 1 || nf + nb > 2) ok = false;
-      }
-      if (!ok) {  // undo
-        for (const Triangle& t : changed)
-          for (int i = 0; i < 3; ++i) --directed[edgeKey(t[i], t[(i + 1) % 3])];
-        for (std::size_t k = 0; k < affected.size(); ++k)
-          for (int i = 0; i < 3; ++i) {
-            const Triangle& t = T[affected[k]];
-            ++directed[edgeKey(t[i], t[(i + 1) % 3])];
-          }
-      }
+    for (std::size_t k = 0; k < changed.size(); ++k) {
+      if (collapses[k]) continue;
+      count(changed[k], +1);
+      for (int i = 0; i < 3; ++i)
+        touched.push_back(edgeKey(changed[k][i], changed[k][(i + 1) % 3]));
     }
-    if (!ok) {
+    bool ok = true;
+    for (std::uint64_t key : touched) {
+      const int u = int(key >> 32), v = int(key & 0xffffffffu);
+      const auto fwd = directed.find(edgeKey(u, v));
+      const auto bwd = directed.find(edgeKey(v, u));
+      const int nf = fwd == directed.end() ? 0 : fwd->second;
+      const int nb = bwd == directed.end() ? 0 : bwd->second;
+      if (nf > 1 || nf + nb > 2) ok = false;
+    }
+    if (!ok) {  // undo
+      for (std::size_t k = 0; k < changed.size(); ++k)
+        if (!collapses[k]) count(changed[k], -1);
+      for (int f : affected) count(T[f], +1);
       ++r.merges_skipped;
       continue;
     }
-    for (std::size_t k = 0; k < affected.size(); ++k) T[affected[k]] = changed[k];
+    for (std::size_t k = 0; k < affected.size(); ++k) {
+      T[affected[k]] = changed[k];
+      if (collapses[k]) {
+        removedFace[affected[k]] = 1;
+        ++r.degenerate_faces_removed;
+      }
+    }
     for (const auto& [from, to] : into) {
-      parent[from] = to;
+      sets.join(from, to);
       facesOf[to].insert(facesOf[to].end(), facesOf[from].begin(), facesOf[from].end());
       facesOf[from].clear();
       ++r.vertices_merged;
     }
-    ++r.edges_merged;
+    if (e2 >= 0) ++r.edges_merged;
   }
-  for (int v = 0; v < n; ++v) target[v] = root(v);
+  for (int v = 0; v < n; ++v) target[v] = sets.root(v);
 }
 
-// Border loops as vertex cycles, following border edges (at a vertex with
-// several, the first unused one).
-std::vector<std::vector<int>> borderLoops(const std::vector<Triangle>& T) {
-  const std::vector<BorderEdge> border = borderEdgesDirected(T);
-  std::unordered_map<int, std::vector<int>> out;
-  for (std::size_t k = 0; k < border.size(); ++k) out[border[k].from].push_back(int(k));
-  std::vector<char> done(border.size(), 0);
-  std::vector<std::vector<int>> loops;
-  for (std::size_t k = 0; k < border.size(); ++k) {
-    if (done[k]) continue;
-    std::vector<int> loop;
-    int e = int(k);
-    while (e >= 0 && !done[e]) {
-      done[e] = 1;
-      loop.push_back(border[e].from);
-      int nextEdge = -1;
-      for (int f : out[border[e].to])
-        if (!done[f]) {
-          nextEdge = f;
-          break;
-        }
-      if (border[e].to == loop.front()) break;
-      e = nextEdge;
+// Step 2: runs of border vertices facing another run within the bound. A
+// border vertex's partner is its nearest border vertex within the bound
+// that lies in front of it (away from its faces, within about 100 degrees
+// of the direction across its border) and is on another border loop, or
+// far along its own loop (the two sides of a crack: at least twice as far
+// along the loop as straight across, more than between any two points of a
+// convex hole's border, where it is at most pi/2). Runs of consecutive vertices
+// of one loop whose partners are on one loop face the run there holding
+// most of those partners. On one loop, two runs whose ends meet at a crack's
+// tip (the same vertex, or the two ends of one border edge) are extended
+// to it, so that stitching them closes the crack. Pairs with a path of
+// fewer than minPathVertices vertices are left out.
+std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                                     double bound, int minPathVertices) {
+  const BorderLoops found = findBorderLoops(P, T);
+  const std::vector<BorderLoop>& loops = found.loops;
+  const std::size_t n = P.size();
+  std::vector<int> loopOf(n, -1), positionOf(n, -1);
+  std::vector<int> ids;
+  std::vector<std::vector<double>> arc(loops.size());  // arc length from the loop's start
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    const std::vector<int>& loop = loops[l].vertices;
+    arc[l].assign(loop.size() + 1, 0);
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      if (loopOf[loop[k]] < 0) {
+        loopOf[loop[k]] = int(l);
+        positionOf[loop[k]] = int(k);
+        ids.push_back(loop[k]);
+      }
+      const int next = loop[(k + 1) % loop.size()];
+      const bool wraps = k + 1 == loop.size();
+      arc[l][k + 1] = arc[l][k] + (wraps && !loops[l].closed ? 0.0 : (P[next] - P[loop[k]]).Norm());
     }
-    if (loop.size() >= 2) loops.push_back(loop);
   }
-  return loops;
+  // Across each border edge, away from its face, in the face's plane.
+  std::vector<Point3> outward(n, Point3(0, 0, 0));
+  for (const BorderEdge& e : borderEdgesDirected(T)) {
+    const Triangle& t = T[e.face];
+    const Point3 normal = (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
+    Point3 across = (P[e.to] - P[e.from]) ^ normal;
+    const double length = across.Norm();
+    if (length > 0) {
+      across /= length;
+      outward[e.from] += across;
+      outward[e.to] += across;
+    }
+  }
+  auto alongLoop = [&](int l, int i, int j) {
+    const double d = std::abs(arc[l][i] - arc[l][j]);
+    return loops[l].closed ? std::min(d, arc[l].back() - d) : d;
+  };
+  const NearPoints near(P, ids, bound);
+  std::vector<int> partnerOf(n, -1);
+  for (int v : ids) {
+    double best = INFINITY;
+    const int l = loopOf[v];
+    near.near(P[v], [&](int w) {
+      if (w == v) return;
+      const Point3 d = P[w] - P[v];
+      const double distance = d.Norm();
+      if (loopOf[w] == l) {
+        const double along = alongLoop(l, positionOf[v], positionOf[w]);
+        if (along <= 0 || along < 2 * distance) return;
+      }
+      const double facing = d * outward[v];
+      if (facing < -0.2 * distance * outward[v].Norm()) return;
+      if (distance < best) best = distance, partnerOf[v] = w;
+    });
+  }
+  // Runs of loop l whose partners are on loop `other`, in the loop's order.
+  auto runsOf = [&](int l, int other) {
+    std::vector<std::vector<int>> runs;
+    const std::vector<int>& loop = loops[l].vertices;
+    const std::size_t m = loop.size();
+    auto facing = [&](std::size_t k) {
+      const int w = partnerOf[loop[k % m]];
+      return w >= 0 && loopOf[w] == other;
+    };
+    std::size_t first = 0;
+    if (loops[l].closed) {
+      while (first < m && facing(first)) ++first;
+      if (first == m) return std::vector<std::vector<int>>{loop};  // the whole loop
+    }
+    const std::size_t end = loops[l].closed ? first + m : m;
+    for (std::size_t k = first; k < end; ++k) {
+      if (!facing(k)) continue;
+      std::vector<int> run;
+      while (k < end && facing(k)) run.push_back(loop[k++ % m]);
+      runs.push_back(run);
+    }
+    return runs;
+  };
+  std::vector<std::array<int, 2>> loopPairs;
+  {
+    std::set<std::array<int, 2>> seen;
+    for (int v : ids)
+      if (const int w = partnerOf[v]; w >= 0) {
+        const std::array<int, 2> key{std::min(loopOf[v], loopOf[w]),
+                                     std::max(loopOf[v], loopOf[w])};
+        if (seen.insert(key).second) loopPairs.push_back(key);
+      }
+  }
+  std::vector<GapReport> gaps;
+  for (const auto& [l1, l2] : loopPairs) {
+    const auto runs1 = runsOf(l1, l2);
+    const auto runs2 = l1 == l2 ? runs1 : runsOf(l2, l1);
+    const bool whole1 = runs1.size() == 1 && runs1[0].size() == loops[l1].vertices.size();
+    const bool whole2 = runs2.size() == 1 && runs2[0].size() == loops[l2].vertices.size();
+    std::unordered_map<int, int> runOf2;
+    for (std::size_t k = 0; k < runs2.size(); ++k)
+      for (int v : runs2[k]) runOf2[v] = int(k);
+    std::vector<char> taken(runs2.size(), 0);
+    for (std::size_t k1 = 0; k1 < runs1.size(); ++k1) {
+      if (l1 == l2 && taken[k1]) continue;
+      const std::vector<int>& run = runs1[k1];
+      std::vector<int> votes(runs2.size(), 0);
+      for (int v : run) {
+        const auto it = runOf2.find(partnerOf[v]);
+        if (it != runOf2.end()) ++votes[it->second];
+      }
+      if (l1 == l2) votes[k1] = 0;  // a run does not face itself
+      if (votes.empty()) continue;
+      const int k2 = int(std::max_element(votes.begin(), votes.end()) - votes.begin());
+      if (votes[k2] == 0 || taken[k2]) continue;
+      taken[k2] = 1;
+      if (l1 == l2) taken[k1] = 1;
+      GapReport g;
+      g.closed = l1 != l2 && whole1 && whole2;
+      g.path_a = run;
+      g.path_b = runs2[k2];
+      for (int v : g.path_a)
+        if (partnerOf[v] >= 0) g.gap = std::max(g.gap, (P[partnerOf[v]] - P[v]).Norm());
+      if (l1 != l2 && (whole1 || whole2) && !g.closed)
+        g.reason = "a whole border loop faces only part of another loop";
+      auto onLoop = [&](int v) { return loopOf[v] == l1; };
+      if (l1 == l2 && loops[l1].closed && onLoop(g.path_a.front()) && onLoop(g.path_a.back()) &&
+          onLoop(g.path_b.front()) && onLoop(g.path_b.back())) {
+        // a runs forward along the loop beside b running backward: a's
+        // start meets b's end, a's end meets b's start.
+        const std::vector<int>& loop = loops[l1].vertices;
+        const int m = int(loop.size());
+        auto at = [&](int k) { return loop[((k % m) + m) % m]; };
+        std::unordered_set<int> used(g.path_a.begin(), g.path_a.end());
+        used.insert(g.path_b.begin(), g.path_b.end());
+        const int p = at(positionOf[g.path_a.front()] - 1), q = at(positionOf[g.path_b.back()] + 1);
+        if (!used.count(p) && !used.count(q) && (p == q || at(positionOf[q] + 1) == p)) {
+          g.path_a.insert(g.path_a.begin(), p);
+          g.path_b.push_back(q);
+          used.insert(p);
+          used.insert(q);
+        }
+        const int s = at(positionOf[g.path_a.back()] + 1), t = at(positionOf[g.path_b.front()] - 1);
+        if (!used.count(s) && !used.count(t) && (s == t || at(positionOf[s] + 1) == t)) {
+          g.path_a.push_back(s);
+          g.path_b.insert(g.path_b.begin(), t);
+        }
+      }
+      if (int(std::min(g.path_a.size(), g.path_b.size())) < minPathVertices) continue;
+      gaps.push_back(g);
+    }
+  }
+  return gaps;
 }
 
 }  // namespace
@@ -1521,20 +1873,33 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
   const auto start = Clock::now();
   requireFacesAndFiniteCoordinates(mesh, "the mesh");
   requireCompact(mesh);
-  if (options.merge_tolerance < 0 || options.max_gap < 0 || options.max_aspect_ratio < 0)
+  if (!(options.merge_tolerance >= 0) || !(options.max_gap >= 0) ||
+      !(options.max_aspect_ratio >= 0))
     throw InvalidInputError("merge_tolerance, max_gap and max_aspect_ratio must not be negative");
   CloseGapsResult r;
   std::vector<Point3> P = positionsOf(mesh);
   std::vector<Triangle> T = trianglesOf(mesh);
   r.border_edges_before = borderEdgesOf(T);
+  double scale = 1;
+  if (!options.absolute_distances) {
+    vcg::Box3d box;
+    for (const Point3& p : P) box.Add(p);
+    scale = box.Diag();
+  }
+  r.merge_tolerance = options.merge_tolerance * scale;
+  r.max_gap = options.max_gap * scale;
 
-  // ---- Step 1: merge coincident borders.
+  // ---- Step 1: orient, merge coincident borders.
   reportProgress(options.progress, 0, "Merging coincident borders");
+  const std::vector<int> classOf = coincidenceClasses(P, borderEdgesDirected(T), r.merge_tolerance);
+  if (options.orient_faces) orientConsistently(P, T, classOf, r);
+  std::vector<char> removedFace;
   std::vector<int> target;
-  mergeCoincidentBorders(P, T, target, options.merge_tolerance, r);
+  mergeCoincidentBorders(P, T, classOf, removedFace, target, r);
   const int n = int(P.size());
   r.vertex_index.assign(n, -1);
-  if (r.vertices_merged > 0) {
+  std::vector<char> changedFace(T.size(), 0);  // corners merged (for the check)
+  if (r.vertices_merged > 0 || r.faces_flipped > 0) {
     VertexOriginHandle vo = vertexOrigins(mesh);
     FaceOriginHandle fo = faceOrigins(mesh);
     std::vector<Point3> points;
@@ -1546,13 +1911,22 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
         vorig.push_back(vo[v]);
       }
     for (int v = 0; v < n; ++v) r.vertex_index[v] = r.vertex_index[target[v]];
+    std::vector<Triangle> kept;
     std::vector<FaceOrigin> forig;
+    std::vector<char> keptChanged;
+    const std::vector<Triangle> input = trianglesOf(mesh);
     for (std::size_t f = 0; f < T.size(); ++f) {
-      for (int& v : T[f]) v = r.vertex_index[v];
+      if (removedFace[f]) continue;
+      bool merged = false;
+      for (int k = 0; k < 3; ++k) merged = merged || target[input[f][k]] != input[f][k];
+      kept.push_back({r.vertex_index[T[f][0]], r.vertex_index[T[f][1]], r.vertex_index[T[f][2]]});
       forig.push_back(fo[f]);
+      keptChanged.push_back(merged);
     }
-    rebuildWithOrigins(mesh, points, T, vorig, forig);
+    rebuildWithOrigins(mesh, points, kept, vorig, forig);
     P = points;
+    T = kept;
+    changedFace = keptChanged;
   } else {
     std::iota(r.vertex_index.begin(), r.vertex_index.end(), 0);
   }
@@ -1560,102 +1934,14 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
   r.border_edges_after = r.border_edges_after_merge;
 
   // ---- Step 2: facing borders.
-  if (options.max_gap > 0) {
+  if (r.max_gap > 0) {
     reportProgress(options.progress, 30, "Finding facing borders");
-    double bound = options.max_gap;
-    if (!options.gap_absolute) {
-      vcg::Box3d box;
-      for (const Point3& p : P) box.Add(p);
-      bound *= box.Diag();
-    }
-    const std::vector<std::vector<int>> loops = borderLoops(T);
-    std::vector<int> loopOf(P.size(), -1);
-    std::vector<int> ids;
-    for (std::size_t l = 0; l < loops.size(); ++l)
-      for (int v : loops[l]) {
-        loopOf[v] = int(l);
-        ids.push_back(v);
-      }
-    const NearPoints near(P, ids, bound);
-    // Each border vertex's nearest border vertex on another loop.
-    std::vector<int> partnerOf(P.size(), -1);
-    for (std::size_t l = 0; l < loops.size(); ++l)
-      for (int v : loops[l]) {
-        double bestD = INFINITY;
-        near.near(P[v], [&](int w) {
-          if (loopOf[w] == int(l)) return;
-          const double d = (P[w] - P[v]).SquaredNorm();
-          if (d < bestD) bestD = d, partnerOf[v] = w;
-        });
-      }
-    // Cyclic runs of a loop's vertices whose partners are on loop `other`.
-    auto runsOf = [&](int l, int other) {
-      std::vector<std::vector<int>> runs;
-      const std::vector<int>& loop = loops[l];
-      const std::size_t m = loop.size();
-      auto facing = [&](std::size_t k) {
-        const int w = partnerOf[loop[k % m]];
-        return w >= 0 && loopOf[w] == other;
-      };
-      std::size_t first = 0;
-      while (first < m && facing(first)) ++first;
-      if (first == m) return std::vector<std::vector<int>>{loop};  // the whole loop
-      for (std::size_t k = first + 1; k <= first + m; ++k) {
-        if (!facing(k)) continue;
-        std::vector<int> run;
-        while (k <= first + m && facing(k)) run.push_back(loop[k++ % m]);
-        if (int(run.size()) >= options.min_path_vertices) runs.push_back(run);
-      }
-      return runs;
-    };
-    std::vector<std::array<int, 2>> loopPairs;
-    {
-      std::set<std::array<int, 2>> seen;
-      for (std::size_t l = 0; l < loops.size(); ++l)
-        for (int v : loops[l])
-          if (const int w = partnerOf[v]; w >= 0) {
-            const std::array<int, 2> key{std::min(int(l), loopOf[w]), std::max(int(l), loopOf[w])};
-            if (seen.insert(key).second) loopPairs.push_back(key);
-          }
-    }
-    for (const auto& [l1, l2] : loopPairs) {
-      const auto runs1 = runsOf(l1, l2), runs2 = runsOf(l2, l1);
-      const bool whole1 = runs1.size() == 1 && runs1[0].size() == loops[l1].size();
-      const bool whole2 = runs2.size() == 1 && runs2[0].size() == loops[l2].size();
-      std::vector<char> taken(runs2.size(), 0);
-      for (const std::vector<int>& run : runs1) {
-        // The run of l2 holding most partners of this run.
-        std::unordered_map<int, int> runOf2;
-        for (std::size_t k = 0; k < runs2.size(); ++k)
-          for (int v : runs2[k]) runOf2[v] = int(k);
-        std::vector<int> votes(runs2.size(), 0);
-        for (int v : run) {
-          const auto it = runOf2.find(partnerOf[v]);
-          if (it != runOf2.end()) ++votes[it->second];
-        }
-        if (votes.empty()) continue;
-        const int k2 = int(std::max_element(votes.begin(), votes.end()) - votes.begin());
-        if (votes[k2] == 0 || taken[k2]) continue;
-        taken[k2] = 1;
-        GapReport g;
-        g.closed = whole1 && whole2;
-        g.path_a = run;
-        g.path_b = runs2[k2];
-        for (int v : g.path_a)
-          if (partnerOf[v] >= 0) g.gap = std::max(g.gap, (P[partnerOf[v]] - P[v]).Norm());
-        if ((whole1 || whole2) && !g.closed) {
-          g.reason = "a whole border loop faces only part of another loop";
-          r.gaps.push_back(g);
-          continue;
-        }
-        r.gaps.push_back(g);
-      }
-    }
+    r.gaps = facingBorders(P, T, r.max_gap, options.min_path_vertices);
     r.gaps_found = r.gaps.size();
     // Stitch each pair on the current mesh (earlier stitches change borders).
     for (std::size_t k = 0; k < r.gaps.size(); ++k) {
       GapReport& g = r.gaps[k];
-      reportProgress(options.progress, 40 + int(55 * k / std::max<std::size_t>(1, r.gaps.size())),
+      reportProgress(options.progress, 40 + int(50 * k / std::max<std::size_t>(1, r.gaps.size())),
                      "Stitching");
       if (!g.reason.empty()) continue;
       StitchOptions so;
@@ -1684,6 +1970,17 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
         g.reason = e.what();
       }
     }
+  }
+  // ---- The output's intersecting pairs that involve a merged or new face.
+  if (options.verify) {
+    reportProgress(options.progress, 90, "Checking the result");
+    changedFace.resize(mesh.face.size(), 1);
+    const std::vector<Point3> points = positionsOf(mesh);
+    const std::vector<Triangle> triangles = trianglesOf(mesh);
+    r.remaining_intersecting_pairs =
+        intersectingOf(points, triangles, pairsWithChangedFaces(points, triangles, changedFace))
+            .size();
+    r.verified = true;
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);
@@ -1755,15 +2052,19 @@ JsonObject toJson(const CloseGapsResult& r) {
       .set("border_edges_after", r.border_edges_after)
       .set("faces_added", r.faces_added)
       .set("vertices_merged", r.vertices_merged)
+      .set("merge_tolerance", r.merge_tolerance)
+      .set("max_gap", r.max_gap)
+      .set("faces_flipped", r.faces_flipped)
+      .set("orientation_conflicts", r.orientation_conflicts)
       .set("border_edges_after_merge", r.border_edges_after_merge)
       .set("edges_merged", r.edges_merged)
       .set("merges_skipped", r.merges_skipped)
+      .set("degenerate_faces_removed", r.degenerate_faces_removed)
       .set("vertices_added", r.vertices_added)
       .set("gaps_found", r.gaps_found)
-      .set("gaps_stitched", r.gaps_stitched)
-      .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs)
-      .set("gaps", gaps)
-      .set("time_ms", r.time_ms);
+      .set("gaps_stitched", r.gaps_stitched);
+  if (r.verified) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
+  j.set("gaps", gaps).set("time_ms", r.time_ms);
   return j;
 }
 

@@ -187,23 +187,39 @@ std::vector<BorderPath> borderPathsFromSelection(const Mesh& mesh,
 // ---------------------------------------------------------------- gap closing
 
 struct CloseGapsOptions {
-  // ---- Step 1 (what CGAL's stitch_borders does, with a tolerance): pairs
-  // of border edges whose end points coincide within merge_tolerance
-  // (absolute; 0 = exactly equal coordinates) and that run opposite ways are
-  // merged into one edge. A merge that would make an edge non-manifold, run
-  // it the same way twice or collapse a face is skipped.
+  // merge_tolerance and max_gap are fractions of the bounding box diagonal
+  // (scripts then work on meshes of any size), or mesh units with this set.
+  bool absolute_distances = false;
+  // ---- Step 1 (what CGAL's stitch_borders does, with a tolerance and
+  // more): border edges whose end points coincide within merge_tolerance
+  // (0 = exactly equal coordinates) and that run opposite ways are merged
+  // into one edge; a border edge whose two ends coincide collapses (its
+  // face has no area: it goes). A merge that would make an edge non-manifold
+  // or run it the same way twice is skipped. Where more than two border
+  // edges coincide (solids touching along an edge), each pairs with the next
+  // one around the edge behind its face; their vertices stay apart where the
+  // solids only touch (a vertex split).
   double merge_tolerance = 0;
-  // ---- Step 2: border loops (or parts of them) facing each other within
-  // this distance are stitched (stitchPaths' triangulation). Relative to the
-  // bounding box diagonal unless gap_absolute; 0 = no stitching.
+  // Before merging, faces are flipped so that faces meeting at an edge
+  // (coincident border vertices count as one) run it opposite ways: the
+  // facets of a soup oriented against their neighbours then merge. A part
+  // that needs flips keeps, when closed, the outward orientation (positive
+  // volume), else the orientation of most of its area. false: faces keep
+  // their orientation, and edges they run the same way stay open.
+  bool orient_faces = true;
+  // ---- Step 2: border runs facing each other within max_gap are stitched
+  // (stitchPaths' triangulation): runs of two loops, or the two sides of a
+  // crack in one loop. 0 = no stitching.
   double max_gap = 0.01;
-  bool gap_absolute = false;
   // Runs of fewer border vertices facing another border are left open.
   int min_path_vertices = 2;
   double max_aspect_ratio = 0;  // subdivision of the stitched strips (StitchOptions)
   // Exact check per stitch; a stitch whose faces would intersect the mesh is
   // left out (with its reason).
   bool check_intersections = true;
+  // Count, exactly, the output's intersecting pairs that involve a merged or
+  // stitched face (remaining_intersecting_pairs).
+  bool verify = true;
   Progress progress;  // called between stages
 };
 
@@ -218,17 +234,26 @@ struct GapReport {
 };
 
 struct CloseGapsResult {
+  double merge_tolerance = 0;  // the distances used, in mesh units
+  double max_gap = 0;
   std::size_t border_edges_before = 0;
   std::size_t border_edges_after_merge = 0;
   std::size_t border_edges_after = 0;
-  std::size_t vertices_merged = 0;  // step 1
-  std::size_t edges_merged = 0;     // border edge pairs merged in step 1
-  std::size_t merges_skipped = 0;   // step 1 pairs refused (manifoldness, orientation)
-  std::size_t faces_added = 0;      // step 2
-  std::size_t vertices_added = 0;   // step 2 subdivision
-  std::size_t gaps_found = 0;       // facing pairs
+  std::size_t faces_flipped = 0;             // step 1, orient_faces
+  std::size_t orientation_conflicts = 0;     // two-face edges left running one way (non-orientable)
+  std::size_t vertices_merged = 0;           // step 1
+  std::size_t edges_merged = 0;              // border edge pairs merged in step 1
+  std::size_t merges_skipped = 0;            // step 1 merges refused (manifoldness, orientation)
+  std::size_t degenerate_faces_removed = 0;  // collapsed by step 1
+  std::size_t faces_added = 0;               // step 2
+  std::size_t vertices_added = 0;            // step 2 subdivision
+  std::size_t gaps_found = 0;                // facing pairs
   std::size_t gaps_stitched = 0;
-  std::size_t remaining_intersecting_pairs = 0;  // involving new faces (0 with the check)
+  // With verify: intersecting pairs (exact, the self-intersection rule) of
+  // the output with a merged or stitched face in them. Faces that only touch
+  // where coincident vertices stay apart count.
+  std::size_t remaining_intersecting_pairs = 0;
+  bool verified = false;
   std::vector<GapReport> gaps;
   // For every input vertex its index in the output (merged vertices share one).
   std::vector<int> vertex_index;
@@ -236,8 +261,9 @@ struct CloseGapsResult {
 };
 
 // Closes the gaps between the borders of `mesh` (in place). Vertices merged
-// in step 1 are removed (indices change: see vertex_index); stitched faces
-// are appended. Never creates a non-manifold edge or an orientation conflict.
+// in step 1 are removed, and so are collapsed faces (indices change: see
+// vertex_index); stitched faces are appended. Never creates a non-manifold
+// edge or an orientation conflict.
 // Throws InvalidInputError for an empty mesh, a non-finite coordinate or a
 // bad option.
 CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options = {});

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <string>
 
 #include "common/errors.h"
@@ -641,12 +642,208 @@ TEST(CloseGaps, FacingSidesOfTwoPlates) {
   Mesh m = appended(A, B);
   CloseGapsOptions o;
   o.max_gap = 0.04;
-  o.gap_absolute = true;
+  o.absolute_distances = true;
   const CloseGapsResult r = closeGaps(m, o);
   EXPECT_EQ(r.gaps_stitched, 1u);
   EXPECT_EQ(r.faces_added, 10u);
   expectClean(m, 2 * 15 + 2 * 12 - 10 + 2, m.vert.size());
   EXPECT_EQ(r.border_edges_after, 2u * 15 + 2 * 12 - 10 + 2);
+}
+
+// Every face with its own three vertices, as an STL file stores it; the
+// faces for which flip(face) holds are turned over.
+Mesh soupOf(
+    const Mesh& m, const std::function<bool(int)>& flip = [](int) { return false; }) {
+  const std::vector<Point3> P = positionsOf(m);
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  const std::vector<Triangle> T = trianglesOf(m);
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    const int first = int(points.size());
+    for (int v : T[f]) points.push_back(P[v]);
+    triangles.push_back(flip(int(f)) ? Triangle{first, first + 2, first + 1}
+                                     : Triangle{first, first + 1, first + 2});
+  }
+  return makeMesh(points, triangles);
+}
+
+TEST(CloseGaps, SoupWithFacetsAgainstTheirNeighboursIsOrientedOutwardAndClosed) {
+  const int n = 3;
+  const Mesh cube = gridCube(n);
+  auto everyThird = [](int f) { return f % 3 == 0; };
+  Mesh m = soupOf(cube, everyThird);
+  const std::size_t flippedInInput = (cube.face.size() + 2) / 3;
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_EQ(r.faces_flipped, flippedInInput);  // the minority, back
+  EXPECT_EQ(r.orientation_conflicts, 0u);
+  EXPECT_EQ(r.border_edges_after, 0u);
+  expectClean(m, 0, cube.vert.size());
+  EXPECT_NEAR(volumeOf(m), 1.0, 1e-12);  // outward
+  // Mostly inward facets: the closed part is still turned outward.
+  Mesh inward = soupOf(cube, [](int f) { return f % 3 != 0; });
+  const CloseGapsResult ri = closeGaps(inward);
+  EXPECT_EQ(ri.faces_flipped, cube.face.size() - flippedInInput);
+  EXPECT_NEAR(volumeOf(inward), 1.0, 1e-12);
+  // Without orienting, the edges between facets that disagree stay open.
+  Mesh kept = soupOf(cube, everyThird);
+  CloseGapsOptions o;
+  o.orient_faces = false;
+  const CloseGapsResult rk = closeGaps(kept, o);
+  EXPECT_EQ(rk.faces_flipped, 0u);
+  EXPECT_GT(rk.border_edges_after, 0u);
+  EXPECT_EQ(edgeStats(kept).nonManifold, 0u);
+  EXPECT_EQ(edgeStats(kept).inconsistent, 0u);
+  EXPECT_EQ(rk.border_edges_after, edgeStats(kept).border);
+}
+
+TEST(CloseGaps, OpenSheetKeepsTheOrientationOfMostOfItsArea) {
+  const Mesh s = sheet(4, 3, [](int i, int j) { return Point3(i, j, 0.1 * i * j); });
+  Mesh m = soupOf(s, [](int f) { return f == 5 || f == 10; });
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_EQ(r.faces_flipped, 2u);
+  expectClean(m, 2 * (4 + 3), s.vert.size());
+  // Every face runs its corners the way the sheet's faces do (normals up).
+  for (const Face& f : m.face) {
+    const Point3 normal = (f.cV(1)->cP() - f.cV(0)->cP()) ^ (f.cV(2)->cP() - f.cV(0)->cP());
+    EXPECT_GT(normal[2], 0);
+  }
+}
+
+TEST(CloseGaps, SolidsTouchingAlongAnEdgeCloseSeparately) {
+  // Two unit cubes sharing only the edge x = y = 1: four facets meet there.
+  const Mesh a = gridCube(2), b = moved(gridCube(2), {1, 1, 0});
+  Mesh m = soupOf(appended(a, b), [](int f) { return f % 2 == 1; });
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_EQ(r.border_edges_after, 0u);
+  const EdgeStats s = edgeStats(m);
+  EXPECT_EQ(s.border, 0u);
+  EXPECT_EQ(s.nonManifold, 0u);
+  EXPECT_EQ(s.inconsistent, 0u);
+  // The vertices of the shared edge stay apart (one copy per cube).
+  EXPECT_EQ(m.vert.size(), a.vert.size() + b.vert.size());
+  EXPECT_NEAR(volumeOf(m), 2.0, 1e-12);
+  // The cubes touch along the edge without sharing a vertex there: those
+  // pairs count, and the count is the whole output's (every face merged).
+  ASSERT_TRUE(r.verified);
+  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
+}
+
+TEST(CloseGaps, BorderEdgeOfZeroLengthCollapsesItsFace) {
+  // CGAL's deg_border case: a fan above the x axis whose border repeats the
+  // point (2, 0) (a face of zero area on it), a fan below without it.
+  const std::vector<Point3> P{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 0, 0}, {3, 0, 0}, {1, 1, 0},
+                              {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}, {1, -1, 0}};
+  const std::vector<Triangle> T{{0, 1, 5},  {1, 2, 5},  {2, 3, 5}, {3, 4, 5},
+                                {7, 6, 10}, {8, 7, 10}, {9, 8, 10}};
+  Mesh m = makeMesh(P, T);
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_EQ(r.border_edges_before, 11u);
+  EXPECT_EQ(r.degenerate_faces_removed, 1u);
+  EXPECT_EQ(r.edges_merged, 3u);
+  EXPECT_EQ(r.border_edges_after, 4u);  // the two fans' outer sides
+  EXPECT_EQ(m.face.size(), 6u);
+  EXPECT_EQ(edgeStats(m).border, 4u);
+  EXPECT_EQ(edgeStats(m).nonManifold, 0u);
+  EXPECT_EQ(edgeStats(m).inconsistent, 0u);
+  // Without the collapse (the repeated point apart), CGAL's count remains.
+  std::vector<Point3> apart = P;
+  apart[3] = {2.5, 0, 0};
+  Mesh n = makeMesh(apart, T);
+  CloseGapsOptions o;
+  o.max_gap = 0;
+  EXPECT_EQ(closeGaps(n, o).degenerate_faces_removed, 0u);
+}
+
+TEST(CloseGaps, CrackInsideOneBorderIsClosed) {
+  // A 6 x 4 grid whose faces above y = 2 no longer share the vertices
+  // (2..4, 2) with the faces below: their own copies are 0.01 higher. The
+  // crack between x = 1 and x = 5 is one border loop whose two sides face
+  // each other, with its tips at (1, 2) and (5, 2).
+  const int nu = 6, nv = 4;
+  Mesh grid = sheet(nu, nv, [](int i, int j) { return Point3(i, j, 0); });
+  std::vector<Point3> P = positionsOf(grid);
+  std::vector<Triangle> T = trianglesOf(grid);
+  std::map<int, int> upper;  // crack vertex (i, 2), 1 < i < 5 -> its upper copy
+  for (int i = 2; i <= 4; ++i) {
+    const int v = 2 * (nu + 1) + i;
+    upper[v] = int(P.size());
+    P.push_back(P[v] + Point3(0, 0.01, 0));
+  }
+  for (Triangle& t : T) {
+    double y = 0;
+    for (int v : t) y += P[v][1];
+    if (y / 3 > 2)
+      for (int& v : t)
+        if (upper.count(v)) v = upper[v];
+  }
+  Mesh m = makeMesh(P, T);
+  ASSERT_EQ(edgeStats(m).border, 2u * (nu + nv) + 2 * 4);
+  CloseGapsOptions o;
+  o.absolute_distances = true;
+  o.max_gap = 0.05;
+  const CloseGapsResult r = closeGaps(m, o);
+  ASSERT_EQ(r.gaps_found, 1u);
+  EXPECT_TRUE(r.gaps[0].stitched) << r.gaps[0].reason;
+  // Sides of four edges sharing both tips: four faces on one side, two on
+  // the other, whose end edges close the strip at the tips.
+  EXPECT_EQ(r.faces_added, 6u);
+  expectClean(m, 2u * (nu + nv), P.size());
+  // A bound below the crack's width leaves it.
+  Mesh wide = makeMesh(P, T);
+  o.max_gap = 0.005;
+  EXPECT_EQ(closeGaps(wide, o).faces_added, 0u);
+}
+
+TEST(CloseGaps, DistancesAreFractionsOfTheDiagonalUnlessAbsolute) {
+  Mesh m = openBoxHalves(4, 1e-3);
+  vcg::Box3d box;
+  for (const Point3& p : positionsOf(m)) box.Add(p);
+  CloseGapsOptions o;
+  o.max_gap = 0;
+  o.merge_tolerance = 1e-3;  // of the diagonal (about 1.73): more than the lift
+  const CloseGapsResult r = closeGaps(m, o);
+  EXPECT_DOUBLE_EQ(r.merge_tolerance, 1e-3 * box.Diag());
+  EXPECT_EQ(r.vertices_merged, 16u);
+  EXPECT_EQ(r.border_edges_after, 0u);
+  Mesh apart = openBoxHalves(4, 1e-3);
+  o.absolute_distances = true;
+  o.merge_tolerance = 0.9e-3;  // less than the lift
+  const CloseGapsResult ra = closeGaps(apart, o);
+  EXPECT_DOUBLE_EQ(ra.merge_tolerance, 0.9e-3);
+  EXPECT_EQ(ra.vertices_merged, 0u);
+  EXPECT_EQ(ra.border_edges_after, 2u * 4 * 4);
+}
+
+TEST(CloseGaps, VerifyCountsThePairsOfMergedAndStitchedFaces) {
+  Mesh m = openBoxHalves(4, 0.02);
+  CloseGapsOptions o;
+  o.max_gap = 0.02;
+  const CloseGapsResult r = closeGaps(m, o);
+  ASSERT_EQ(r.gaps_stitched, 1u);
+  EXPECT_TRUE(r.verified);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(selfIntersectingPairs(m), 0u);
+  EXPECT_NE(toJson(r).str().find("remaining_intersecting_pairs"), std::string::npos);
+  // A small triangle across the gap, through the wall y = 0: the checked
+  // stitch leaves the gap open; unchecked, the verification finds the pairs
+  // the stitch made (the only ones: the triangle touches nothing else).
+  const Mesh across =
+      makeMesh({{0.6, -0.03, 0.505}, {0.6, 0.03, 0.505}, {0.6, 0, 0.515}}, {{0, 1, 2}});
+  Mesh checked = appended(openBoxHalves(4, 0.02), across);
+  EXPECT_EQ(closeGaps(checked, o).gaps_stitched, 0u);
+  EXPECT_EQ(selfIntersectingPairs(checked), 0u);
+  Mesh crossed = appended(openBoxHalves(4, 0.02), across);
+  o.check_intersections = false;
+  const CloseGapsResult rc = closeGaps(crossed, o);
+  ASSERT_GE(rc.gaps_stitched, 1u);
+  EXPECT_GT(rc.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(rc.remaining_intersecting_pairs, selfIntersectingPairs(crossed));
+  o.verify = false;
+  Mesh unverified = openBoxHalves(4, 0.02);
+  const CloseGapsResult ru = closeGaps(unverified, o);
+  EXPECT_FALSE(ru.verified);
+  EXPECT_EQ(toJson(ru).str().find("remaining_intersecting_pairs"), std::string::npos);
 }
 
 TEST(Reports, JsonKeys) {

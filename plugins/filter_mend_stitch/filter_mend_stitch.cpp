@@ -340,6 +340,11 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "Border vertices closer than this fraction of the bounding box diagonal are merged "
         "where their border edges pair up; 0 merges only exactly equal coordinates (what "
         "CGAL's stitch_borders does)."));
+    parameters.addParam(RichBool(
+        "orient_faces", true, "Orient faces consistently",
+        "Before merging, flips faces so that faces meeting at an edge run it opposite ways "
+        "(soups whose facets face against their neighbours then merge); a part that needs it is "
+        "turned outward when closed, else keeps the orientation of most of its area."));
     parameters.addParam(
         RichFloat("max_gap", 0.01f, "Max gap (fraction of the diagonal)",
                   "Borders facing each other within this fraction of the bounding box diagonal are "
@@ -664,13 +669,14 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
                              vcg::CallBackPos* cb) {
   CloseGapsOptions options;
   options.progress = progressFrom(cb);
-  const double mergeFraction = parameters.getFloat("merge_tolerance");
+  options.merge_tolerance = parameters.getFloat("merge_tolerance");  // fractions of the diagonal
   options.max_gap = parameters.getFloat("max_gap");
-  options.gap_absolute = false;
+  options.orient_faces = parameters.getBool("orient_faces");
   options.min_path_vertices = parameters.getInt("min_path_vertices");
   options.max_aspect_ratio = parameters.getFloat("max_aspect_ratio");
   options.check_intersections = parameters.getBool("check_intersections");
-  if (!(mergeFraction >= 0) || !(options.max_gap >= 0) || !(options.max_aspect_ratio >= 0))
+  if (!(options.merge_tolerance >= 0) || !(options.max_gap >= 0) ||
+      !(options.max_aspect_ratio >= 0))
     throw InvalidInputError(
         "the merge tolerance, the max gap and the aspect ratio bound must not be negative");
   const bool allVisible = parameters.getBool("all_visible_layers");
@@ -697,11 +703,6 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   }
   const std::string what = allVisible ? "the visible layers" : layerName(*layers[0]);
   requireFacesAndFiniteCoordinates(*core, what);
-  // The tolerance is a fraction of the diagonal, like the gap: scripts then
-  // work on meshes of any size.
-  vcg::Box3d box;
-  for (const Vertex& v : core->vert) box.Add(v.cP());
-  options.merge_tolerance = mergeFraction * box.Diag();
   const std::size_t facesBefore = core->face.size();
 
   const CloseGapsResult r = meshmend::closeGaps(*core, options);
@@ -723,9 +724,13 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
       Log("  gap %zu (%zu and %zu vertices, width %.3g): left open: %s", k, g.path_a.size(),
           g.path_b.size(), g.gap, g.reason.c_str());
   }
+  if (r.faces_flipped || r.degenerate_faces_removed)
+    Log("  %zu faces flipped to agree with their neighbours, %zu collapsed faces removed",
+        r.faces_flipped, r.degenerate_faces_removed);
   if (r.vertices_added)
     Log("  note: the %zu new vertices are stored in float (computed in double)", r.vertices_added);
-  if (r.vertices_merged == 0 && r.faces_added == 0 && !allVisible) {
+  if (r.vertices_merged == 0 && r.faces_added == 0 && r.faces_flipped == 0 &&
+      r.degenerate_faces_removed == 0 && !allVisible) {
     Log("MeshMend: nothing to merge or stitch; the layer is unchanged");
     return;
   }
