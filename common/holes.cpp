@@ -1065,19 +1065,20 @@ std::array<double, 3> cotangents(const Point3& a, const Point3& b, const Point3&
   return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
 }
 
-// The membrane (harmonic) system raises edge weights below this to it:
+// The membrane (harmonic) system, and the curvature samples of the
+// regression, raise edge weights below this to it:
 // obtuse triangles give negative cotangent sums, which would make its
 // matrix indefinite. The least-squares systems (biharmonic, regression)
 // are positive semi-definite whatever the signs and keep the true weights:
 // raising them would bend a flat fan whose triangles are slivers (CAD
 // meshes), where the true weights give it a zero Laplacian.
-constexpr double kMembraneMinimumWeight = 0.05;
+constexpr double kPositiveWeightFloor = 0.05;
 
 // One vertex's Laplacian: neighbours (keys) with cotangent weights w_ij (Eq. 2-3).
 struct LaplacianRow {
   std::vector<std::pair<int, double>> weights;  // key, omega (not normalised)
   double total = 0;
-  double area = 0;  // a third of the area of the faces around the vertex
+  double area = 0;  // the mixed Voronoi area of the vertex (A of Eq. 4)
 
   void add(int key, double omega) {
     for (auto& [k, w] : weights)
@@ -1094,14 +1095,30 @@ struct LaplacianRow {
   }
 };
 
-// Cotangents at the corners of a triangle, and a third of its area.
+// Cotangents at the corners of a triangle, and the part of its area each
+// corner's Laplacian counts (Meyer et al.'s mixed Voronoi area: the Voronoi
+// part in a non-obtuse triangle, else half the area to the obtuse corner
+// and a quarter to each other one).
 struct TriangleWeights {
   std::array<double, 3> cot;
-  double thirdArea;
+  std::array<double, 3> area;
 };
 
 TriangleWeights triangleWeights(const Point3& a, const Point3& b, const Point3& c) {
-  return {cotangents(a, b, c), ((b - a) ^ (c - a)).Norm() / 6};
+  TriangleWeights w{cotangents(a, b, c), {0, 0, 0}};
+  const double area = ((b - a) ^ (c - a)).Norm() / 2;
+  const std::array<Point3, 3> p{a, b, c};
+  for (int k = 0; k < 3; ++k)
+    if (w.cot[k] < 0) {  // obtuse at k
+      for (int m = 0; m < 3; ++m) w.area[m] = m == k ? area / 2 : area / 4;
+      return w;
+    }
+  for (int k = 0; k < 3; ++k) {
+    const int j = (k + 1) % 3, l = (k + 2) % 3;
+    w.area[k] =
+        ((p[l] - p[k]).SquaredNorm() * w.cot[j] + (p[j] - p[k]).SquaredNorm() * w.cot[l]) / 8;
+  }
+  return w;
 }
 
 // Adds a triangle (keys k[0..2]) to the row of its corner `corner`.
@@ -1110,7 +1127,7 @@ void addTriangleToRow(LaplacianRow& row, const std::array<int, 3>& k, const Tria
   const int j = (corner + 1) % 3, l = (corner + 2) % 3;
   row.add(k[j], w.cot[l]);
   row.add(k[l], w.cot[j]);
-  row.area += w.thirdArea;
+  row.area += w.area[corner];
 }
 
 void addTriangleToRow(LaplacianRow& row, const std::array<int, 3>& k,
@@ -1872,7 +1889,7 @@ class HoleFiller {
   };
 
   // The membrane L x = 0 over the new vertices, boundary fixed (symmetric
-  // form, weights raised to kMembraneMinimumWeight): the harmonic shape, and
+  // form, weights raised to kPositiveWeightFloor): the harmonic shape, and
   // the flat placement over a disk. Its rows are those of the new vertices
   // alone: the membrane does not see the surface beyond the boundary.
   bool membrane(std::vector<Point3>& x, MembraneWeights kind, double& residual) const {
@@ -1894,7 +1911,7 @@ class HoleFiller {
             if (c != v) row.add(c, 0.5);  // each neighbour on two faces around v: 1
         row.finish();
       } else {
-        rowOf(v, weights, row, kMembraneMinimumWeight);
+        rowOf(v, weights, row, kPositiveWeightFloor);
       }
       entries.push_back({int(r), int(r), row.total});
       diagonal += row.total;
@@ -1971,7 +1988,9 @@ class HoleFiller {
       bool closedFan = !count.empty();
       for (const auto& [c, k] : count) closedFan = closedFan && k == 2;
       if (!closedFan || !(area > 0) || !(n.Norm() > 0)) continue;
-      row.finish();
+      // Raised weights: one sliver in a scan's ring must not make its
+      // vertex's curvature sample an outlier the regression then spreads.
+      row.finish(kPositiveWeightFloor);
       Point3 sum(0, 0, 0);
       for (const auto& [c, w] : row.weights) sum += (s_.points[c] - s_.points[v]) * w;
       n.Normalize();
