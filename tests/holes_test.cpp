@@ -400,6 +400,58 @@ TEST(HoleShape, SphereCapInEveryMode) {
   EXPECT_LT(deviation[HoleFairing::Biharmonic], deviation[HoleFairing::Flat] / 4);
 }
 
+// A tube of obtuse slivers (each triangle 0.52 wide and 0.1 high, like a
+// CAD export's): the biharmonic patch of a hole in its side continues the
+// cylinder. The slivers' cotangent weights are negative; raised to a floor
+// they would bend the rows of the border vertices.
+TEST(HoleShape, HoleInATubeOfSliversFollowsTheCylinder) {
+  Mesh m = withHole(openTube(12, 40, 1, 4),
+                    [](const Point3& c) { return (c - Point3(1, 0, 2)).Norm() < 0.9; });
+  HoleFillOptions o = withFairing(HoleFairing::Biharmonic);
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_found, 3u);  // the tube's two ends and the hole
+  ASSERT_EQ(r.holes_filled, 3u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectSound(m, 0);
+  const std::vector<Point3> P = positionsOf(m);
+  double worst = 0;
+  std::size_t inSide = 0;
+  for (int v : r.new_vertices)
+    if (P[v][2] > 0.5 && P[v][2] < 3.5) {  // the side hole's (the ends' patches are flat)
+      ++inSide;
+      worst = std::max(worst, std::abs(std::hypot(P[v][0], P[v][1]) - 1));
+    }
+  ASSERT_GT(inSide, 10u);
+  std::cout << "tube of slivers: " << inSide << " patch vertices, max distance to the cylinder "
+            << worst << "\n";
+  EXPECT_LT(worst, 0.1);  // raised to a floor of 0.05, the weights give 0.44
+}
+
+// A round hole around the rim of a thin plate: its border folds over the
+// rim, so every plane squeezes part of it. The patch over the disk competes
+// with the plane's, and whichever is taken, the shape is biharmonic and
+// stays near the plate.
+TEST(HoleShape, HoleAroundTheRimOfAThinPlate) {
+  Mesh plate = gridCube(12);
+  for (auto& v : plate.vert) v.P()[2] *= 0.15;
+  Mesh m =
+      withHole(plate, [](const Point3& c) { return (c - Point3(1, 0.5, 0.075)).Norm() < 0.25; });
+  const HoleFillResult r = fillHoles(m, withFairing(HoleFairing::Biharmonic));
+  ASSERT_EQ(r.holes_found, 1u);
+  ASSERT_EQ(r.holes_filled, 1u) << r.holes[0].reason;
+  EXPECT_EQ(r.holes[0].fairing, HoleFairing::Biharmonic) << r.holes[0].reason;
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectSound(m, 0);
+  const std::vector<Point3> P = positionsOf(m);
+  for (int v : r.new_vertices) {
+    EXPECT_GT(P[v][2], -0.05);
+    EXPECT_LT(P[v][2], 0.2);
+    EXPECT_LT(P[v][0], 1.05);
+  }
+  std::cout << "thin plate rim: " << r.faces_added << " faces, over "
+            << (r.holes[0].planar_domain ? "the plane" : "a disk") << "\n";
+}
+
 // ---- Intersections ----------------------------------------------------------------------
 
 TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
