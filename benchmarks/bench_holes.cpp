@@ -3,10 +3,11 @@
 // same holes in the same run. Fills every hole of FILE. Prints one JSON object.
 //
 // Methods:
-//   meshmend_regression   ours, fillHoles with the default options (the
+//   meshmend_biharmonic   ours, fillHoles with the default options (the
+//                         biharmonic shape)
+//   meshmend_regression, meshmend_harmonic, meshmend_flat
+//                         ours with the other patch shapes (regression: the
 //                         paper's LS-SVM Laplacian regression)
-//   meshmend_biharmonic, meshmend_harmonic, meshmend_flat
-//                         ours with the other patch shapes
 //   cgal_refine_fair      PMP::triangulate_refine_and_fair_hole on each border
 //                         cycle (defaults: Delaunay search space, fairing
 //                         continuity 1), on a Surface_mesh copy; only the calls
@@ -295,7 +296,7 @@ int main(int argc, char** argv) {
   int repeat = 5, limit = 600;
   std::string outDir, file;
   bool bad = false;
-  std::vector<std::string> names = {"meshmend_regression", "meshmend_biharmonic",
+  std::vector<std::string> names = {"meshmend_biharmonic", "meshmend_regression",
                                     "meshmend_harmonic",   "meshmend_flat",
                                     "cgal_refine_fair",    "meshlab_close_holes"};
   for (int i = 1; i < argc; ++i) {
@@ -323,9 +324,10 @@ int main(int argc, char** argv) {
     const std::string stem = outDir.empty() ? "" : outDir + "/" + name;
     std::pair<Method, Method> p;
     if (name == "meshmend_regression")
-      p = passes(name, "ours", ours(file, HoleFairing::LaplacianRegression, repeat), stem, repeat);
+      p = passes(name, "alternative", ours(file, HoleFairing::LaplacianRegression, repeat), stem,
+                 repeat);
     else if (name == "meshmend_biharmonic")
-      p = passes(name, "alternative", ours(file, HoleFairing::Biharmonic, repeat), stem, repeat);
+      p = passes(name, "ours", ours(file, HoleFairing::Biharmonic, repeat), stem, repeat);
     else if (name == "meshmend_harmonic")
       p = passes(name, "alternative", ours(file, HoleFairing::Harmonic, repeat), stem, repeat);
     else if (name == "meshmend_flat")

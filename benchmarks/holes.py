@@ -41,9 +41,11 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"
 
 MESHES = ["spot.obj", "fandisk.obj", "armadillo.off", "igea.ply", "horse.ply"]
-OURS = ["meshmend_regression", "meshmend_biharmonic", "meshmend_harmonic", "meshmend_flat"]
-MODE_LABEL = {"meshmend_regression": "ours: regression (default)",
-              "meshmend_biharmonic": "ours: biharmonic", "meshmend_harmonic": "ours: harmonic",
+OURS = ["meshmend_biharmonic", "meshmend_regression", "meshmend_harmonic", "meshmend_flat"]
+DEFAULT = OURS[0]  # what fillHoles does with its default options
+DEFAULT_FAIRING = "biharmonic"
+MODE_LABEL = {"meshmend_biharmonic": "ours: biharmonic (default)",
+              "meshmend_regression": "ours: regression", "meshmend_harmonic": "ours: harmonic",
               "meshmend_flat": "ours: flat"}
 METHODS = OURS + ["cgal", "meshlab"]
 SAMPLES = 100000  # meshcheck --vs samples per surface
@@ -752,17 +754,16 @@ def speed(tools, repeat, work, fidelity_holes):
                   check["longest_border_loop"] == h["border_edges"] and
                   check["connected_components"] == 1)
     timing = tools.bench(d / "holed.off", repeat, d,
-                         ["meshmend_regression", "cgal_refine_fair", "meshlab_close_holes"])
+                         [DEFAULT, "cgal_refine_fair", "meshlab_close_holes"])
     hV, hF = read_mesh(d / "holed.off")
     h["timing"] = timing
-    h["report"] = json.loads((d / "meshmend_regression.json").read_text())
-    if timing["meshmend_regression"]["ok"]:
-        h["ours"] = measure_output(tools, h, hV, hF, "meshmend_regression",
-                                   d / "meshmend_regression.ply")
+    h["report"] = json.loads((d / f"{DEFAULT}.json").read_text())
+    if timing[DEFAULT]["ok"]:
+        h["ours"] = measure_output(tools, h, hV, hF, DEFAULT, d / f"{DEFAULT}.ply")
     if timing["cgal_refine_fair"]["ok"]:
         h["cgal"] = measure_output(tools, h, hV, hF, "cgal", d / "cgal_refine_fair.off")
     h["rows"] = [speed_row("sphere, 1,000-edge hole", h["border_edges"], h["faces"],
-                           timing["meshmend_regression"], timing["cgal_refine_fair"],
+                           timing[DEFAULT], timing["cgal_refine_fair"],
                            timing["meshlab_close_holes"], h["report"]["median_holes_ms"])]
     for f in fidelity_holes:
         if f["label"] == "round L":
@@ -893,7 +894,7 @@ def tables(holes, sp, repeat, machine, elapsed):
                         for h in holes) for m in OURS}
     goal = share["mean"] >= 0.8 * n
     out += ["",
-            f"**Summary** ({n} holes). Our default mode (regression) is at least as accurate as "
+            f"**Summary** ({n} holes). Our default mode ({DEFAULT_FAIRING}) is at least as accurate as "
             f"CGAL on **{share['mean']} of {n} holes ({100 * share['mean'] / n:.0f} %) by mean "
             f"distance** (goal of issue 7: ≥ 80 %, {'met' if goal else 'not met'}), "
             f"{share['max']} of {n} ({100 * share['max'] / n:.0f} %) by maximum distance and "
@@ -903,15 +904,14 @@ def tables(holes, sp, repeat, machine, elapsed):
             ", ".join(f"{MODE_LABEL[m].split(': ')[1]} {best_mode[m]} of {n}" for m in OURS) + ".",
             ""]
     open_holes = {m: [f"{h['mesh']} {h['label']}" for h in holes
-                      if not h["results"][m].get("filled")] for m in ["meshmend_regression",
-                                                                       "cgal", "meshlab"]}
+                      if not h["results"][m].get("filled")] for m in [DEFAULT, "cgal", "meshlab"]}
     fallbacks = [f"{h['mesh']} {h['label']}" for h in holes
                  if h["results"][OURS[0]].get("filled") and
-                 h["results"][OURS[0]].get("fairing") != "laplacian_regression"]
+                 h["results"][OURS[0]].get("fairing") != DEFAULT_FAIRING]
     out[-1:] = ["",
                 "Holes left open (or partly open): ours (default) "
-                f"{len(open_holes['meshmend_regression'])} "
-                f"({', '.join(open_holes['meshmend_regression']) or 'none'}; our reasons in the "
+                f"{len(open_holes[DEFAULT])} "
+                f"({', '.join(open_holes[DEFAULT]) or 'none'}; our reasons in the "
                 "table above), CGAL "
                 f"{len(open_holes['cgal'])} ({', '.join(open_holes['cgal']) or 'none'}), MeshLab "
                 f"{len(open_holes['meshlab'])} ({', '.join(open_holes['meshlab']) or 'none'}). "
