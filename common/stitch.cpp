@@ -489,36 +489,42 @@ class LocalEdges {
     int slots = 0;
     for (int v : vertices)
       if (slot_[v] < 0) slot_[v] = slots++;
-    // Two passes over the faces: count the uses per vertex, then place them.
+    // Two passes: over every face to count the uses per vertex (and note the
+    // faces that have some), then over the noted faces to place them.
     start_.assign(std::size_t(slots) + 1, 0);
     const Vertex* base = mesh.vert.data();
-    auto forEachUse = [&](auto&& visit) {
-      for (const Face& f : mesh.face) {
-        const int c[3] = {int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
-        const int s[3] = {slot_[c[0]], slot_[c[1]], slot_[c[2]]};
-        if (s[0] < 0 && s[1] < 0 && s[2] < 0) continue;
-        for (int k = 0; k < 3; ++k) {
-          const int i = (k + 1) % 3, o = c[(k + 2) % 3];
-          if (among && (s[k] < 0 || s[i] < 0)) continue;
-          if (s[k] >= 0) visit(s[k], Neighbour{c[i], o, 1, 0});
-          if (s[i] >= 0) visit(s[i], Neighbour{c[k], o, 0, 1});
-        }
+    std::vector<int> concerned;
+    auto usesOf = [&](int face, auto&& visit) {
+      const Face& f = mesh.face[face];
+      const int c[3] = {int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
+      const int s[3] = {slot_[c[0]], slot_[c[1]], slot_[c[2]]};
+      bool any = false;
+      for (int k = 0; k < 3; ++k) {
+        const int i = (k + 1) % 3, o = c[(k + 2) % 3];
+        if (among ? (s[k] < 0 || s[i] < 0) : (s[k] < 0 && s[i] < 0)) continue;
+        any = true;
+        if (s[k] >= 0) visit(s[k], Neighbour{c[i], o, 1, 0});
+        if (s[i] >= 0) visit(s[i], Neighbour{c[k], o, 0, 1});
       }
+      return any;
     };
-    forEachUse([&](int s, const Neighbour&) { ++start_[s + 1]; });
+    for (int face = 0; face < int(mesh.face.size()); ++face)
+      if (usesOf(face, [&](int s, const Neighbour&) { ++start_[s + 1]; }))
+        concerned.push_back(face);
     for (int s = 0; s < slots; ++s) start_[s + 1] += start_[s];
     entries_.resize(start_.back());
     {
       std::vector<int> fill(start_.begin(), start_.end() - 1);
-      forEachUse([&](int s, const Neighbour& n) { entries_[fill[s]++] = n; });
+      for (int face : concerned)
+        usesOf(face, [&](int s, const Neighbour& n) { entries_[fill[s]++] = n; });
     }
     // Merge the uses of one edge (a vertex has few), in place.
     int write = 0;
     for (int s = 0, read = 0; s < slots; ++s) {
       const int end = start_[s + 1];
-      auto b = entries_.begin() + read, e = entries_.begin() + end;
-      if (e - b > 1)
-        std::sort(b, e, [](const Neighbour& x, const Neighbour& y) { return x.v < y.v; });
+      for (int i = read + 1; i < end; ++i)  // insertion sort: a vertex has few uses
+        for (int j = i; j > read && entries_[j - 1].v > entries_[j].v; --j)
+          std::swap(entries_[j - 1], entries_[j]);
       start_[s] = write;
       const int first = write;
       for (; read < end; ++read) {
@@ -655,6 +661,7 @@ std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, P
                          Valid&& valid, bool forward, std::vector<Triangle>& faces) {
   std::vector<char> steps;
   steps.reserve(a.size() + b.size());
+  faces.reserve(faces.size() + a.size() + b.size());
   std::size_t i = 0, j = 0;
   while (i + 1 < a.size() || j + 1 < b.size()) {
     bool alongA;
@@ -736,7 +743,10 @@ void rotate(std::vector<T>& v, std::size_t first) {
   std::rotate(v.begin(), v.begin() + first, v.end());
 }
 
-StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
+// facesRead is called once the mesh's faces are no longer read (the plan
+// reads vertices and what it gathered from then on).
+StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
+                      const std::function<void()>& facesRead = {}) {
   StitchPlan plan;
   PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
   std::vector<char> inA(mesh.vert.size(), 0);
@@ -763,6 +773,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o) {
                                     " is not on a border edge: stitch paths must follow borders");
     }
   }
+  if (facesRead) facesRead();
   // Auto shape: a path whose ends share a border edge goes all around.
   for (auto [p, path] : {std::make_pair(&A, &o.a), std::make_pair(&B, &o.b)})
     if (path->shape == BorderPath::Shape::Auto && !p->closed && p->v.size() >= 3 &&
@@ -1078,6 +1089,7 @@ void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
       r.new_vertices.push_back(int(n + k));
     }
   }
+  r.new_faces.reserve(plan.faces.size());
   if (!plan.faces.empty()) {
     auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, plan.faces.size());
     for (std::size_t k = 0; k < plan.faces.size(); ++k, ++fi) {
@@ -1137,26 +1149,47 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
     throw InvalidInputError("max_aspect_ratio and max_rows must not be negative");
   reportProgress(options.progress, 0, "Planning the stitch");
   StitchResult r;
-  // The mesh's border edges are counted (for the report) on the second
-  // core while the stitch is planned: both only read the mesh.
-  auto borderCount = std::async(std::launch::async, [&mesh] {
+  // On the second core, while the stitch is planned: the mesh's border edges
+  // are counted (for the report), then, once the faces are no longer read,
+  // room is made for the new ones (the copy into a larger array is most of
+  // the cost of adding them).
+  std::promise<void> facesFree;
+  bool freed = false;
+  auto release = [&] {
+    if (!freed) facesFree.set_value();
+    freed = true;
+  };
+  const std::size_t room = mesh.face.size() + options.a.vertices.size() + options.b.vertices.size();
+  auto background = std::async(std::launch::async, [&mesh, free = facesFree.get_future(), room] {
     const auto t = Clock::now();
     const std::size_t count = countBorderEdges(mesh);
-    return std::make_pair(count, msSince(t));
+    const double ms = msSince(t);
+    free.wait();
+    mesh.face.reserve(room);
+    return std::make_pair(count, ms);
   });
-  auto clock = Clock::now();
-  const StitchPlan plan = planStitch(mesh, options);
-  r.stage_ms.plan = msSince(clock);
-  if (options.check_intersections) {
-    reportProgress(options.progress, 50, "Checking intersections");
-    clock = Clock::now();
-    r.remaining_intersecting_pairs = newIntersections(mesh, plan);
-    r.checked = true;
-    r.stage_ms.check = msSince(clock);
+  StitchPlan plan;
+  try {
+    auto clock = Clock::now();
+    plan = planStitch(mesh, options, [&] {
+      if (!options.check_intersections) release();
+    });
+    r.stage_ms.plan = msSince(clock);
+    if (options.check_intersections) {
+      reportProgress(options.progress, 50, "Checking intersections");
+      clock = Clock::now();
+      r.remaining_intersecting_pairs = newIntersections(mesh, plan);
+      r.checked = true;
+      r.stage_ms.check = msSince(clock);
+    }
+  } catch (...) {
+    release();  // the second thread finishes before the error leaves
+    throw;
   }
+  release();
   reportProgress(options.progress, 90, "Writing");
-  std::tie(r.border_edges_before, r.stage_ms.count) = borderCount.get();
-  clock = Clock::now();
+  std::tie(r.border_edges_before, r.stage_ms.count) = background.get();
+  const auto clock = Clock::now();
   applyPlan(mesh, plan, r);
   r.stage_ms.write = msSince(clock);
   r.border_edges_after = std::size_t(long(r.border_edges_before) + plan.borderDelta);
