@@ -300,16 +300,19 @@ OptionTable<CloseGapsOptions> gapsTable() {
   using O = CloseGapsOptions;
   OptionTable<O> t;
   t.add(
+      "absolute_distances", [](O& o) -> bool& { return o.absolute_distances; },
+      "merge_tolerance and max_gap are in mesh units (else fractions of the bounding box "
+      "diagonal)");
+  t.add(
       "merge_tolerance", [](O& o) -> double& { return o.merge_tolerance; },
-      "border edges whose ends coincide within this distance (absolute) are merged; 0 = exactly "
-      "equal coordinates (CGAL's stitch_borders)");
+      "border edges whose ends coincide within this distance are merged; 0 = exactly equal "
+      "coordinates (CGAL's stitch_borders)");
+  t.add(
+      "orient_faces", [](O& o) -> bool& { return o.orient_faces; },
+      "first flip faces so that faces meeting at an edge run it opposite ways (soups)");
   t.add(
       "max_gap", [](O& o) -> double& { return o.max_gap; },
-      "borders facing each other within this distance are stitched (a fraction of the bounding "
-      "box diagonal unless gap_absolute); 0 = no stitching");
-  t.add(
-      "gap_absolute", [](O& o) -> bool& { return o.gap_absolute; },
-      "max_gap is a distance in mesh units");
+      "border runs facing each other within this distance are stitched; 0 = no stitching");
   t.add(
       "min_path_vertices", [](O& o) -> int& { return o.min_path_vertices; },
       "runs of fewer border vertices facing another border are left open");
@@ -319,6 +322,9 @@ OptionTable<CloseGapsOptions> gapsTable() {
   t.add(
       "check_intersections", [](O& o) -> bool& { return o.check_intersections; },
       "check every stitch exactly; one that would intersect the mesh is left out");
+  t.add(
+      "verify", [](O& o) -> bool& { return o.verify; },
+      "count the output's intersecting pairs that involve a merged or stitched face");
   return t;
 }
 
