@@ -494,6 +494,8 @@ def test_close_gaps_merges_a_seam_and_stitches_a_slit():
     assert out.report["gaps_stitched"] == 1 and out.report["faces_added"] == 8
     assert mm.inspect(out.vertices, out.faces)["connected_components"] == 1
     assert mm.close_gaps(*slit, max_gap=0).report["faces_added"] == 0
+    assert mm.close_gaps(*slit, max_gap=0.001, absolute_distances=True).report["faces_added"] == 0
+    assert mm.close_gaps(*slit, max_gap=0.003, absolute_distances=True).report["faces_added"] == 8
 
 
 # ---------------------------------------------------------------- clearance
