@@ -69,12 +69,15 @@ std::vector<int> patchIds(MeshModel& model, const std::vector<CFaceO*>& faces, b
 }  // namespace
 
 RenderValuesPlugin::RenderValuesPlugin() {
-  typeList << PREPARE_SHADER_VIEW;
-  for (FilterIDType id : types()) actionList << new QAction(filterName(id), this);
+  addFilters(this, {PREPARE_SHADER_VIEW});
 }
 
 QString RenderValuesPlugin::filterName(FilterIDType) const {
   return "MeshMend: Prepare Shader View";
+}
+
+QString RenderValuesPlugin::pythonFilterName(FilterIDType) const {
+  return "meshmend_prepare_shader_view";
 }
 
 QString RenderValuesPlugin::filterInfo(FilterIDType) const {
@@ -90,12 +93,12 @@ QString RenderValuesPlugin::filterInfo(FilterIDType) const {
          "texture coordinates when saving the layer if the file should not keep them.";
 }
 
-void RenderValuesPlugin::initParameterSet(QAction*, MeshModel& m, RichParameterList& parameters) {
-  // The values the layer holds, most specific first.
+void RenderValuesPlugin::initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) {
+  // The values the current layer holds, most specific first.
   int values = kClearanceValues;
-  if (hasFaceAttribute<int>(m.cm, kPatchAttribute))
+  if (md.mm() && hasFaceAttribute<int>(md.mm()->cm, kPatchAttribute))
     values = kPatchValues;
-  else if (hasFaceAttribute<unsigned char>(m.cm, kFaceChangeAttribute))
+  else if (md.mm() && hasFaceAttribute<unsigned char>(md.mm()->cm, kFaceChangeAttribute))
     values = kFaceChangeValues;
   parameters.addParam(RichEnum(
       "values", values,
@@ -116,111 +119,109 @@ void RenderValuesPlugin::initParameterSet(QAction*, MeshModel& m, RichParameterL
       "new_faces; time_ms)."));
 }
 
-bool RenderValuesPlugin::applyFilter(QAction*, MeshDocument& md,
-                                     const RichParameterList& parameters, vcg::CallBackPos*) {
-  return guarded(*this, errorMessage, [&] {
-    MeshModel* model = md.mm();
-    if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
-    QElapsedTimer timer;
-    timer.start();
-    CMeshO& cm = model->cm;
-    if (cm.fn == 0) throw InvalidInputError(layerName(*model) + " has no faces to show");
-    if (!holdsNoTextureOfItsOwn(*model))
+void RenderValuesPlugin::apply(QAction*, MeshDocument& md, const RichParameterList& parameters,
+                               vcg::CallBackPos*) {
+  MeshModel* model = md.mm();
+  if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
+  QElapsedTimer timer;
+  timer.start();
+  CMeshO& cm = model->cm;
+  if (cm.fn == 0) throw InvalidInputError(layerName(*model) + " has no faces to show");
+  if (!holdsNoTextureOfItsOwn(*model))
+    throw InvalidInputError(
+        layerName(*model) +
+        " has texture coordinates of its own, which this would overwrite: duplicate the layer "
+        "(Filters > Layer and Attribute Management > Duplicate Current Layer) and prepare the "
+        "copy");
+  const int values = parameters.getEnum("values");
+  if (values < kClearanceValues || values > kFaceChangeValues)
+    throw InvalidInputError("unknown values " + std::to_string(values) +
+                            ": use 0 (clearance), 1 (patches) or 2 (faces the last filter made)");
+
+  Triangles triangles;
+  std::vector<CFaceO*> faces;
+  triangles.reserve(cm.fn);
+  faces.reserve(cm.fn);
+  for (CFaceO& f : cm.face)
+    if (!f.IsD()) {
+      triangles.push_back({int(vcg::tri::Index(cm, f.V(0))), int(vcg::tri::Index(cm, f.V(1))),
+                           int(vcg::tri::Index(cm, f.V(2)))});
+      faces.push_back(&f);
+    }
+
+  JsonObject report;
+  report.set("layer", toStd(model->label())).set("faces", faces.size());
+  std::vector<WedgeCoords> coords;
+  std::string summary, shader;
+  if (values == kClearanceValues) {
+    if (!model->hasDataMask(MeshModel::MM_VERTQUALITY))
+      throw InvalidInputError(layerName(*model) +
+                              " has no vertex quality: run MeshMend: Measure Clearance first");
+    std::vector<double> quality(cm.vert.size(), 0);
+    double low = HUGE_VAL, high = -HUGE_VAL;
+    for (const auto& t : triangles)
+      for (int v : t) {
+        quality[v] = cm.vert[v].cQ();
+        low = std::min(low, quality[v]);
+        high = std::max(high, quality[v]);
+      }
+    coords = encodeVertexValues(triangles, quality);
+    report.set("values", "clearance").set("value_min", low).set("value_max", high);
+    char text[160];
+    std::snprintf(text, sizeof text, "vertex quality from %.6g to %.6g", low, high);
+    summary = text;
+    shader = "meshmend_clearance.gdp (set tau and colour_range in its dialog)";
+  } else if (values == kPatchValues) {
+    bool fromQuality = false;
+    const std::vector<int> ids = patchIds(*model, faces, fromQuality);
+    coords = encodeFaceLabels(triangles, ids, RenderChannel::kPatches, true);
+    const std::size_t patches = std::set<int>(ids.begin(), ids.end()).size();
+    report.set("values", "patches").set("patches", patches);
+    summary =
+        std::to_string(patches) + " patches" + (fromQuality ? " (ids from the face quality)" : "");
+    shader = "meshmend_patches.gdp";
+  } else {
+    if (!hasFaceAttribute<unsigned char>(cm, kFaceChangeAttribute))
       throw InvalidInputError(
           layerName(*model) +
-          " has texture coordinates of its own, which this would overwrite: duplicate the layer "
-          "(Filters > Layer and Attribute Management > Duplicate Current Layer) and prepare the "
-          "copy");
-    const int values = parameters.getEnum("values");
-    if (values < kClearanceValues || values > kFaceChangeValues)
-      throw InvalidInputError("unknown values " + std::to_string(values) +
-                              ": use 0 (clearance), 1 (patches) or 2 (faces the last filter made)");
-
-    Triangles triangles;
-    std::vector<CFaceO*> faces;
-    triangles.reserve(cm.fn);
-    faces.reserve(cm.fn);
-    for (CFaceO& f : cm.face)
-      if (!f.IsD()) {
-        triangles.push_back({int(vcg::tri::Index(cm, f.V(0))), int(vcg::tri::Index(cm, f.V(1))),
-                             int(vcg::tri::Index(cm, f.V(2)))});
-        faces.push_back(&f);
-      }
-
-    JsonObject report;
-    report.set("layer", toStd(model->label())).set("faces", faces.size());
-    std::vector<WedgeCoords> coords;
-    std::string summary, shader;
-    if (values == kClearanceValues) {
-      if (!model->hasDataMask(MeshModel::MM_VERTQUALITY))
-        throw InvalidInputError(layerName(*model) +
-                                " has no vertex quality: run MeshMend: Measure Clearance first");
-      std::vector<double> quality(cm.vert.size(), 0);
-      double low = HUGE_VAL, high = -HUGE_VAL;
-      for (const auto& t : triangles)
-        for (int v : t) {
-          quality[v] = cm.vert[v].cQ();
-          low = std::min(low, quality[v]);
-          high = std::max(high, quality[v]);
-        }
-      coords = encodeVertexValues(triangles, quality);
-      report.set("values", "clearance").set("value_min", low).set("value_max", high);
-      char text[160];
-      std::snprintf(text, sizeof text, "vertex quality from %.6g to %.6g", low, high);
-      summary = text;
-      shader = "meshmend_clearance.gdp (set tau and colour_range in its dialog)";
-    } else if (values == kPatchValues) {
-      bool fromQuality = false;
-      const std::vector<int> ids = patchIds(*model, faces, fromQuality);
-      coords = encodeFaceLabels(triangles, ids, RenderChannel::kPatches, true);
-      const std::size_t patches = std::set<int>(ids.begin(), ids.end()).size();
-      report.set("values", "patches").set("patches", patches);
-      summary = std::to_string(patches) + " patches" +
-                (fromQuality ? " (ids from the face quality)" : "");
-      shader = "meshmend_patches.gdp";
-    } else {
-      if (!hasFaceAttribute<unsigned char>(cm, kFaceChangeAttribute))
-        throw InvalidInputError(
-            layerName(*model) +
-            " has no record of the faces a MeshMend filter made: run a filter that rebuilds the "
-            "layer first (Fill Holes, Stitch Boundaries, Close Gaps Between Borders, Intersect "
-            "and Split Layers, Remove Self-Intersections, Remove Patches); the record lives in "
-            "memory only, saved files do not keep it");
-      auto change =
-          vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(cm, kFaceChangeAttribute);
-      std::vector<int> labels;
-      std::size_t count[3] = {0, 0, 0};
-      for (CFaceO* f : faces) {
-        const int c = std::min<int>(change[f], kFaceNew);
-        labels.push_back(c);
-        ++count[c];
-      }
-      coords = encodeFaceLabels(triangles, labels, RenderChannel::kFaceChanges, false);
-      report.set("values", "face_changes")
-          .set("kept_faces", count[kFaceKept])
-          .set("cut_faces", count[kFaceCut])
-          .set("new_faces", count[kFaceNew]);
-      summary = std::to_string(count[kFaceNew]) + " new faces, " + std::to_string(count[kFaceCut]) +
-                " cut from input faces, " + std::to_string(count[kFaceKept]) + " kept";
-      shader = "meshmend_new_faces.gdp";
+          " has no record of the faces a MeshMend filter made: run a filter that rebuilds the "
+          "layer first (Fill Holes, Stitch Boundaries, Close Gaps Between Borders, Intersect "
+          "and Split Layers, Remove Self-Intersections, Remove Patches); the record lives in "
+          "memory only, saved files do not keep it");
+    auto change =
+        vcg::tri::Allocator<CMeshO>::GetPerFaceAttribute<unsigned char>(cm, kFaceChangeAttribute);
+    std::vector<int> labels;
+    std::size_t count[3] = {0, 0, 0};
+    for (CFaceO* f : faces) {
+      const int c = std::min<int>(change[f], kFaceNew);
+      labels.push_back(c);
+      ++count[c];
     }
-    report.set("time_ms", double(timer.nsecsElapsed()) / 1e6);
-    writeReport(parameters.getString("report_file"), report);
+    coords = encodeFaceLabels(triangles, labels, RenderChannel::kFaceChanges, false);
+    report.set("values", "face_changes")
+        .set("kept_faces", count[kFaceKept])
+        .set("cut_faces", count[kFaceCut])
+        .set("new_faces", count[kFaceNew]);
+    summary = std::to_string(count[kFaceNew]) + " new faces, " + std::to_string(count[kFaceCut]) +
+              " cut from input faces, " + std::to_string(count[kFaceKept]) + " kept";
+    shader = "meshmend_new_faces.gdp";
+  }
+  report.set("time_ms", double(timer.nsecsElapsed()) / 1e6);
+  publishReport(parameters, report);
 
-    // The only change to the document, made last.
-    model->updateDataMask(MeshModel::MM_WEDGTEXCOORD);
-    for (std::size_t i = 0; i < faces.size(); ++i)
-      for (int k = 0; k < 3; ++k) {
-        faces[i]->WT(k).U() = coords[i][k][0];
-        faces[i]->WT(k).V() = coords[i][k][1];
-        faces[i]->WT(k).N() = 0;
-      }
-    Log("MeshMend: %s of %s in its texture coordinates (%s); show them with Render > Shaders > %s",
-        values == kClearanceValues ? "clearance"
-        : values == kPatchValues   ? "patch ids"
-                                   : "faces made",
-        layerName(*model).c_str(), summary.c_str(), shader.c_str());
-  });
+  // The only change to the document, made last.
+  model->updateDataMask(MeshModel::MM_WEDGTEXCOORD);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      faces[i]->WT(k).U() = coords[i][k][0];
+      faces[i]->WT(k).V() = coords[i][k][1];
+      faces[i]->WT(k).N() = 0;
+    }
+  Log("MeshMend: %s of %s in its texture coordinates (%s); show them with Render > Shaders > %s",
+      values == kClearanceValues ? "clearance"
+      : values == kPatchValues   ? "patch ids"
+                                 : "faces made",
+      layerName(*model).c_str(), summary.c_str(), shader.c_str());
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(RenderValuesPlugin)

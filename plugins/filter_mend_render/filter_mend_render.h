@@ -3,12 +3,12 @@
 // the shaders in shaders/ (common/render_channels.h).
 #pragma once
 
-#include <common/interfaces.h>
+#include "plugins/bridge/filter_plugin.h"
 
-class RenderValuesPlugin : public QObject, public MeshFilterInterface {
+class RenderValuesPlugin : public QObject, public meshmend::bridge::FilterAdapter {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  MESHLAB_PLUGIN_IID_EXPORTER(MESHMEND_FILTER_IID)
+  Q_INTERFACES(MESHMEND_FILTER_INTERFACE)
 
  public:
   enum { PREPARE_SHADER_VIEW };
@@ -16,12 +16,13 @@ class RenderValuesPlugin : public QObject, public MeshFilterInterface {
   RenderValuesPlugin();
   QString pluginName() const override { return "MeshMendRender"; }
   QString filterName(FilterIDType filter) const override;
+  QString pythonFilterName(FilterIDType filter) const override;
   QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction*) override { return MeshFilterInterface::Texture; }
-  FILTER_ARITY filterArity(QAction*) const override { return SINGLE_MESH; }
-  int getPreConditions(QAction*) const override { return MeshModel::MM_NONE; }
-  int postCondition(QAction*) const override { return MeshModel::MM_WEDGTEXCOORD; }
-  void initParameterSet(QAction*, MeshModel& m, RichParameterList& parameters) override;
-  bool applyFilter(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
-                   vcg::CallBackPos* cb) override;
+  FilterClass filterClass(QAction*) const override { return Texture; }
+  Arity arity(QAction*) const override { return SINGLE_MESH; }
+  int preconditions(QAction*) const override { return MeshModel::MM_NONE; }
+  int postconditions(QAction*) const override { return MeshModel::MM_WEDGTEXCOORD; }
+  void initParameters(QAction*, MeshDocument& md, RichParameterList& parameters) override;
+  void apply(QAction* filter, MeshDocument& md, const RichParameterList& parameters,
+             vcg::CallBackPos* cb) override;
 };
