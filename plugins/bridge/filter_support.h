@@ -65,15 +65,6 @@ bool guarded(QString& errorMessage, Body&& body, Log&& log) {
   return false;
 }
 
-#if MESHMEND_MESHLAB_API == 2020
-// The plugin-side form: logs into the plugin's MeshLab log.
-template <class Body>
-bool guarded(MeshCommonInterface& plugin, QString& errorMessage, Body&& body) {
-  return guarded(errorMessage, std::forward<Body>(body),
-                 [&plugin](const std::string& m) { plugin.Log(m); });
-}
-#endif
-
 // Writes `report` to `path` when it is not empty (throws InvalidInputError
 // with the path when it cannot be written).
 void writeReport(const QString& path, const JsonObject& report);
