@@ -1648,73 +1648,92 @@ void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>&
   }
   if (requests.empty()) return;
 
-  // Faces per vertex and directed edge counts, updated merge by merge.
+  // Faces per vertex (a merged vertex's go to the vertex it joins).
   std::vector<std::vector<int>> facesOf(n);
   for (std::size_t f = 0; f < T.size(); ++f)
     for (int v : T[f]) facesOf[v].push_back(int(f));
-  std::unordered_map<std::uint64_t, int> directed;
-  for (const Triangle& t : T)
-    for (int k = 0; k < 3; ++k) ++directed[edgeKey(t[k], t[(k + 1) % 3])];
   DisjointSets sets(P.size());
+  std::vector<int> affected;
+  std::vector<Triangle> changed;
+  std::vector<char> collapses;
   for (const auto& [e1, e2] : requests) {
     // e1 = a -> b, e2 = c -> d: d joins a, c joins b; a collapse: b joins a.
     const int a = sets.root(border[e1].from), b = sets.root(border[e1].to);
-    std::unordered_map<int, int> into;
+    int from[2], to[2], joins = 0;
+    auto join = [&](int x, int y) {
+      if (x != y) from[joins] = x, to[joins++] = y;
+    };
     if (e2 < 0) {
-      if (b != a) into[b] = a;
+      join(b, a);
     } else {
-      const int c = sets.root(border[e2].from), d = sets.root(border[e2].to);
-      if (d != a) into[d] = a;
-      if (c != b) into[c] = b;
-      if (into.size() == 2 && into.count(a) && into.count(b)) continue;  // crossed: a <-> b
+      join(sets.root(border[e2].to), a);
+      join(sets.root(border[e2].from), b);
+      if (joins == 2 && from[0] == to[1] && from[1] == to[0]) continue;  // crossed: a <-> b
     }
-    if (into.empty()) {  // done by the merges before
+    if (joins == 0) {  // done by the merges before
       if (e2 >= 0) ++r.edges_merged;
       continue;
     }
-    auto mapped = [&](int v) {
-      const auto it = into.find(v);
-      return it == into.end() ? v : it->second;
+    auto mapped = [&](int v) {  // at most two steps (c -> b -> a)
+      for (int step = 0; step < 2; ++step)
+        for (int k = 0; k < joins; ++k)
+          if (v == from[k]) {
+            v = to[k];
+            break;
+          }
+      return v;
     };
-    std::vector<int> affected;
-    for (const auto& [from, to] : into) {
-      (void)to;
-      for (int f : facesOf[from])
+    affected.clear();
+    for (int k = 0; k < joins; ++k)
+      for (int f : facesOf[from[k]])
         if (!removedFace[f]) affected.push_back(f);
-    }
     std::sort(affected.begin(), affected.end());
     affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
-    std::vector<Triangle> changed;
-    std::vector<char> collapses;
+    changed.clear();
+    collapses.clear();
     for (int f : affected) {
       const Triangle t{mapped(T[f][0]), mapped(T[f][1]), mapped(T[f][2])};
       changed.push_back(t);
       collapses.push_back(t[0] == t[1] || t[1] == t[2] || t[2] == t[0]);
     }
-    auto count = [&](const Triangle& t, int by) {
-      for (int i = 0; i < 3; ++i) directed[edgeKey(t[i], t[(i + 1) % 3])] += by;
+    // Every edge of a changed face, with the faces it has after the merge:
+    // those of its first end and of the vertices joining that end.
+    auto faceAfter = [&](int f, const Triangle*& t) {
+      const auto it = std::lower_bound(affected.begin(), affected.end(), f);
+      if (it == affected.end() || *it != f) {
+        t = &T[f];
+        return true;
+      }
+      const std::size_t k = std::size_t(it - affected.begin());
+      t = &changed[k];
+      return !collapses[k];
     };
-    for (int f : affected) count(T[f], -1);
-    std::vector<std::uint64_t> touched;
-    for (std::size_t k = 0; k < changed.size(); ++k) {
-      if (collapses[k]) continue;
-      count(changed[k], +1);
-      for (int i = 0; i < 3; ++i)
-        touched.push_back(edgeKey(changed[k][i], changed[k][(i + 1) % 3]));
-    }
+    auto usesOf = [&](int u, int v, int& forward, int& backward) {
+      forward = backward = 0;
+      auto visit = [&](const std::vector<int>& faces) {
+        for (int f : faces) {
+          const Triangle* t = nullptr;
+          if (removedFace[f] || !faceAfter(f, t)) continue;
+          for (int i = 0; i < 3; ++i) {
+            if ((*t)[i] == u && (*t)[(i + 1) % 3] == v) ++forward;
+            if ((*t)[i] == v && (*t)[(i + 1) % 3] == u) ++backward;
+          }
+        }
+      };
+      visit(facesOf[u]);
+      for (int k = 0; k < joins; ++k)
+        if (mapped(from[k]) == u) visit(facesOf[from[k]]);
+    };
     bool ok = true;
-    for (std::uint64_t key : touched) {
-      const int u = int(key >> 32), v = int(key & 0xffffffffu);
-      const auto fwd = directed.find(edgeKey(u, v));
-      const auto bwd = directed.find(edgeKey(v, u));
-      const int nf = fwd == directed.end() ? 0 : fwd->second;
-      const int nb = bwd == directed.end() ? 0 : bwd->second;
-      if (nf > 1 || nf + nb > 2) ok = false;
+    for (std::size_t k = 0; k < changed.size() && ok; ++k) {
+      if (collapses[k]) continue;
+      for (int i = 0; i < 3 && ok; ++i) {
+        int forward, backward;
+        usesOf(changed[k][i], changed[k][(i + 1) % 3], forward, backward);
+        ok = forward <= 1 && forward + backward <= 2;
+      }
     }
-    if (!ok) {  // undo
-      for (std::size_t k = 0; k < changed.size(); ++k)
-        if (!collapses[k]) count(changed[k], -1);
-      for (int f : affected) count(T[f], +1);
+    if (!ok) {
       ++r.merges_skipped;
       continue;
     }
@@ -1725,10 +1744,11 @@ void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>&
         ++r.degenerate_faces_removed;
       }
     }
-    for (const auto& [from, to] : into) {
-      sets.join(from, to);
-      facesOf[to].insert(facesOf[to].end(), facesOf[from].begin(), facesOf[from].end());
-      facesOf[from].clear();
+    for (int k = 0; k < joins; ++k) {
+      const int into = mapped(from[k]);
+      sets.join(from[k], into);
+      facesOf[into].insert(facesOf[into].end(), facesOf[from[k]].begin(), facesOf[from[k]].end());
+      facesOf[from[k]].clear();
       ++r.vertices_merged;
     }
     if (e2 >= 0) ++r.edges_merged;
