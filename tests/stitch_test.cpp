@@ -148,6 +148,30 @@ TEST(StitchFigure2, ParallelPathsWithWideningGap) {
   expectClean(s.mesh, r.border_edges_after, vertices);
 }
 
+TEST(StitchCheck, CountsThePairsTheStitchMakesAsAWholeMeshCountDoes) {
+  // A small triangle standing across the gap, touching neither sheet: the
+  // strip passes through it.
+  TwoSheets s = smoothSheets(40, 27, 0.15);
+  const double y = 0.3 * std::sin(2.0) - 0.085;  // halfway across the gap at x = 1
+  const Mesh pin = makeMesh({{1.0, y, -0.05}, {1.0, y, 0.05}, {1.02, y, 0}}, {{0, 1, 2}});
+  Mesh m = appended(s.mesh, pin);
+  ASSERT_EQ(selfIntersectingPairs(m), 0u);
+  StitchOptions o;
+  o.a.vertices = s.a;
+  o.b.vertices = s.b;
+  const StitchResult r = stitchPaths(m, o);
+  ASSERT_TRUE(r.checked);
+  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
+  // Without the check nothing is counted, and the same faces are added.
+  Mesh unchecked = appended(s.mesh, pin);
+  o.check_intersections = false;
+  const StitchResult u = stitchPaths(unchecked, o);
+  EXPECT_FALSE(u.checked);
+  EXPECT_EQ(u.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(trianglesOf(unchecked), trianglesOf(m));
+}
+
 TEST(StitchFigure2, PathGivenBackwardsIsTurnedAround) {
   TwoSheets s = smoothSheets(30, 21, 0.1);
   StitchOptions o;
