@@ -627,7 +627,9 @@ class PathLine {
   }
 
  private:
-  Point3 point(std::size_t i) const { return mesh_.vert[path_[i % path_.size()]].cP(); }
+  Point3 point(std::size_t i) const {  // i == path_.size(): back at the first vertex
+    return mesh_.vert[path_[i < path_.size() ? i : 0]].cP();
+  }
   const Mesh& mesh_;
   const std::vector<int>& path_;
   std::vector<double> s_;
@@ -730,7 +732,7 @@ void orientPath(PreparedPath& p, const LocalEdges& edges) {
   long along = 0, against = 0;
   const std::size_t count = p.closed ? p.v.size() : p.v.size() - 1;
   for (std::size_t k = 0; k < count; ++k) {
-    const LocalEdges::Neighbour* e = edges.find(p.v[k], p.v[(k + 1) % p.v.size()]);
+    const LocalEdges::Neighbour* e = edges.find(p.v[k], p.v[k + 1 < p.v.size() ? k + 1 : 0]);
     if (!e || e->out + e->in != 1) continue;
     (e->out ? along : against)++;
   }
