@@ -225,10 +225,13 @@ QString StitchPlugin::filterInfo(FilterIDType id) const {
            "MeshLab in float; the exact check is made on the double ones." +
            paper;
   return "Closes the gaps between borders automatically. Step 1 (what CGAL's stitch_borders "
-         "does, with a tolerance): border edges whose end points coincide within the merge "
-         "tolerance and that run opposite ways are merged. Step 2: border loops, or runs of "
-         "them, that face each other within the maximum gap are stitched with the merge-like "
-         "triangulation. Nothing is merged or stitched that would make an edge non-manifold "
+         "does, with a tolerance): faces that face against their neighbours are flipped (a "
+         "closed part is turned outward), then border edges whose end points coincide within "
+         "the merge tolerance and that run opposite ways are merged; a border edge of zero "
+         "length collapses its face, and where solids touch along an edge each closes on its "
+         "own. Step 2: border loops, or runs of them, that face each other within the maximum "
+         "gap are stitched with the merge-like triangulation, also the two sides of a crack in "
+         "one loop. Nothing is merged or stitched that would make an edge non-manifold "
          "or break the orientation; a stitch whose faces would intersect the mesh is left out "
          "with its reason in the log. Works on the current layer, or on all visible layers "
          "merged into a new layer (layer matrices applied). Merged vertices are removed, so "
