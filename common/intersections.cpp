@@ -301,12 +301,46 @@ std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
   return pairs;
 }
 
+namespace {
+
+// Exact and sufficient for "faces f and g meet at most in the corners they
+// share": in the projection dropping the axis of f's largest normal
+// component, the line through an edge of one face has the other face
+// strictly beyond it, but for shared corners on the line. Neighbours in a
+// smooth surface (most box-overlapping pairs of a mesh) are settled by these
+// 2-D tests, coplanar ones included.
+bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                           const TrianglePoints& b) {
+  const int axis = projectionAxis(a[0], a[1], a[2]);
+  for (int pass = 0; pass < 2; ++pass) {
+    const Triangle& t = pass == 0 ? ta : tb;
+    const TrianglePoints& p = pass == 0 ? a : b;
+    const Triangle& other = pass == 0 ? tb : ta;
+    const TrianglePoints& q = pass == 0 ? b : a;
+    if (orient2dDropping(p[0], p[1], p[2], axis) == 0) continue;
+    for (int e = 0; e < 3; ++e) {
+      const int u = e, w = (e + 1) % 3, o = (e + 2) % 3;
+      const int inside = orient2dDropping(p[u], p[w], p[o], axis);
+      bool separated = true;
+      for (int k = 0; k < 3 && separated; ++k) {
+        if (other[k] == t[u] || other[k] == t[w]) continue;
+        separated = orient2dDropping(p[u], p[w], q[k], axis) == -inside;
+      }
+      if (separated) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
                     std::uint32_t g) {
   const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
   const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
   if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
   const SharedCorners c = sharedCorners(T[f], T[g]);
+  if (c.count < 3 && separatedInProjection(T[f], a, T[g], b)) return false;
   return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
 }
 
