@@ -8,11 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <numeric>
 #include <optional>
 #include <queue>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -1220,7 +1222,6 @@ struct Surface {
   std::vector<int> inputFaceOf;  // per face beyond the input: the input face it is part of, or -1
   std::unordered_map<int, Triangle> inputCorners;  // input faces changed by splits: their corners
   std::vector<int> patchFaces, splitFaces;         // faces added by patches / by splits
-  std::vector<Box> inputBoxes;
   std::unique_ptr<BoxTree>
       inputTree;           // over the input faces' boxes (built once there are many holes)
   std::size_t checks = 0;  // patches checked so far
@@ -1394,19 +1395,22 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
     if (intersect(checked[i], checked[j])) ++pairs;
   });
-  // Boxes of the input faces as they came (a split face's halves lie
-  // within it, the later half being checked below), made once.
-  if (s.inputBoxes.size() != s.inputFaces) {
-    s.inputBoxes.resize(s.inputFaces);
+  // The input faces as they came (a split face's halves lie within it, the
+  // later half being checked below).
+  auto inputCorners = [&](std::size_t f) {
+    return s.inputCorners.empty() ? T[f] : s.originalCorners(int(f));
+  };
+  // A few holes scan the input faces; many pay for a hierarchy of their boxes once.
+  if (!s.inputTree && ++s.checks > 8) {
+    std::vector<Box> inputBoxes(s.inputFaces);
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
-        const Triangle t = s.inputCorners.empty() ? T[f] : s.originalCorners(int(f));
-        s.inputBoxes[f] = boxOf(P[t[0]], P[t[1]], P[t[2]]);
+        const Triangle t = inputCorners(f);
+        inputBoxes[f] = boxOf(P[t[0]], P[t[1]], P[t[2]]);
       }
     });
+    s.inputTree = std::make_unique<BoxTree>(std::move(inputBoxes));
   }
-  // A few holes scan the input faces' boxes; many pay for a hierarchy once.
-  if (!s.inputTree && ++s.checks > 8) s.inputTree = std::make_unique<BoxTree>(s.inputBoxes);
   // The rest of the surface: faces before the patch that are not split ones
   // (facesIntersect skips degenerate faces).
   auto other = [&](std::size_t f) { return !ownSet.count(int(f)); };
@@ -1424,8 +1428,16 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
   } else {
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
       for (std::size_t f = begin; f < end; ++f) {
-        if (!overlap(s.inputBoxes[f], bounds) || !other(f)) continue;
-        tree.query(s.inputBoxes[f], worker, [&](std::uint32_t i, unsigned) {
+        const Triangle t = inputCorners(f);
+        const Point3 &a = P[t[0]], &b = P[t[1]], &c = P[t[2]];
+        // Beyond the patch's bounds on one side of an axis (they are
+        // rounded outwards): nothing to test. Most of a large mesh.
+        bool away = false;
+        for (int k = 0; k < 3 && !away; ++k)
+          away = (a[k] < bounds.lo[k] && b[k] < bounds.lo[k] && c[k] < bounds.lo[k]) ||
+                 (a[k] > bounds.hi[k] && b[k] > bounds.hi[k] && c[k] > bounds.hi[k]);
+        if (away || !other(f)) continue;
+        tree.query(boxOf(a, b, c), worker, [&](std::uint32_t i, unsigned) {
           if (intersect(checked[i], int(f))) ++pairs;
         });
       }
@@ -1487,28 +1499,46 @@ class HoleFiller {
     // Each domain's patch, shaped in the first mode. The plane's is kept
     // when its triangles come out round in space; where the plane squeezes
     // part of the hole (the surface turns away from it), the disk's patch
-    // competes and the rounder of the two is tried first.
+    // competes and the rounder of the two is tried first. The disk's is
+    // made on a second thread meanwhile (the machine's other core), by a
+    // filler of its own: both only read the surface.
+    const std::vector<Domain> domains = domainsOf(boundary, faceNormals);
+    std::vector<Candidate> made(domains.size());
+    std::vector<std::string> problem(domains.size());
+    HoleFillResult::StageTimes twinTimes;
+    std::exception_ptr twinError;
+    if (domains.size() == 2) {
+      HoleFiller twin(s_, options_, pinched_, twinTimes);
+      twin.n_ = n_;
+      twin.front_ = front_;
+      twin.local_ = local_;
+      twin.meanEdge_ = meanEdge_;
+      std::thread disk([&] {
+        try {
+          HoleReport scratch;
+          twin.shapeOver(domains[1], modes[0], scratch, made[1], problem[1]);
+        } catch (...) {
+          twinError = std::current_exception();
+        }
+      });
+      shapeOver(domains[0], modes[0], report, made[0], problem[0]);
+      disk.join();
+      if (twinError) std::rethrow_exception(twinError);
+      times_.triangulate += twinTimes.triangulate;
+      times_.fair += twinTimes.fair;
+    } else {
+      for (std::size_t i = 0; i < domains.size(); ++i)
+        shapeOver(domains[i], modes[0], report, made[i], problem[i]);
+    }
     std::string problems;
     std::vector<Candidate> candidates;
-    for (const Domain& domain : domainsOf(boundary, faceNormals)) {
-      Candidate c;
-      c.domain = domain;
-      report.reason.clear();
-      if (!prepare(domain, report, c.flat)) {
-        problems += (problems.empty() ? "" : "; ") + where(domain) + report.reason;
+    for (std::size_t i = 0; i < domains.size(); ++i) {
+      if (!problem[i].empty()) {
+        problems += (problems.empty() ? "" : "; ") + where(domains[i]) + problem[i];
         continue;
       }
-      c.first.positions = c.flat;
-      c.first.fairing = modes[0];
-      const auto clock = Clock::now();
-      c.firstShaped = modes[0] == HoleFairing::Flat || fair(modes[0], c.first, report);
-      times_.fair += msSince(clock);
-      c.quality = c.firstShaped ? meanShapeQuality(c.first.positions) : -1;
-      c.trainingSamples = report.training_samples;
-      c.firstNote = report.reason;
-      swapState(c.state);
-      candidates.push_back(std::move(c));
-      if (domain.planar && candidates.back().quality >= kRoundPatchQuality) break;
+      candidates.push_back(std::move(made[i]));
+      if (domains[i].planar && candidates.back().quality >= kRoundPatchQuality) break;
     }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const Candidate& a, const Candidate& b) { return a.quality > b.quality; });
@@ -1585,6 +1615,27 @@ class HoleFiller {
       if (squares > 0) sum += 2 * std::sqrt(3.0) * ((b - a) ^ (c - a)).Norm() / squares;
     }
     return sum / double(localTriangles_.size());
+  }
+
+  // The candidate patch over `domain`, shaped in `mode` (state swapped out
+  // into c); `problem` says why there is none.
+  void shapeOver(const Domain& domain, HoleFairing mode, HoleReport& report, Candidate& c,
+                 std::string& problem) {
+    c.domain = domain;
+    report.reason.clear();
+    if (!prepare(domain, report, c.flat)) {
+      problem = report.reason.empty() ? "no patch" : report.reason;
+      return;
+    }
+    c.first.positions = c.flat;
+    c.first.fairing = mode;
+    const auto clock = Clock::now();
+    c.firstShaped = mode == HoleFairing::Flat || fair(mode, c.first, report);
+    times_.fair += msSince(clock);
+    c.quality = c.firstShaped ? meanShapeQuality(c.first.positions) : -1;
+    c.trainingSamples = report.training_samples;
+    c.firstNote = report.reason;
+    swapState(c.state);
   }
 
   // Triangulates the hole over `domain` into the members; `flat` gets the
@@ -2132,8 +2183,14 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
 
   Surface s;
   s.roundToFloat = options.round_to_float;
-  s.points = positionsOf(mesh);
-  s.triangles = trianglesOf(mesh);
+  // With room for the patches: each is appended for its check, and a
+  // reallocation would copy the whole mesh.
+  s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
+  for (const Vertex& v : mesh.vert) s.points.push_back(v.cP());
+  s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
+  for (const Face& f : mesh.face)
+    s.triangles.push_back({int(vcg::tri::Index(mesh, f.cV(0))), int(vcg::tri::Index(mesh, f.cV(1))),
+                           int(vcg::tri::Index(mesh, f.cV(2)))});
   s.inputVertices = s.points.size();
   s.inputFaces = s.triangles.size();
   s.adjacency = std::make_unique<VertexFaces>(s.triangles, s.points.size());
