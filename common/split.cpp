@@ -1119,11 +1119,11 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers();
     if (options.snap_tolerance > 0 && r.faces_split > 0) {
       reportProgress(options.progress, 95, "Snapping curve points");
+      const std::size_t facesBefore = merged.triangles.size();  // edge snaps add faces
       CurveSnapper snapper(merged, curves, r.merged_new_face, options.snap_tolerance);
       r.vertices_snapped = snapper.snapVertices();
       r.edges_snapped = snapper.snapEdges();
       const std::vector<int> snappedTo = snapper.snappedTo();
-      const std::size_t facesBefore = merged.triangles.size();
       std::vector<int> index;
       snapper.compact(merged, index);
       if (options.separate_meshes) {

@@ -87,6 +87,9 @@ TEST(Split, QualitySnappingRemovesSliversAndKeepsTheResultValid) {
     EXPECT_LE(merged.min_angle_deg, r.smallest_new_angle_deg + 1e-9);
     // Snapping merged vertices away: fewer vertices than without it.
     EXPECT_EQ(r.merged.vn + r.vertices_snapped, plain.merged.vn);
+    // The report counts what the output holds: faces added by edge snaps too.
+    EXPECT_EQ(std::size_t(r.merged.fn), std::size_t(a.fn + b.fn) + r.faces_added);
+    EXPECT_EQ(std::size_t(plain.merged.fn), std::size_t(a.fn + b.fn) + plain.faces_added);
   }
 }
 
