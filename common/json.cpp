@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 
 #include "common/errors.h"
@@ -42,8 +43,12 @@ std::string jsonQuote(const std::string& text) {
 
 std::string jsonNumber(double value) {
   if (!std::isfinite(value)) return "null";
+  // The fewest digits (of 15, 16, 17) that read back as the same double.
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", value);
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    if (std::strtod(buf, nullptr) == value) break;
+  }
   return buf;
 }
 
