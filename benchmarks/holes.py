@@ -894,7 +894,8 @@ def tables(holes, sp, repeat, machine, elapsed):
                         for h in holes) for m in OURS}
     goal = share["mean"] >= 0.8 * n
     out += ["",
-            f"**Summary** ({n} holes). Our default mode ({DEFAULT_FAIRING}) is at least as accurate as "
+            f"**Summary** ({n} holes). Our default mode ({DEFAULT_FAIRING}) is at least as "
+            "accurate as "
             f"CGAL on **{share['mean']} of {n} holes ({100 * share['mean'] / n:.0f} %) by mean "
             f"distance** (goal of issue 7: ≥ 80 %, {'met' if goal else 'not met'}), "
             f"{share['max']} of {n} ({100 * share['max'] / n:.0f} %) by maximum distance and "
