@@ -1496,6 +1496,11 @@ class HoleFiller {
       if (int(m) <= int(options_.fairing) &&
           std::find(modes.begin(), modes.end(), m) == modes.end())
         modes.push_back(m);
+    // Asked for the smoothest shape and none down to flat fits: the
+    // regression's, which bends with the curvature around the hole instead,
+    // may clear what they hit; it is tried before the hole is left open.
+    if (options_.fairing == HoleFairing::Biharmonic)
+      modes.push_back(HoleFairing::LaplacianRegression);
     // Each domain's patch, shaped in the first mode. The plane's is kept
     // when its triangles come out round in space; where the plane squeezes
     // part of the hole (the surface turns away from it), the disk's patch

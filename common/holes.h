@@ -88,8 +88,9 @@ struct HoleFillOptions {
   // ---- Checks. Exact test of every patch (with the faces its pre-treatment
   // split) against itself and the surface around it; a patch that
   // intersects is replaced by a flatter one (LaplacianRegression ->
-  // Biharmonic -> Harmonic -> Flat), or left out. Each shape is tried over
-  // both domains (plane, disk) that were triangulated before a flatter one. Its counts make
+  // Biharmonic -> Harmonic -> Flat; from Biharmonic, LaplacianRegression
+  // last), or left out. Each shape is tried over both domains (plane,
+  // disk) that were triangulated before the next one. Its counts make
   // remaining_intersecting_pairs exact.
   bool check_intersections = true;
   // Recount, independently and exactly, the intersecting pairs that involve

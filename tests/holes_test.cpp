@@ -512,6 +512,10 @@ TEST(HoleChecks, HoleWhoseFillMustCrossAnotherPartIsSkipped) {
   for (const HoleReport& h : r.holes) {
     if (h.boundary_edges > 4) {
       EXPECT_NE(h.reason.find("intersect"), std::string::npos) << h.reason;
+      // Every shape of the default chain was tried, the regression's last.
+      for (const char* shape : {"biharmonic", "harmonic", "flat", "laplacian_regression"})
+        EXPECT_NE(h.reason.find(std::string(shape) + " patch would intersect"), std::string::npos)
+            << shape << ": " << h.reason;
     }
   }
   EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
