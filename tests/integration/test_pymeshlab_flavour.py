@@ -6,9 +6,9 @@ name and the 2020.09 flavour's parameters, returns its report as the result
 map, raises MLException on bad input, and gives the same counts as the
 2020.09 flavour run by meshlabserver on the same real meshes."""
 import json
-import math
 import os
 import subprocess
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +16,7 @@ import pytest
 
 from conftest import (BUILD, DATA, PLUGIN_DIR, filters, meshcheck, mlx, read_ply,
                       require_shared_data, run_server, write_off, write_ply)
-from test_clearance import icosphere, nested_spheres
+from test_clearance import nested_spheres
 from test_stitch import indices, joined, sphere, two_sheets
 
 FLAVOUR = Path(os.environ.get("MESHMEND_PYMESHLAB_FLAVOUR_DIR", BUILD / "pymeshlab-flavour"))
@@ -190,10 +190,16 @@ def test_every_plugin_loads_and_passes_the_checks():
         assert [p["name"] for p in f["parameters"]] == \
             [p["name"] for p in old[f["name"]]["parameters"]], python
         assert f["class"] == old[f["name"]]["class"] and f["arity"] == old[f["name"]]["arity"]
-    # Defaults as pymeshlab computes them (on its 1x1x1 cube).
+    # Defaults as pymeshlab computes them (on its 1x1x1 cube), those of the
+    # 2020.09 flavour's dialog.
     holes = {p["name"]: p for p in listed["meshmend_fill_holes"]["parameters"]}
-    assert holes["max_diameter"]["type"] == "RichFloat" and holes["max_diameter"]["default"] == 0.5
-    assert holes["fairing"]["type"] == "RichEnum" and holes["fairing"]["default"] == 0
+    dialog = {p["name"]: ET.fromstring(p["xml"]).get("value")
+              for p in old[NAMES["meshmend_fill_holes"]]["parameters"]}
+    assert holes["max_diameter"]["type"] == "RichFloat"
+    assert holes["max_diameter"]["default"] == float(dialog["max_diameter"]) == 0.5
+    assert holes["fairing"]["type"] == "RichEnum"
+    assert str(holes["fairing"]["default"]) == dialog["fairing"]
+    assert holes["selected_only"]["default"] is False and dialog["selected_only"] == "false"
     assert holes["report_file"]["default"] == ""
 
 
