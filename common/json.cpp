@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 
 #include "common/errors.h"
@@ -43,12 +42,8 @@ std::string jsonQuote(const std::string& text) {
 
 std::string jsonNumber(double value) {
   if (!std::isfinite(value)) return "null";
-  // The fewest digits (of 15, 16, 17) that read back as the same double.
   char buf[32];
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-    if (std::strtod(buf, nullptr) == value) break;
-  }
+  std::snprintf(buf, sizeof buf, "%.10g", value);
   return buf;
 }
 
