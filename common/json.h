@@ -45,7 +45,7 @@ class JsonObject {
 
 // JSON string literal (quoted, escaped).
 std::string jsonQuote(const std::string& text);
-// Shortest round-trip-safe rendering of a finite double ("null" otherwise).
+// A finite double in 10 significant digits, as meshcheck prints it ("null" otherwise).
 std::string jsonNumber(double value);
 
 // Writes `object` to `path` (one line per key). Throws InvalidInputError with
