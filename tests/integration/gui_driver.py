@@ -10,7 +10,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from conftest import BUILD, ROOT
+from conftest import BUILD
 
 PREFIX = BUILD / "meshlab-prefix"
 SCREEN = (1280, 1024)
@@ -169,16 +169,18 @@ class MeshLabGui:
     def text(self, png=None):
         return " ".join(w.text for w in self.words(png))
 
-    def find(self, phrase, png=None, region=None, timeout=0):
-        """The first occurrence of `phrase` (words in a row) on the screen, as the
-        Word of its first word; None when absent. region = (x0, y0, x1, y1)."""
+    def find(self, phrase, png=None, region=None, timeout=0, last=False):
+        """The first (or lowest on the screen, with `last`) occurrence of
+        `phrase` (words in a row) on the screen, as the Word of its first word;
+        None when absent. region = (x0, y0, x1, y1)."""
         end = time.time() + timeout
         wanted = phrase.split()
         while True:
             words = self.words(png, region)
-            for i in range(len(words) - len(wanted) + 1):
-                if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted))):
-                    return words[i]
+            hits = [words[i] for i in range(len(words) - len(wanted) + 1)
+                    if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted)))]
+            if hits:
+                return max(hits, key=lambda w: w.top) if last else hits[0]
             if time.time() >= end or png:
                 return None
             time.sleep(0.5)
