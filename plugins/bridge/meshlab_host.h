@@ -30,6 +30,8 @@ using HostPoint = CMeshO::CoordType;
 // Whether the document stores float: the filters then decide on (and check)
 // the coordinates rounded as they will be stored.
 inline constexpr bool kHostStoresFloat = std::is_same_v<HostScalar, float>;
+// Its name, for the messages and tooltips that say how the result is stored.
+inline constexpr const char* kHostPrecision = kHostStoresFloat ? "float" : "double";
 
 // The document's layers, in the layer dialog's order.
 inline std::vector<MeshModel*> layersOf(MeshDocument& md) {

@@ -121,11 +121,13 @@ void IntersectPlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
                                  "curve edges, to see them and save them."));
     parameters.addParam(RichBool(
         "verify", true, "Check the written result",
-        "Counts the intersecting pairs left in the result as written (in float, as MeshLab "
-        "stores meshes; faces meeting only along a shared curve do not count) and logs them. "
-        "When every intersection of the inputs was split (self-intersections included), the "
-        "faces left as they were cannot intersect anything, so only pairs with a new face are "
-        "checked; otherwise the whole result is."));
+        QString("Counts the intersecting pairs left in the result as written (in %1, as "
+                "MeshLab stores meshes; faces meeting only along a shared curve do not count) "
+                "and logs them. ")
+                .arg(kHostPrecision) +
+            "When every intersection of the inputs was split (self-intersections included), the "
+            "faces left as they were cannot intersect anything, so only pairs with a new face are "
+            "checked; otherwise the whole result is."));
   } else {
     parameters.addParam(RichBool(
         "segments_layer", false, "Create a layer with the segments",

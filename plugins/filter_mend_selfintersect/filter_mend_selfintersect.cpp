@@ -67,8 +67,9 @@ void SelfIntersectPlugin::initParameters(QAction*, MeshDocument&, RichParameterL
       "new layer named 'removed parts', to see what went."));
   parameters.addParam(
       RichBool("verify", defaults.verify, "Verify the result",
-               "Counts the intersecting face pairs left in the result, exactly, as stored in float "
-               "(remaining_intersecting_pairs in the log and report)."));
+               QString("Counts the intersecting face pairs left in the result, exactly, as "
+                       "stored in %1 (remaining_intersecting_pairs in the log and report).")
+                   .arg(kHostPrecision)));
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
