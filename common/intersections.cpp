@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "common/box_tree.h"
@@ -21,10 +22,10 @@ double msSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// A mesh flattened for the inner loops.
+// A mesh flattened for the inner loops (the caller's arrays, not a copy).
 struct Soup {
-  std::vector<Point3> points;
-  std::vector<Triangle> triangles;
+  const std::vector<Point3>& points;
+  const std::vector<Triangle>& triangles;
   std::vector<Box> boxes;
   std::vector<char> degenerate;
   std::vector<PlaneSide> planes;  // per face: exact side of points against its plane
@@ -173,11 +174,17 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
         const std::size_t small = swap ? k : m, large = swap ? m : k;
         const Soup &s = soups[small], &l = soups[large];
         const Box& smallBounds = trees[small].bounds();
+        // Most faces of a large mesh lie inside the smaller one's bounds but
+        // far from its faces: a coarse grid of those turns them away before
+        // a tree descent (for a small mesh, its set-up would cost more).
+        std::unique_ptr<BoxGrid> nearSmall;
+        if (l.triangles.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(s.boxes);
         parallelChunks(
             l.triangles.size(),
             [&](std::size_t begin, std::size_t end, unsigned worker) {
               for (std::size_t g = begin; g < end; ++g) {
                 if (l.degenerate[g] || !overlap(l.boxes[g], smallBounds)) continue;
+                if (nearSmall && !nearSmall->touches(l.boxes[g])) continue;
                 const TrianglePoints tg = l.at(std::uint32_t(g));
                 trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
                   if (s.degenerate[f]) return;
