@@ -1,6 +1,7 @@
 #include "common/exact_point.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <numeric>
 
@@ -147,6 +148,80 @@ const RationalPoint& ExactPoint::exact() const {
   return *exact_;
 }
 
+namespace {
+
+// The input points of a construction as integers: coordinate = integer ×
+// 2^shift for one shift (the lowest bit any of them has), so that the
+// construction runs on integers and needs one reduction at the end instead
+// of a gcd after every rational operation.
+struct ScaledPoints {
+  std::array<std::array<mpz_class, 3>, 5> x;
+  long shift = 0;
+
+  ScaledPoints(const std::array<Point3, 5>& points, int count) {
+    long lowest = LONG_MAX;
+    for (int i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (points[i][k] != 0) {
+          int e;
+          std::frexp(points[i][k], &e);  // |value| = m 2^e, m in [0.5, 1): lowest bit >= e - 53
+          lowest = std::min(lowest, long(e) - 53);
+        }
+    shift = lowest == LONG_MAX ? 0 : lowest;
+    for (int i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k) {
+        int e;
+        const double m = std::frexp(points[i][k], &e);
+        mpz_class& z = x[i][k];
+        z = std::ldexp(m, 53);                    // an integer below 2^53: exact
+        const long raise = long(e) - 53 - shift;  // >= 0 for every non-zero coordinate
+        if (z != 0 && raise > 0) mpz_mul_2exp(z.get_mpz_t(), z.get_mpz_t(), (unsigned long)raise);
+      }
+  }
+};
+
+mpz_class orient3dInteger(const std::array<mpz_class, 3>& a, const std::array<mpz_class, 3>& b,
+                          const std::array<mpz_class, 3>& c, const std::array<mpz_class, 3>& d) {
+  mpz_class m[3][3];
+  for (int k = 0; k < 3; ++k) {
+    m[0][k] = b[k] - a[k];
+    m[1][k] = c[k] - a[k];
+    m[2][k] = d[k] - a[k];
+  }
+  return mpz_class(m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                   m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                   m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]));
+}
+
+mpz_class orient2dInteger(const std::array<mpz_class, 3>& a, const std::array<mpz_class, 3>& b,
+                          const std::array<mpz_class, 3>& c, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return mpz_class((b[u] - a[u]) * (c[v] - a[v]) - (b[v] - a[v]) * (c[u] - a[u]));
+}
+
+// p + t (q - p) for t = wp / (wp - wq), that is (wp q - wq p) / (wp - wq),
+// with p and q the scaled points 0 and 1 (wp and wq of one degree in them).
+RationalPoint alongScaled(const ScaledPoints& s, const mpz_class& wp, const mpz_class& wq) {
+  const mpz_class denominator = wp - wq;
+  RationalPoint r;
+  for (int k = 0; k < 3; ++k) {
+    mpq_class& x = r.x[k];
+    x.get_num() = wp * s.x[1][k] - wq * s.x[0][k];
+    x.get_den() = denominator;
+    if (sgn(x.get_den()) < 0) {
+      x.get_num() = -x.get_num();
+      x.get_den() = -x.get_den();
+    }
+    x.canonicalize();
+    // The weights' scale cancels in the ratio; the coordinates' remains.
+    if (s.shift > 0) mpq_mul_2exp(x.get_mpq_t(), x.get_mpq_t(), (unsigned long)s.shift);
+    if (s.shift < 0) mpq_div_2exp(x.get_mpq_t(), x.get_mpq_t(), (unsigned long)-s.shift);
+  }
+  return r;
+}
+
+}  // namespace
+
 void ExactPoint::computeExact() const {
   const auto& d = definition_;
   switch (kind_) {
@@ -155,17 +230,17 @@ void ExactPoint::computeExact() const {
       exact_ = std::make_shared<RationalPoint>(rationalOf(d[0]));
       return;
     case Kind::kEdgePlane: {
-      const RationalPoint p = rationalOf(d[0]), q = rationalOf(d[1]);
-      const RationalPoint r = rationalOf(d[2]), s = rationalOf(d[3]), t = rationalOf(d[4]);
-      const mpq_class sp = orient3dValue(r, s, t, p), sq = orient3dValue(r, s, t, q);
-      exact_ = std::make_shared<RationalPoint>(along(p, q, sp / (sp - sq)));
+      const ScaledPoints s(d, 5);
+      const mpz_class sp = orient3dInteger(s.x[2], s.x[3], s.x[4], s.x[0]);
+      const mpz_class sq = orient3dInteger(s.x[2], s.x[3], s.x[4], s.x[1]);
+      exact_ = std::make_shared<RationalPoint>(alongScaled(s, sp, sq));
       return;
     }
     case Kind::kEdgeLine: {
-      const RationalPoint p = rationalOf(d[0]), q = rationalOf(d[1]);
-      const RationalPoint r = rationalOf(d[2]), s = rationalOf(d[3]);
-      const mpq_class op = orient2dValue(r, s, p, axis_), oq = orient2dValue(r, s, q, axis_);
-      exact_ = std::make_shared<RationalPoint>(along(p, q, op / (op - oq)));
+      const ScaledPoints s(d, 4);
+      const mpz_class op = orient2dInteger(s.x[2], s.x[3], s.x[0], axis_);
+      const mpz_class oq = orient2dInteger(s.x[2], s.x[3], s.x[1], axis_);
+      exact_ = std::make_shared<RationalPoint>(alongScaled(s, op, oq));
       return;
     }
   }
@@ -189,7 +264,8 @@ int compareCoordinate(const ExactPoint& a, const ExactPoint& b, int k) {
   return sgn(a.exact().x[k] - b.exact().x[k]);
 }
 
-int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c, int axis) {
+int orient2dDroppingFiltered(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c,
+                             int axis) {
   if (a.isInputPoint() && b.isInputPoint() && c.isInputPoint())
     return orient2dDropping(a.approx(), b.approx(), c.approx(), axis);
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
@@ -197,7 +273,12 @@ int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint&
   const Interval det = (pb[u] - pa[u]) * (pc[v] - pa[v]) - (pb[v] - pa[v]) * (pc[u] - pa[u]);
   if (det.positive()) return 1;
   if (det.negative()) return -1;
-  return sgn(orient2dValue(a.exact(), b.exact(), c.exact(), axis));
+  return kUndecided;
+}
+
+int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c, int axis) {
+  const int sign = orient2dDroppingFiltered(a, b, c, axis);
+  return sign != kUndecided ? sign : sgn(orient2dValue(a.exact(), b.exact(), c.exact(), axis));
 }
 
 bool onSegment(const ExactPoint& p, const ExactPoint& a, const ExactPoint& b) {

@@ -83,6 +83,11 @@ int compareCoordinate(const ExactPoint& a, const ExactPoint& b, int k);
 // Sign of the orientation of (a, b, c) projected onto the plane that drops
 // `axis` (coordinates (axis+1)%3, (axis+2)%3): +1 counter-clockwise.
 int orient2dDropping(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c, int axis);
+// The same when the rounded values decide it (input points always do);
+// otherwise kUndecided, and only the exact value can tell.
+inline constexpr int kUndecided = 2;
+int orient2dDroppingFiltered(const ExactPoint& a, const ExactPoint& b, const ExactPoint& c,
+                             int axis);
 
 // Is p on the closed segment ab (collinear in 3-D and between them)?
 bool onSegment(const ExactPoint& p, const ExactPoint& a, const ExactPoint& b);
