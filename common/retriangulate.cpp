@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <set>
 
 #include "common/errors.h"
@@ -21,6 +20,12 @@ Edge key(int a, int b) {
 class Retriangulator {
  public:
   explicit Retriangulator(const PatchInput& in) {
+    // Room for every vertex and triangle a few constraints make, without
+    // moving the points (each copy of an ExactPoint is a reference count).
+    const std::size_t vertices = 3 + in.points.size() + in.segments.size();
+    V_.reserve(vertices);
+    edges_.reserve(vertices);
+    T_.reserve(2 * vertices);
     for (int i = 0; i < 3; ++i) add(in.corners[i], std::uint8_t((1 << i) | (1 << ((i + 2) % 3))));
     chooseProjection();
     T_.push_back({0, 1, 2});
@@ -41,8 +46,8 @@ class Retriangulator {
       insertSegment(out.vertex_of_input[s[0]], out.vertex_of_input[s[1]]);
     }
     if (in.improve) improve();
-    out.vertices = V_;
-    out.triangles = T_;
+    out.vertices = std::move(V_);
+    out.triangles = std::move(T_);
     for (const Edge& e : constrained_) out.constrained_edges.push_back({e.first, e.second});
     return out;
   }
@@ -85,7 +90,26 @@ class Retriangulator {
   }
   int orient(int a, int b, int c) const {
     if (edges_[a] & edges_[b] & edges_[c]) return 0;  // on one edge of the input triangle
-    return sign_ * orient2dDropping(V_[a], V_[b], V_[c], axis_);
+    const int sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
+    return sign_ * (sign != kUndecided ? sign : exactOrient(a, b, c));
+  }
+
+  // The exact orientation of three vertices the rounded values leave open
+  // (points on one curve are often exactly collinear), computed once per
+  // vertex triple: the segment insertion and the flips ask for the same
+  // triples in every order.
+  int exactOrient(int a, int b, int c) const {
+    std::array<int, 3> key{a, b, c};
+    int parity = 1;  // sorting the triple by swaps: each swap turns the orientation
+    if (key[0] > key[1]) std::swap(key[0], key[1]), parity = -parity;
+    if (key[1] > key[2]) std::swap(key[1], key[2]), parity = -parity;
+    if (key[0] > key[1]) std::swap(key[0], key[1]), parity = -parity;
+    for (const auto& [known, sign] : exactOrientations_)
+      if (known == key) return parity * sign;
+    const int sign =
+        sgn(orient2dValue(V_[key[0]].exact(), V_[key[1]].exact(), V_[key[2]].exact(), axis_));
+    exactOrientations_.push_back({key, sign});
+    return parity * sign;
   }
 
   // Is p visibly off the triangle's plane (from the rounded values)?
@@ -218,7 +242,8 @@ class Retriangulator {
       return u != a && u != b && w != a && w != b && orient(a, b, u) * orient(a, b, w) < 0 &&
              orient(u, w, a) * orient(u, w, b) < 0;
     };
-    std::deque<Edge> queue;
+    std::vector<Edge> queue;  // first in, first out from `next`
+    std::size_t next = 0;
     for (const auto& tri : T_)
       for (int i = 0; i < 3; ++i) {
         const int u = tri[i], w = tri[(i + 1) % 3];
@@ -241,11 +266,10 @@ class Retriangulator {
       }
     // Sloan's edge recovery: flip crossing edges whose quadrilateral is
     // convex; a flipped edge that still crosses goes back in the queue.
-    for (std::size_t guard = 0; !queue.empty(); ++guard) {
+    for (std::size_t guard = 0; next < queue.size(); ++guard) {
       if (guard > 100000)
         throw InvalidInputError("retriangulate: constraint recovery did not finish");
-      const Edge e = queue.front();
-      queue.pop_front();
+      const Edge e = queue[next++];
       Edge flipped;
       if (!flipIfConvex(e.first, e.second, &flipped)) {
         queue.push_back(e);
@@ -317,6 +341,7 @@ class Retriangulator {
   std::vector<std::array<int, 3>> T_;
   std::set<Edge> constrained_;
   int axis_ = 2, sign_ = 1;
+  mutable std::vector<std::pair<std::array<int, 3>, int>> exactOrientations_;
 };
 
 }  // namespace
