@@ -186,17 +186,7 @@ class MeshSplitter {
         points_(std::move(input.mesh.points)),
         triangles_(std::move(input.mesh.triangles)),
         vertexOrigin_(std::move(input.vertex_origin)),
-        faceOrigin_(std::move(input.face_origin)) {
-    // Faces around each vertex (compressed rows), to find the faces on an edge.
-    offsets_.assign(points_.size() + 1, 0);
-    for (const Triangle& t : triangles_)
-      for (int v : t) ++offsets_[v + 1];
-    for (std::size_t v = 0; v < points_.size(); ++v) offsets_[v + 1] += offsets_[v];
-    faces_.resize(offsets_.back());
-    std::vector<std::uint32_t> next(offsets_.begin(), offsets_.end() - 1);
-    for (std::size_t f = 0; f < triangles_.size(); ++f)
-      for (int v : triangles_[f]) faces_[next[v]++] = std::uint32_t(f);
-  }
+        faceOrigin_(std::move(input.face_origin)) {}
 
   const std::vector<Triangle>& triangles() const { return triangles_; }
 
@@ -223,6 +213,26 @@ class MeshSplitter {
       int id;
       std::uint8_t edges;
     };
+    // The faces around the corners of the faces that received points
+    // (compressed rows): two reading passes over the faces, where rows for
+    // every vertex would write three entries per face of the whole mesh.
+    std::vector<int> row(points_.size(), -1);
+    int rows = 0;
+    for (const auto& [f, w] : work_)
+      for (int v : triangles_[f])
+        if (row[v] < 0) row[v] = rows++;
+    std::vector<std::uint32_t> offsets(std::size_t(rows) + 1, 0), faces;
+    for (const Triangle& t : triangles_)
+      for (int v : t)
+        if (row[v] >= 0) ++offsets[row[v] + 1];
+    for (int r = 0; r < rows; ++r) offsets[r + 1] += offsets[r];
+    faces.resize(offsets.back());
+    {
+      std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+      for (std::size_t f = 0; f < triangles_.size(); ++f)
+        for (int v : triangles_[f])
+          if (row[v] >= 0) faces[next[row[v]]++] = std::uint32_t(f);
+    }
     std::vector<Shared> shared;
     for (auto& [f, w] : work_) {
       const Triangle& t = triangles_[f];
@@ -231,8 +241,8 @@ class MeshSplitter {
           const int a = t[i], b = t[(i + 1) % 3];
           if (!onEdge(table, w.points[p], a, b)) continue;
           w.edges[p] |= std::uint8_t(1 << i);
-          for (std::uint32_t k = offsets_[a]; k < offsets_[a + 1]; ++k) {
-            const std::uint32_t g = faces_[k];
+          for (std::uint32_t k = offsets[row[a]]; k < offsets[row[a] + 1]; ++k) {
+            const std::uint32_t g = faces[k];
             if (g == f) continue;
             const Triangle& u = triangles_[g];
             for (int j = 0; j < 3; ++j)
@@ -260,7 +270,9 @@ class MeshSplitter {
             if (collinear(t[0], t[1], t[2])) continue;  // degenerate: kept as it is (empty patch)
             PatchInput in;
             for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(t[k]);
+            in.points.reserve(w.points.size());
             for (int id : w.points) in.points.push_back(table.point(id));
+            in.segments.reserve(w.segments.size());
             in.on_edges = w.edges;
             for (const auto& s : w.segments) in.segments.push_back({3 + s[0], 3 + s[1]});
             patches_[i] = retriangulate(in);
@@ -379,7 +391,6 @@ class MeshSplitter {
   std::vector<Point3> points_;
   std::vector<Triangle> triangles_;
   std::vector<int> vertexOrigin_, faceOrigin_;  // input index of each vertex and face
-  std::vector<std::uint32_t> offsets_, faces_;
   std::unordered_map<std::uint32_t, FaceWork> work_;
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
@@ -993,6 +1004,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 
   reportProgress(options.progress, 40, "Collecting curve points");
   std::vector<MeshSplitter> splitters;
+  splitters.reserve(meshes.size());
   for (std::size_t m = 0; m < meshes.size(); ++m)
     splitters.emplace_back(std::move(inputs[m]), std::uint32_t(m));
   std::vector<const std::vector<Triangle>*> triangles;
