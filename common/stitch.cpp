@@ -7,6 +7,7 @@
 #include <cstring>
 #include <functional>
 #include <future>
+#include <memory>
 #include <numeric>
 #include <queue>
 #include <set>
@@ -489,75 +490,72 @@ class LocalEdges {
     int slots = 0;
     for (int v : vertices)
       if (slot_[v] < 0) slot_[v] = slots++;
-    // Two passes: over every face to count the uses per vertex (and note the
-    // faces that have some), then over the noted faces to place them.
+    // One pass over every face notes the edges concerned (a test on the
+    // slots of their ends, which the most edges fail) with the way the face
+    // runs them and its third corner; the uses are counted per vertex on the
+    // way, then placed.
     start_.assign(std::size_t(slots) + 1, 0);
-    const Vertex* base = mesh.vert.data();
-    std::vector<int> concerned;
-    auto usesOf = [&](int face, auto&& visit) {
-      const Face& f = mesh.face[face];
-      const int c[3] = {int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
-      const int s[3] = {slot_[c[0]], slot_[c[1]], slot_[c[2]]};
-      bool any = false;
-      for (int k = 0; k < 3; ++k) {
-        const int i = (k + 1) % 3, o = c[(k + 2) % 3];
-        if (among ? (s[k] < 0 || s[i] < 0) : (s[k] < 0 && s[i] < 0)) continue;
-        any = true;
-        if (s[k] >= 0) visit(s[k], Neighbour{c[i], o, 1, 0});
-        if (s[i] >= 0) visit(s[i], Neighbour{c[k], o, 0, 1});
-      }
-      return any;
+    struct Use {
+      int from, to, opposite;  // a face runs from -> to
     };
-    for (int face = 0; face < int(mesh.face.size()); ++face)
-      if (usesOf(face, [&](int s, const Neighbour&) { ++start_[s + 1]; }))
-        concerned.push_back(face);
+    std::vector<Use> found;
+    found.reserve(std::size_t(slots) * (among ? 2 : 6));  // a border path vertex: two edges
+    const Vertex* base = mesh.vert.data();
+    auto note = [&](int from, int to, int opposite, int slotFrom, int slotTo) {
+      // (s | t) >= 0: both are slots; (s & t) >= 0: one of them is.
+      if ((among ? (slotFrom | slotTo) : (slotFrom & slotTo)) < 0) return;
+      found.push_back({from, to, opposite});
+      if (slotFrom >= 0) ++start_[slotFrom + 1];
+      if (slotTo >= 0) ++start_[slotTo + 1];
+    };
+    for (const Face& f : mesh.face) {
+      const int c0 = int(f.cV(0) - base), c1 = int(f.cV(1) - base), c2 = int(f.cV(2) - base);
+      const int s0 = slot_[c0], s1 = slot_[c1], s2 = slot_[c2];
+      note(c0, c1, c2, s0, s1);
+      note(c1, c2, c0, s1, s2);
+      note(c2, c0, c1, s2, s0);
+    }
     for (int s = 0; s < slots; ++s) start_[s + 1] += start_[s];
     entries_.resize(start_.back());
     {
       std::vector<int> fill(start_.begin(), start_.end() - 1);
-      for (int face : concerned)
-        usesOf(face, [&](int s, const Neighbour& n) { entries_[fill[s]++] = n; });
-    }
-    // Merge the uses of one edge (a vertex has few), in place.
-    int write = 0;
-    for (int s = 0, read = 0; s < slots; ++s) {
-      const int end = start_[s + 1];
-      for (int i = read + 1; i < end; ++i)  // insertion sort: a vertex has few uses
-        for (int j = i; j > read && entries_[j - 1].v > entries_[j].v; --j)
-          std::swap(entries_[j - 1], entries_[j]);
-      start_[s] = write;
-      const int first = write;
-      for (; read < end; ++read) {
-        const Neighbour n = entries_[read];
-        if (write > first && entries_[write - 1].v == n.v) {
-          entries_[write - 1].out += n.out;
-          entries_[write - 1].in += n.in;
-        } else {
-          entries_[write++] = n;
-        }
+      for (const Use& u : found) {
+        const int slotFrom = slot_[u.from], slotTo = slot_[u.to];
+        if (slotFrom >= 0) entries_[fill[slotFrom]++] = Neighbour{u.to, u.opposite, 1, 0};
+        if (slotTo >= 0) entries_[fill[slotTo]++] = Neighbour{u.from, u.opposite, 0, 1};
       }
     }
-    start_[slots] = write;
-    entries_.resize(write);
   }
 
-  // The entry for b among a's neighbours (a must be one of the vertices).
-  const Neighbour* find(int a, int b) const {
+  // Edge a-b (a must be one of the vertices): the faces that run it each
+  // way and the third corner of one of them; no face: out = in = 0. The uses
+  // of an edge are added up here, not merged beforehand (a vertex has few,
+  // most edges are asked about once or twice).
+  Neighbour find(int a, int b) const {
+    Neighbour e{b, -1, 0, 0};
     const int s = a >= 0 && std::size_t(a) < slot_.size() ? slot_[a] : -1;
-    if (s < 0) return nullptr;
+    if (s < 0) return e;
     for (int i = start_[s]; i < start_[s + 1]; ++i)
-      if (entries_[i].v == b) return &entries_[i];
-    return nullptr;
+      if (entries_[i].v == b) {
+        if (e.opposite < 0) e.opposite = entries_[i].opposite;
+        e.out += entries_[i].out;
+        e.in += entries_[i].in;
+      }
+    return e;
   }
   int uses(int a, int b) const {
-    const Neighbour* e = find(a, b);
-    return e ? e->out + e->in : 0;
+    const Neighbour e = find(a, b);
+    return e.out + e.in;
   }
   // On a border edge (with `among`: on one to another of the vertices).
   bool onBorder(int a) const {
     const int s = slot_[a];
-    for (int i = start_[s]; i < start_[s + 1]; ++i)
-      if (entries_[i].out + entries_[i].in == 1) return true;
+    for (int i = start_[s]; i < start_[s + 1]; ++i) {
+      int uses = 0;
+      for (int j = start_[s]; j < start_[s + 1]; ++j)
+        if (entries_[j].v == entries_[i].v) uses += entries_[j].out + entries_[j].in;
+      if (uses == 1) return true;
+    }
     return false;
   }
 
@@ -577,11 +575,12 @@ struct StitchPlan {
   double maxAspect = 0;
 };
 
-// Longest edge over shortest altitude (infinite for a degenerate triangle).
-double aspectRatio(const Point3& a, const Point3& b, const Point3& c) {
+// The square of the aspect ratio, longest edge over shortest altitude
+// (infinite for a degenerate triangle): no root per face, one for the largest.
+double squaredAspectRatio(const Point3& a, const Point3& b, const Point3& c) {
   const double l = std::max({(b - a).SquaredNorm(), (c - b).SquaredNorm(), (a - c).SquaredNorm()});
-  const double area2 = ((b - a) ^ (c - a)).Norm();
-  return area2 > 0 ? l / area2 : INFINITY;
+  const double area2 = ((b - a) ^ (c - a)).SquaredNorm();
+  return area2 > 0 ? l * l / area2 : INFINITY;
 }
 
 // Arc-length parametrised polyline (the rows of a subdivided strip).
@@ -655,12 +654,15 @@ double correspondenceCost(const PathLine& a, const PathLine& b, bool reversedB) 
 // number of steps along one list. A step that would make a triangle with
 // exactly collinear corners takes the other list when it can, and so does a
 // step whose triangle would fold back over the face on its path edge
-// (valid(p, q, x): x lies beyond edge p-q, away from that face). Faces are
+// (valid(false, i, x): x lies beyond edge a[i]-a[i+1], away from that face;
+// valid(true, j, x): beyond edge b[j]-b[j+1]). Faces are
 // `forward` = (a[i], a[i+1], b[j]) and (b[j], a[i], b[j+1]), else reversed.
-// Returns, per step, whether it advanced along a.
+// Returns, per step, whether it advanced along a; raises maxSquaredAspect to
+// the faces' squared aspect ratios (their corners are at hand).
 template <class PointOf, class Valid>
 std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, PointOf&& point,
-                         Valid&& valid, bool forward, std::vector<Triangle>& faces) {
+                         Valid&& valid, bool forward, std::vector<Triangle>& faces,
+                         double& maxSquaredAspect) {
   std::vector<char> steps;
   steps.reserve(a.size() + b.size());
   faces.reserve(faces.size() + a.size() + b.size());
@@ -675,16 +677,20 @@ std::vector<char> zipper(const std::vector<int>& a, const std::vector<int>& b, P
       const Point3 &ai = point(a[i]), &ai1 = point(a[i + 1]), &bj = point(b[j]),
                    &bj1 = point(b[j + 1]);
       alongA = (ai1 - bj).SquaredNorm() <= (ai - bj1).SquaredNorm();
-      const bool validA = valid(a[i], a[i + 1], b[j]), validB = valid(b[j], b[j + 1], a[i]);
+      const bool validA = valid(false, i, b[j]), validB = valid(true, j, a[i]);
       if (validA != validB) alongA = validA;
       const bool flat = alongA ? collinear(ai, ai1, bj) : collinear(bj, ai, bj1);
       if (flat && !(alongA ? collinear(bj, ai, bj1) : collinear(ai, ai1, bj))) alongA = !alongA;
     }
     if (alongA) {
       faces.push_back(forward ? Triangle{a[i], a[i + 1], b[j]} : Triangle{a[i + 1], a[i], b[j]});
+      maxSquaredAspect =
+          std::max(maxSquaredAspect, squaredAspectRatio(point(a[i]), point(a[i + 1]), point(b[j])));
       ++i;
     } else {
       faces.push_back(forward ? Triangle{b[j], a[i], b[j + 1]} : Triangle{a[i], b[j], b[j + 1]});
+      maxSquaredAspect =
+          std::max(maxSquaredAspect, squaredAspectRatio(point(b[j]), point(a[i]), point(b[j + 1])));
       ++j;
     }
     steps.push_back(alongA);
@@ -732,9 +738,9 @@ void orientPath(PreparedPath& p, const LocalEdges& edges) {
   long along = 0, against = 0;
   const std::size_t count = p.closed ? p.v.size() : p.v.size() - 1;
   for (std::size_t k = 0; k < count; ++k) {
-    const LocalEdges::Neighbour* e = edges.find(p.v[k], p.v[k + 1 < p.v.size() ? k + 1 : 0]);
-    if (!e || e->out + e->in != 1) continue;
-    (e->out ? along : against)++;
+    const LocalEdges::Neighbour e = edges.find(p.v[k], p.v[k + 1 < p.v.size() ? k + 1 : 0]);
+    if (e.out + e.in != 1) continue;
+    (e.out ? along : against)++;
   }
   p.sign = along > against ? 1 : against > along ? -1 : 0;
   p.against = std::size_t(std::min(along, against));
@@ -745,10 +751,11 @@ void rotate(std::vector<T>& v, std::size_t first) {
   std::rotate(v.begin(), v.begin() + first, v.end());
 }
 
-// facesRead is called once the mesh's faces are no longer read (the plan
-// reads vertices and what it gathered from then on).
+// topologyRead is called once the mesh's faces are no longer read and
+// before any coordinate is (from then on the plan reads the path vertices'
+// coordinates and what it gathered).
 StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
-                      const std::function<void()>& facesRead = {}) {
+                      const std::function<void()>& topologyRead = {}) {
   StitchPlan plan;
   PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
   std::vector<char> inA(mesh.vert.size(), 0);
@@ -775,7 +782,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
                                     " is not on a border edge: stitch paths must follow borders");
     }
   }
-  if (facesRead) facesRead();
+  if (topologyRead) topologyRead();
   // Auto shape: a path whose ends share a border edge goes all around.
   for (auto [p, path] : {std::make_pair(&A, &o.a), std::make_pair(&B, &o.b)})
     if (path->shape == BorderPath::Shape::Auto && !p->closed && p->v.size() >= 3 &&
@@ -862,15 +869,18 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
   }
 
   // Every edge of a path gets one new face: it must be a border edge run
-  // the other way, or no edge yet.
+  // the other way, or no edge yet. Noted per edge: the third corner of the
+  // face on it (-1: no face), for the zipper's fold test.
   auto checkPathEdges = [&](const std::vector<int>& p, bool newFaceRunsForward, const char* name) {
+    std::vector<int> opposite(p.size() > 1 ? p.size() - 1 : 0, -1);
     for (std::size_t k = 0; k + 1 < p.size(); ++k) {
-      const LocalEdges::Neighbour* e = edges.find(p[k], p[k + 1]);
-      const int used = e ? e->out + e->in : 0;
+      const LocalEdges::Neighbour e = edges.find(p[k], p[k + 1]);
+      const int used = e.out + e.in;
       if (used == 0) {
         ++plan.borderDelta;
       } else if (used == 1) {
-        const bool existingForward = e->out == 1;
+        opposite[k] = e.opposite;
+        const bool existingForward = e.out == 1;
         if (existingForward == newFaceRunsForward && !o.allow_orientation_conflict)
           throw TopologyError("the border along path " + std::string(name) +
                               " changes direction between " + describeVertex(mesh, p[k]) + " and " +
@@ -883,22 +893,38 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
                             " already has two faces: the path leaves the border there");
       }
     }
+    return opposite;
   };
-  checkPathEdges(a, forward, "a");
-  checkPathEdges(b, !forward, "b");
+  const std::vector<int> oppositeA = checkPathEdges(a, forward, "a");
+  const std::vector<int> oppositeB = checkPathEdges(b, !forward, "b");
 
   const int n = int(mesh.vert.size());
   auto existingPoint = [&](int v) -> Point3 { return mesh.vert[v].cP(); };
-  // Beyond edge p-q: on the other side of it than the face already on it,
-  // measured in that face's plane (any point is beyond an edge with no face).
-  auto beyond = [&](int p, int q, int x) {
-    const LocalEdges::Neighbour* e = edges.find(p, q);
-    if (!e || e->out + e->in != 1 || x >= n) return true;
-    const Point3 P = existingPoint(p), d = existingPoint(q) - P;
-    const Point3 normal = d ^ (existingPoint(e->opposite) - P);
-    return ((d ^ (existingPoint(x) - P)) * normal) < 0;
+  // Beyond edge k of path a (onB: of path b): on the other side of it than
+  // the face already on it, measured in that face's plane (any point is
+  // beyond an edge with no face).
+  // The zipper asks about one edge of each path until it moves past it: the
+  // edge's frame is kept for the next question.
+  struct EdgeFrame {
+    std::size_t k = SIZE_MAX;
+    Point3 P, d, normal;
+  } frames[2];
+  auto beyond = [&](bool onB, std::size_t k, int x) {
+    const int opposite = (onB ? oppositeB : oppositeA)[k];
+    if (opposite < 0) return true;
+    EdgeFrame& f = frames[onB];
+    if (f.k != k) {
+      const std::vector<int>& p = onB ? b : a;
+      f.k = k;
+      f.P = existingPoint(p[k]);
+      f.d = existingPoint(p[k + 1]) - f.P;
+      f.normal = f.d ^ (existingPoint(opposite) - f.P);
+    }
+    return ((f.d ^ (existingPoint(x) - f.P)) * f.normal) < 0;
   };
-  std::vector<char> steps = zipper(a, b, existingPoint, beyond, forward, plan.faces);
+  double maxSquaredAspect = 0;
+  std::vector<char> steps =
+      zipper(a, b, existingPoint, beyond, forward, plan.faces, maxSquaredAspect);
 
   // Rungs: an end rung may close an existing border edge; an inner rung
   // gets two new faces, so it must not exist yet.
@@ -906,14 +932,15 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
     std::size_t i = 0, j = 0;
     for (std::size_t s = 0; s <= steps.size(); ++s) {
       const bool end = !A.closed && (s == 0 || s == steps.size());
-      const LocalEdges::Neighbour* e = a[i] != b[j] ? edges.find(a[i], b[j]) : nullptr;
-      const int used = e ? e->out + e->in : 0;
+      const LocalEdges::Neighbour e =
+          a[i] != b[j] ? edges.find(a[i], b[j]) : LocalEdges::Neighbour{b[j], -1, 0, 0};
+      const int used = e.out + e.in;
       if (end) {
         // The first face runs b[0] -> a[0] (forward), the last a -> b.
         const bool newRunsAToB = (s == 0) != forward;
         if (used == 0) {
           ++plan.borderDelta;
-        } else if (used == 1 && (e->out == 1) != newRunsAToB) {
+        } else if (used == 1 && (e.out == 1) != newRunsAToB) {
           --plan.borderDelta;
         } else {
           throw TopologyError("the stitch would add a face to the edge from " +
@@ -969,6 +996,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
     }
     if (strips > 1) {
       plan.faces.clear();
+      maxSquaredAspect = 0;
       std::vector<std::vector<int>> rows{a};
       for (int k = 1; k < strips; ++k) {
         const double t = double(k) / strips;
@@ -994,8 +1022,11 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
       auto anyPoint = [&](int v) -> Point3 {
         return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
       };
+      // One of the two rows of every strip is new vertices: the fold test,
+      // made between an existing edge and an existing vertex, never applies.
+      auto anyIsValid = [](bool, std::size_t, int) { return true; };
       for (std::size_t k = 0; k + 1 < rows.size(); ++k)
-        zipper(rows[k], rows[k + 1], anyPoint, beyond, forward, plan.faces);
+        zipper(rows[k], rows[k + 1], anyPoint, anyIsValid, forward, plan.faces, maxSquaredAspect);
       // End rungs are now chains of strips edges (new border edges).
       if (!A.closed) {
         const bool closesFirst = edges.uses(a.front(), b.front()) == 1;
@@ -1007,12 +1038,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
       }
     }
   }
-  auto anyPoint = [&](int v) -> Point3 {
-    return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
-  };
-  for (const Triangle& t : plan.faces)
-    plan.maxAspect =
-        std::max(plan.maxAspect, aspectRatio(anyPoint(t[0]), anyPoint(t[1]), anyPoint(t[2])));
+  plan.maxAspect = std::sqrt(maxSquaredAspect);
   return plan;
 }
 
@@ -1113,68 +1139,104 @@ void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
 }  // namespace
 
 std::size_t countBorderEdges(const Mesh& mesh) {
-  // Each edge's other end listed at its smaller end (a counting sort), then
-  // the few per vertex sorted: linear, and lighter than full edge uses.
+  // Each edge's other end is listed at its smaller end (a counting sort:
+  // one pass to count, one to place). While placing, the few ends already
+  // listed at that vertex are searched: an end listed once is turned into
+  // its complement (a second use), and a third use changes nothing. The
+  // count follows as the edges are placed: no sort, no pass over the lists.
   const Vertex* base = mesh.vert.data();
   const std::size_t n = mesh.vert.size();
-  std::vector<int> start(n + 1, 0);
-  for (const Face& f : mesh.face)
-    for (int k = 0; k < 3; ++k) ++start[std::min(f.cV(k) - base, f.cV((k + 1) % 3) - base) + 1];
-  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
-  std::vector<int> other(start.back());
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (const Face& f : mesh.face)
-    for (int k = 0; k < 3; ++k) {
-      const auto a = f.cV(k) - base, b = f.cV((k + 1) % 3) - base;
-      other[fill[std::min(a, b)]++] = int(std::max(a, b));
-    }
+  auto cornersOf = [base](const Face& f) {
+    return std::array<int, 3>{int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
+  };
+  std::vector<int> fill(n + 1, 0);
+  for (const Face& f : mesh.face) {
+    const std::array<int, 3> c = cornersOf(f);
+    ++fill[std::min(c[0], c[1]) + 1];
+    ++fill[std::min(c[1], c[2]) + 1];
+    ++fill[std::min(c[2], c[0]) + 1];
+  }
+  // fill[v]: where v's list starts, then where its next end goes.
+  for (std::size_t v = 0; v < n; ++v) fill[v + 1] += fill[v];
+  std::vector<int> start(fill.begin(), fill.end() - 1);
+  const std::unique_ptr<int[]> other(new int[std::size_t(fill[n])]);  // every slot written first
   std::size_t border = 0;
-  for (std::size_t v = 0; v < n; ++v) {
-    int* b = other.data() + start[v];
-    int* e = other.data() + start[v + 1];
-    std::sort(b, e);
-    for (int* i = b; i != e;) {
-      int* j = i + 1;
-      while (j != e && *j == *i) ++j;
-      if (j - i == 1) ++border;
-      i = j;
+  auto place = [&](int a, int b) {
+    const int low = std::min(a, b), high = std::max(a, b);  // ~high < 0 <= high
+    int* const first = other.get() + start[low];
+    int* const last = other.get() + fill[low];
+    for (int* e = first; e != last; ++e) {
+      if (*e == high) {  // the second use: no longer a border edge
+        *e = ~high;
+        --border;
+        return;
+      }
+      if (*e == ~high) return;  // a third or later use
     }
+    *last = high;
+    ++fill[low];
+    ++border;
+  };
+  for (const Face& f : mesh.face) {
+    const std::array<int, 3> c = cornersOf(f);
+    place(c[0], c[1]);
+    place(c[1], c[2]);
+    place(c[2], c[0]);
   }
   return border;
 }
 
 StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
   const auto start = Clock::now();
-  requireFacesAndFiniteCoordinates(mesh, "the mesh");
   requireCompact(mesh);
   if (options.max_aspect_ratio < 0 || options.max_rows < 0)
     throw InvalidInputError("max_aspect_ratio and max_rows must not be negative");
   reportProgress(options.progress, 0, "Planning the stitch");
   StitchResult r;
-  // On the second core, while the stitch is planned: the mesh's border edges
-  // are counted (for the report), then, once the faces are no longer read,
-  // room is made for the new ones (the copy into a larger array is most of
-  // the cost of adding them).
-  std::promise<void> facesFree;
+  // On the second core, while the plan reads the faces around the paths:
+  // the coordinates are checked (the plan waits for that before it reads
+  // one), the mesh's border edges are counted (for the report), then, once
+  // the faces are no longer read, room is made for the new faces and their
+  // provenance (the copy into larger arrays is most of the cost of adding
+  // them), its memory touched by a resize up and back, so that writing the
+  // new faces does not stop at every fresh page.
+  std::promise<void> coordinatesChecked, facesFree;
+  const std::shared_future<void> coordinates = coordinatesChecked.get_future().share();
   bool freed = false;
   auto release = [&] {
     if (!freed) facesFree.set_value();
     freed = true;
   };
   const std::size_t room = mesh.face.size() + options.a.vertices.size() + options.b.vertices.size();
-  auto background = std::async(std::launch::async, [&mesh, free = facesFree.get_future(), room] {
+  auto secondCore = [&mesh, &coordinatesChecked, free = facesFree.get_future(), room] {
+    try {
+      requireFacesAndFiniteCoordinates(mesh, "the mesh");
+      coordinatesChecked.set_value();
+    } catch (...) {
+      coordinatesChecked.set_exception(std::current_exception());
+      return std::make_pair(std::size_t(0), 0.0);
+    }
     const auto t = Clock::now();
     const std::size_t count = countBorderEdges(mesh);
     const double ms = msSince(t);
     free.wait();
+    const std::size_t faces = mesh.face.size();
     mesh.face.reserve(room);
+    mesh.face.resize(room);
+    mesh.face.resize(faces);
+    auto& origins = faceOrigins(mesh)._handle->data;
+    origins.reserve(room);
+    origins.resize(room);
+    origins.resize(faces);
     return std::make_pair(count, ms);
-  });
+  };
+  auto background = std::async(std::launch::async, std::move(secondCore));
   StitchPlan plan;
   try {
     auto clock = Clock::now();
     plan = planStitch(mesh, options, [&] {
       if (!options.check_intersections) release();
+      coordinates.get();
     });
     r.stage_ms.plan = msSince(clock);
     if (options.check_intersections) {
@@ -1185,7 +1247,8 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
       r.stage_ms.check = msSince(clock);
     }
   } catch (...) {
-    release();  // the second thread finishes before the error leaves
+    release();          // the second thread finishes before the error leaves
+    coordinates.get();  // an empty mesh or a bad coordinate is reported first
     throw;
   }
   release();
