@@ -709,7 +709,8 @@ PreparedPath preparePath(const Mesh& mesh, const BorderPath& path, const char* n
   PreparedPath p;
   p.v = path.vertices;
   const std::string what = std::string("path ") + name;
-  for (int v : p.v) requireVertex(mesh, v, what);
+  for (int v : p.v)
+    if (v < 0 || std::size_t(v) >= mesh.vert.size()) requireVertex(mesh, v, what);
   bool repeated = false;
   if (p.v.size() > 2 && p.v.front() == p.v.back()) {
     p.v.pop_back();
@@ -724,12 +725,13 @@ PreparedPath preparePath(const Mesh& mesh, const BorderPath& path, const char* n
   return p;
 }
 
-void checkDistinct(const Mesh& mesh, const PreparedPath& p, std::vector<char>& seen,
+// Marks the path's vertices with `bit` in `on`, and refuses a repeated one.
+void checkDistinct(const Mesh& mesh, const PreparedPath& p, std::vector<char>& on, char bit,
                    const char* name) {
   for (int v : p.v) {
-    if (seen[v])
+    if (on[v] & bit)
       throw InvalidInputError(describeVertex(mesh, v) + " appears twice in path " + name);
-    seen[v] = 1;
+    on[v] |= bit;
   }
 }
 
@@ -758,12 +760,10 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
                       const std::function<void()>& topologyRead = {}) {
   StitchPlan plan;
   PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
-  std::vector<char> inA(mesh.vert.size(), 0);
-  {
-    checkDistinct(mesh, A, inA, "a");
-    std::vector<char> seenB(mesh.vert.size(), 0);
-    checkDistinct(mesh, B, seenB, "b");
-  }
+  constexpr char kOnA = 1, kOnB = 2;
+  std::vector<char> on(mesh.vert.size(), 0);
+  checkDistinct(mesh, A, on, kOnA, "a");
+  checkDistinct(mesh, B, on, kOnB, "b");
   std::vector<int> all = A.v;
   all.insert(all.end(), B.v.begin(), B.v.end());
   const LocalEdges edges(mesh, all, true);
@@ -796,7 +796,7 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
   // Shared vertices: only the ends of open paths (a crack closing at a point).
   {
     for (std::size_t k = 0; k < B.v.size(); ++k)
-      if (inA[B.v[k]]) {
+      if (on[B.v[k]] & kOnA) {
         const bool endOfB = k == 0 || k + 1 == B.v.size();
         const bool endOfA = B.v[k] == A.v.front() || B.v[k] == A.v.back();
         if (A.closed || !endOfA || !endOfB)
