@@ -1468,6 +1468,21 @@ class NearPoints {
             if ((points_[id] - q).SquaredNorm() <= radius_ * radius_) visit(id);
         }
   }
+  // Points within `radius` of q, which may exceed the cell (a few cells
+  // further; a cell may be visited twice where two hash alike).
+  template <class Visit>
+  void near(const Point3& q, double radius, Visit&& visit) const {
+    const long reach = std::max(1L, long(std::ceil(radius / radius_)));
+    const auto c = cellOf(q);
+    for (long dx = -reach; dx <= reach; ++dx)
+      for (long dy = -reach; dy <= reach; ++dy)
+        for (long dz = -reach; dz <= reach; ++dz) {
+          const auto it = cells_.find(hash({c[0] + dx, c[1] + dy, c[2] + dz}));
+          if (it == cells_.end()) continue;
+          for (int id : it->second)
+            if ((points_[id] - q).SquaredNorm() <= radius * radius) visit(id);
+        }
+  }
 
  private:
   std::array<long, 3> cellOf(const Point3& p) const {
@@ -1833,8 +1848,13 @@ void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>&
 // tip (the same vertex, or the two ends of one border edge) are extended
 // to it, so that stitching them closes the crack. Pairs with a path of
 // fewer than minPathVertices vertices are left out.
+// The bound: `bound`, or, between two vertices of one part (joined by
+// faces: a slit or crack, not a gap between separate parts), localFactor x
+// the mean length of the border edges at either vertex, whichever is
+// smaller (at most four times the typical local bound: a few long border
+// edges do not widen the search everywhere).
 std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::vector<Triangle>& T,
-                                     double bound, int minPathVertices) {
+                                     double bound, double localFactor, int minPathVertices) {
   const BorderLoops found = findBorderLoops(P, T);
   const std::vector<BorderLoop>& loops = found.loops;
   const std::size_t n = P.size();
@@ -1855,9 +1875,17 @@ std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::ve
       arc[l][k + 1] = arc[l][k] + (wraps && !loops[l].closed ? 0.0 : (P[next] - P[loop[k]]).Norm());
     }
   }
-  // Across each border edge, away from its face, in the face's plane.
+  // Across each border edge, away from its face, in the face's plane; and
+  // the lengths of the border edges at each vertex.
   std::vector<Point3> outward(n, Point3(0, 0, 0));
+  std::vector<double> borderLength(n, 0);
+  std::vector<int> borderEdges(n, 0);
   for (const BorderEdge& e : borderEdgesDirected(T)) {
+    const double edgeLength = (P[e.to] - P[e.from]).Norm();
+    for (const int v : {e.from, e.to}) {
+      borderLength[v] += edgeLength;
+      ++borderEdges[v];
+    }
     const Triangle& t = T[e.face];
     const Point3 normal = (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
     Point3 across = (P[e.to] - P[e.from]) ^ normal;
@@ -1872,15 +1900,40 @@ std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::ve
     const double d = std::abs(arc[l][i] - arc[l][j]);
     return loops[l].closed ? std::min(d, arc[l].back() - d) : d;
   };
-  const NearPoints near(P, ids, bound);
+  auto localBound = [&](int v) {
+    return borderEdges[v] > 0 ? localFactor * borderLength[v] / borderEdges[v] : 0.0;
+  };
+  // Parts: vertices joined through faces.
+  std::vector<int> part(n);
+  std::iota(part.begin(), part.end(), 0);
+  auto partOf = [&](int v) {
+    while (part[v] != v) v = part[v] = part[part[v]];
+    return v;
+  };
+  for (const Triangle& t : T)
+    for (int k = 1; k < 3; ++k) part[partOf(t[k])] = partOf(t[0]);
+  // The grid's cell: the bound, or the typical (median) local bound if larger.
+  double cell = bound;
+  if (localFactor > 0 && !ids.empty()) {
+    std::vector<double> locals;
+    for (int v : ids) locals.push_back(localBound(v));
+    std::nth_element(locals.begin(), locals.begin() + locals.size() / 2, locals.end());
+    cell = std::max(cell, locals[locals.size() / 2]);
+  }
+  if (!(cell > 0)) return {};
+  const NearPoints near(P, ids, cell);
   std::vector<int> partnerOf(n, -1);
   for (int v : ids) {
     double best = INFINITY;
     const int l = loopOf[v];
-    near.near(P[v], [&](int w) {
+    const double radius = std::min(std::max(bound, localBound(v)), 4 * cell);
+    near.near(P[v], radius, [&](int w) {
       if (w == v) return;
       const Point3 d = P[w] - P[v];
       const double distance = d.Norm();
+      if (distance > bound &&
+          (partOf(v) != partOf(w) || distance > std::min(localBound(v), localBound(w))))
+        return;
       if (loopOf[w] == l) {
         const double along = alongLoop(l, positionOf[v], positionOf[w]);
         if (along <= 0 || along < 2 * distance) return;
@@ -1992,8 +2045,9 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
   requireFacesAndFiniteCoordinates(mesh, "the mesh");
   requireCompact(mesh);
   if (!(options.merge_tolerance >= 0) || !(options.max_gap >= 0) ||
-      !(options.max_aspect_ratio >= 0))
-    throw InvalidInputError("merge_tolerance, max_gap and max_aspect_ratio must not be negative");
+      !(options.local_gap_factor >= 0) || !(options.max_aspect_ratio >= 0))
+    throw InvalidInputError(
+        "merge_tolerance, max_gap, local_gap_factor and max_aspect_ratio must not be negative");
   CloseGapsResult r;
   std::vector<Point3> P = positionsOf(mesh);
   std::vector<Triangle> T = trianglesOf(mesh);
@@ -2051,42 +2105,51 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
   r.border_edges_after_merge = borderEdgesOf(T);
   r.border_edges_after = r.border_edges_after_merge;
 
-  // ---- Step 2: facing borders.
+  // ---- Step 2: facing borders, in rounds: a stitch can leave borders that
+  // face each other anew (the rest of an L-shaped slit), so they are looked
+  // for again until a round stitches nothing.
   if (r.max_gap > 0) {
-    reportProgress(options.progress, 30, "Finding facing borders");
-    r.gaps = facingBorders(P, T, r.max_gap, options.min_path_vertices);
-    r.gaps_found = r.gaps.size();
-    // Stitch each pair on the current mesh (earlier stitches change borders).
-    for (std::size_t k = 0; k < r.gaps.size(); ++k) {
-      GapReport& g = r.gaps[k];
-      reportProgress(options.progress, 40 + int(50 * k / std::max<std::size_t>(1, r.gaps.size())),
-                     "Stitching");
-      if (!g.reason.empty()) continue;
-      StitchOptions so;
-      so.a = {g.path_a, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
-      so.b = {g.path_b, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
-      so.max_aspect_ratio = options.max_aspect_ratio;
-      try {
-        const StitchPlan plan = planStitch(mesh, so);
-        if (plan.conflicts > 0) {
-          g.reason = "the two sides are inconsistently oriented";
-          continue;
+    constexpr int kRounds = 8;
+    std::set<std::pair<std::vector<int>, std::vector<int>>> reported;
+    for (int round = 0; round < kRounds; ++round) {
+      reportProgress(options.progress, 30 + 60 * round / kRounds, "Finding facing borders");
+      std::vector<GapReport> gaps =
+          facingBorders(positionsOf(mesh), trianglesOf(mesh), r.max_gap, options.local_gap_factor,
+                        options.min_path_vertices);
+      std::size_t stitched = 0;
+      // Stitch each pair on the current mesh (earlier stitches change borders).
+      for (GapReport& g : gaps) {
+        if (!reported.insert({g.path_a, g.path_b}).second) continue;  // left open before
+        ++r.gaps_found;
+        if (g.reason.empty()) {
+          StitchOptions so;
+          so.a = {g.path_a, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
+          so.b = {g.path_b, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
+          so.max_aspect_ratio = options.max_aspect_ratio;
+          try {
+            const StitchPlan plan = planStitch(mesh, so);
+            if (plan.conflicts > 0) {
+              g.reason = "the two sides are inconsistently oriented";
+            } else if (options.check_intersections && newIntersections(mesh, plan) > 0) {
+              g.reason = "the stitch would intersect the mesh";
+            } else {
+              StitchResult sr;
+              applyPlan(mesh, plan, sr);
+              g.stitched = true;
+              g.faces_added = sr.faces_added;
+              r.faces_added += sr.faces_added;
+              r.vertices_added += sr.vertices_added;
+              r.border_edges_after = std::size_t(long(r.border_edges_after) + plan.borderDelta);
+              ++r.gaps_stitched;
+              ++stitched;
+            }
+          } catch (const Error& e) {
+            g.reason = e.what();
+          }
         }
-        if (options.check_intersections && newIntersections(mesh, plan) > 0) {
-          g.reason = "the stitch would intersect the mesh";
-          continue;
-        }
-        StitchResult sr;
-        applyPlan(mesh, plan, sr);
-        g.stitched = true;
-        g.faces_added = sr.faces_added;
-        r.faces_added += sr.faces_added;
-        r.vertices_added += sr.vertices_added;
-        r.border_edges_after = std::size_t(long(r.border_edges_after) + plan.borderDelta);
-        ++r.gaps_stitched;
-      } catch (const Error& e) {
-        g.reason = e.what();
+        r.gaps.push_back(std::move(g));
       }
+      if (stitched == 0) break;
     }
   }
   // ---- The output's intersecting pairs that involve a merged or new face.

@@ -211,6 +211,12 @@ struct CloseGapsOptions {
   // (stitchPaths' triangulation): runs of two loops, or the two sides of a
   // crack in one loop. 0 = no stitching.
   double max_gap = 0.01;
+  // Within one part (vertices joined through faces), a slit or crack is
+  // closed too where it is no wider than local_gap_factor x the mean length
+  // of the border edges on either side (whichever is shorter), even beyond
+  // max_gap: a crack as narrow as the edges around it, whatever the mesh's
+  // size. Separate parts are stitched within max_gap only. 0 = max_gap alone.
+  double local_gap_factor = 1.5;
   // Runs of fewer border vertices facing another border are left open.
   int min_path_vertices = 2;
   double max_aspect_ratio = 0;  // subdivision of the stitched strips (StitchOptions)

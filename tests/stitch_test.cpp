@@ -813,10 +813,76 @@ TEST(CloseGaps, CrackInsideOneBorderIsClosed) {
   // the other, whose end edges close the strip at the tips.
   EXPECT_EQ(r.faces_added, 6u);
   expectClean(m, 2u * (nu + nv), P.size());
-  // A bound below the crack's width leaves it.
+  // A bound below the crack's width leaves it, when it is the only bound;
+  // the crack is far narrower than its edges, so the local one closes it.
   Mesh wide = makeMesh(P, T);
   o.max_gap = 0.005;
+  o.local_gap_factor = 0;
   EXPECT_EQ(closeGaps(wide, o).faces_added, 0u);
+  Mesh local = makeMesh(P, T);
+  o.local_gap_factor = 1.5;
+  EXPECT_EQ(closeGaps(local, o).faces_added, 6u);
+  expectClean(local, 2u * (nu + nv), P.size());
+}
+
+// A sheet of unit edges with a slit one edge wide: the faces of column 3,
+// rows 1 to 3, are missing.
+Mesh slitSheet(int nu, int nv) {
+  Mesh full = sheet(nu, nv, [](int i, int j) { return Point3(i, j, 0); });
+  std::vector<Triangle> T;
+  for (const Triangle& t : trianglesOf(full)) {
+    const int i = std::min({t[0], t[1], t[2]}) % (nu + 1), j = t[0] / (nu + 1);
+    if (!(i == 3 && j >= 1 && j <= 3)) T.push_back(t);
+  }
+  return makeMesh(positionsOf(full), T);
+}
+
+TEST(CloseGaps, SlitOneEdgeWideIsClosedByDefault) {
+  const int nu = 8, nv = 6;
+  Mesh m = slitSheet(nu, nv);
+  const std::size_t vertices = m.vert.size();
+  ASSERT_EQ(edgeStats(m).border, 2u * (nu + nv) + 8);
+  // The default max_gap (1 % of the diagonal, 0.1) is a tenth of the slit's
+  // width; its sides are as far apart as their edges are long.
+  const CloseGapsResult r = closeGaps(m);
+  EXPECT_LT(r.max_gap, 0.2);
+  ASSERT_EQ(r.gaps_stitched, 1u);
+  EXPECT_EQ(r.faces_added, 6u);
+  EXPECT_EQ(r.border_edges_after, 2u * (nu + nv));
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectClean(m, 2u * (nu + nv), vertices);
+  // With the diagonal's fraction alone it stays open.
+  Mesh open = slitSheet(nu, nv);
+  CloseGapsOptions o;
+  o.local_gap_factor = 0;
+  EXPECT_EQ(closeGaps(open, o).faces_added, 0u);
+  EXPECT_EQ(edgeStats(open).border, 2u * (nu + nv) + 8);
+}
+
+TEST(CloseGaps, SeparatePartsAreStitchedWithinMaxGapOnly) {
+  // Two sheets of unit edges facing each other across `gap`: separate
+  // parts, so the local bound (1.5 edges) does not join them, whether the
+  // gap is within it or beyond it; max_gap does.
+  auto twoSheets = [](double gap) {
+    const Mesh a = sheet(6, 2, [](int i, int j) { return Point3(i, j, 0); });
+    const Mesh b = sheet(6, 2, [&](int i, int j) { return Point3(i, 2 + gap + j, 0); });
+    return appended(a, b);
+  };
+  for (const double gap : {1.0, 2.0}) {
+    Mesh m = twoSheets(gap);
+    const std::size_t border = edgeStats(m).border;
+    CloseGapsOptions o;
+    o.absolute_distances = true;
+    o.max_gap = 0.5 * gap;
+    const CloseGapsResult r = closeGaps(m, o);
+    EXPECT_EQ(r.gaps_found, 0u) << "gap " << gap;
+    EXPECT_EQ(r.faces_added, 0u) << "gap " << gap;
+    EXPECT_EQ(edgeStats(m).border, border) << "gap " << gap;
+    Mesh joined = twoSheets(gap);
+    o.max_gap = 1.01 * gap;
+    EXPECT_EQ(closeGaps(joined, o).faces_added, 12u) << "gap " << gap;
+    expectClean(joined, border - 12 + 2, m.vert.size());
+  }
 }
 
 TEST(CloseGaps, DistancesAreFractionsOfTheDiagonalUnlessAbsolute) {

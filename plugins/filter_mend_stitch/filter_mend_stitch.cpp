@@ -348,10 +348,16 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "Before merging, flips faces so that faces meeting at an edge run it opposite ways "
         "(soups whose facets face against their neighbours then merge); a part that needs it is "
         "turned outward when closed, else keeps the orientation of most of its area."));
-    parameters.addParam(
-        RichFloat("max_gap", 0.01f, "Max gap (fraction of the diagonal)",
-                  "Borders facing each other within this fraction of the bounding box diagonal are "
-                  "stitched with new faces; 0 only merges."));
+    parameters.addParam(RichFloat(
+        "max_gap", 0.01f, "Max gap (fraction of the diagonal)",
+        "Borders facing each other within this fraction of the bounding box diagonal are "
+        "stitched with new faces (within one part, narrow slits also beyond it: see the local "
+        "gap factor); 0 only merges."));
+    parameters.addParam(RichFloat(
+        "local_gap_factor", 1.5f, "Local gap factor (x border edge length)",
+        "Within one part, a slit or crack no wider than this many times the mean length of the "
+        "border edges on either side is closed too, even beyond the max gap; separate parts are "
+        "stitched within the max gap only. 0: the max gap alone."));
     parameters.addParam(
         RichInt("min_path_vertices", 2, "Min facing run (vertices)",
                 "Runs of fewer border vertices facing another border are left open."));
@@ -674,14 +680,16 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   options.progress = progressFrom(cb);
   options.merge_tolerance = parameters.getFloat("merge_tolerance");  // fractions of the diagonal
   options.max_gap = parameters.getFloat("max_gap");
+  options.local_gap_factor = parameters.getFloat("local_gap_factor");
   options.orient_faces = parameters.getBool("orient_faces");
   options.min_path_vertices = parameters.getInt("min_path_vertices");
   options.max_aspect_ratio = parameters.getFloat("max_aspect_ratio");
   options.check_intersections = parameters.getBool("check_intersections");
   if (!(options.merge_tolerance >= 0) || !(options.max_gap >= 0) ||
-      !(options.max_aspect_ratio >= 0))
+      !(options.local_gap_factor >= 0) || !(options.max_aspect_ratio >= 0))
     throw InvalidInputError(
-        "the merge tolerance, the max gap and the aspect ratio bound must not be negative");
+        "the merge tolerance, the max gap, the local gap factor and the aspect ratio bound must "
+        "not be negative");
   const bool allVisible = parameters.getBool("all_visible_layers");
 
   std::vector<MeshModel*> layers;

@@ -314,6 +314,10 @@ OptionTable<CloseGapsOptions> gapsTable() {
       "max_gap", [](O& o) -> double& { return o.max_gap; },
       "border runs facing each other within this distance are stitched; 0 = no stitching");
   t.add(
+      "local_gap_factor", [](O& o) -> double& { return o.local_gap_factor; },
+      "within one part, slits no wider than this many times their border edges are closed too "
+      "(even beyond max_gap); 0 = max_gap alone");
+  t.add(
       "min_path_vertices", [](O& o) -> int& { return o.min_path_vertices; },
       "runs of fewer border vertices facing another border are left open");
   t.add(

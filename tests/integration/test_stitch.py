@@ -490,30 +490,34 @@ def test_close_gaps_leaves_fewer_borders_than_cgal(tmp_path, name):
         assert key in r
 
 
-def test_close_gaps_closes_holes_one_edge_wide_within_a_larger_max_gap(tmp_path):
-    """CGAL's pinched grid: after the merge, its inside borders are holes
-    one grid cell (0.1, 8.6 % of the diagonal) wide, left by the default
-    max_gap (1 %); with 10 % their facing sides are stitched, and only the
-    grid's outline (32 edges) and what the checks refuse stay open."""
+def test_close_gaps_closes_slits_one_edge_wide_by_default(tmp_path):
+    """CGAL's pinched grid: after the merge, its inside borders are slits
+    one grid cell (0.1, 8.6 % of the diagonal) wide, beyond the default
+    max_gap (1 %) but as narrow as their border edges, so the default local
+    bound closes them and only the grid's outline (32 edges) stays open
+    (an L-shaped slit in a second round). With the diagonal's fraction alone
+    they stay open, unless max_gap reaches their width."""
     require_shared_data()
     src = DATA / "stitching" / "cgaltest_pinched.off"
-    outs = []
-    for max_gap in (0.01, 0.1):
-        out = tmp_path / f"closed_{max_gap}.ply"
-        script = sample("close_gaps.mlx").replace('name="max_gap" value="0.01"',
-                                                  f'name="max_gap" value="{max_gap}"')
+    runs = {}
+    for name, max_gap, factor in (("default", "0.01", "1.5"), ("global", "0.01", "0"),
+                                  ("wide", "0.1", "0")):
+        out = tmp_path / f"closed_{name}.ply"
+        script = sample("close_gaps.mlx").replace(
+            'name="max_gap" value="0.01"', f'name="max_gap" value="{max_gap}"').replace(
+            'name="local_gap_factor" value="1.5"', f'name="local_gap_factor" value="{factor}"')
         run = run_server(tmp_path, [src], script, outputs=[out])
         assert run.returncode == 0, run.log[-3000:]
         after = meshcheck(out)
         assert run.report["border_edges_after"] == after["border_edges"]
         expect_clean(after)
-        outs.append((run.report, after))
-    (default, _), (wide, after) = outs
-    print(f"\npinched: border edges {default['border_edges_after']} (max_gap 0.01) -> "
-          f"{wide['border_edges_after']} (0.1), {wide['gaps_stitched']} of {wide['gaps_found']} "
-          f"facing pairs stitched")
-    assert default["border_edges_after"] == 56 and default["faces_added"] == 0
-    assert 32 <= wide["border_edges_after"] < 56 and wide["faces_added"] > 0
+        runs[name] = run.report
+    print("\npinched: border edges " + ", ".join(
+        f"{name} {r['border_edges_after']} ({r['gaps_stitched']} of {r['gaps_found']} facing "
+        f"pairs stitched)" for name, r in runs.items()))
+    assert runs["default"]["border_edges_after"] == 32 and runs["default"]["faces_added"] == 18
+    assert runs["global"]["border_edges_after"] == 56 and runs["global"]["faces_added"] == 0
+    assert runs["wide"]["border_edges_after"] == 32 and runs["wide"]["faces_added"] == 18
 
 
 # ---- an assembly of two real range scans --------------------------------------
