@@ -528,9 +528,10 @@ def stitch(repeat):
            "sheet's first row. Each run stitches its own copy of the mesh, made beforehand. No "
            "peer library does this (CGAL's `stitch_borders` only merges borders that already "
            "coincide, MeshLab has no such filter), so ours is measured alone, without and with "
-           "the exact check of the new faces against the faces near the gap. The stitch counts "
-           "the mesh's border edges (for its report) and makes room for the new faces on a "
-           "second thread while it plans; *CPU* is the time one untimed run kept the calling "
+           "the exact check of the new faces against the faces near the gap. The stitch checks "
+           "the coordinates, counts the mesh's border edges (for its report) and makes room for "
+           "the new faces on a second thread while it plans; *CPU* is the time one untimed run "
+           "kept the calling "
            "thread and the whole process busy (on a loaded machine the wall time also waits "
            "for other programs).",
            "",
@@ -558,8 +559,9 @@ def stitch(repeat):
            f"{fmt(checked['median_ms'])} ms.",
            "",
            "**Close Gaps Between Borders** (`closeGaps` with the filter's defaults: orienting, "
-           "merging at 0 tolerance, stitching within 1 % of the diagonal, each stitch checked, "
-           "the result verified) against CGAL 5.5's `PMP::stitch_borders`, on the files of "
+           "merging at 0 tolerance, stitching within 1 % of the diagonal and, within one part, "
+           "slits no wider than 1.5 times their border edges, each stitch checked, the result "
+           "verified) against CGAL 5.5's `PMP::stitch_borders`, on the files of "
            "`../shared/data/stitching` as stored (an STL as its facet soup, three vertices per "
            "facet, for both; CGAL's `Surface_mesh` made from the same soup without merging its "
            "points). Both timed on a copy made in the timed run; *unverified* is ours without "
@@ -591,10 +593,14 @@ def stitch(repeat):
     out += ["",
             "What is left open: on `cgaltest_deg_border.off` the outer sides of the two fans "
             "(the zero-area face on CGAL's border collapses, so its three edges merge too); on "
-            "`quads_to_stitch.off` the outline of the joined sheet; on `cgaltest_pinched.off` "
-            "the grid's outline (32 edges) and three holes one grid cell wide (0.1, 8.6 % of "
-            "the diagonal, beyond the default `max_gap` of 1 %; with `max_gap` 0.1 their facing "
-            "sides are stitched and 38 edges remain, `tests/integration/test_stitch.py`). "
+            "`quads_to_stitch.off` the outline of the joined sheet (two strips of four quads, "
+            "1 × 1 each, merged along their common side into one 1 × 2 sheet: 4 + 4 + 2 + 2 "
+            "edges, which no closing of gaps can remove, so 12 is the least possible); on "
+            "`cgaltest_pinched.off` the grid's outline (32 edges, likewise the least): its three "
+            "slits one grid cell wide (0.1, 8.6 % of the diagonal, beyond the default `max_gap` "
+            "of 1 %) are as narrow as their border edges, so the local bound closes them (the "
+            "rest of the L-shaped one, if a first stitch leaves it, in a second round; "
+            "`tests/integration/test_stitch.py`). "
             "`conrod.stl`'s facets are oriented against their neighbours: `stitch_borders` "
             "merges none of those edges, ours flips 2,170 facets first and closes the part; "
             "where two of its solids touch along an edge their vertices stay apart."]
