@@ -231,8 +231,11 @@ QString StitchPlugin::filterInfo(FilterIDType id) const {
          "length collapses its face, and where solids touch along an edge each closes on its "
          "own. Step 2: border loops, or runs of them, that face each other within the maximum "
          "gap are stitched with the merge-like triangulation, also the two sides of a crack in "
-         "one loop. Nothing is merged or stitched that would make an edge non-manifold "
-         "or break the orientation; a stitch whose faces would intersect the mesh is left out "
+         "one loop; within one part, a slit or crack no wider than the local gap factor times "
+         "its border edges is closed even beyond the maximum gap, and borders that face each "
+         "other after a round of stitches are stitched in the next. Nothing is merged or "
+         "stitched that would make an edge non-manifold or break the orientation; a stitch "
+         "whose faces would intersect the mesh is left out "
          "with its reason in the log. Works on the current layer, or on all visible layers "
          "merged into a new layer (layer matrices applied). Merged vertices are removed, so "
          "vertex indices change; faces keep their attributes." +

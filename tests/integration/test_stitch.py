@@ -495,7 +495,8 @@ def test_close_gaps_closes_slits_one_edge_wide_by_default(tmp_path):
     one grid cell (0.1, 8.6 % of the diagonal) wide, beyond the default
     max_gap (1 %) but as narrow as their border edges, so the default local
     bound closes them and only the grid's outline (32 edges) stays open
-    (an L-shaped slit in a second round). With the diagonal's fraction alone
+    (the rest of an L-shaped slit, if a first stitch leaves it, in a second
+    round). With the diagonal's fraction alone
     they stay open, unless max_gap reaches their width."""
     require_shared_data()
     src = DATA / "stitching" / "cgaltest_pinched.off"
