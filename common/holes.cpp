@@ -72,18 +72,29 @@ class VertexFaces {
   VertexFaces(const std::vector<Triangle>& triangles, std::size_t vertexCount)
       : triangles_(triangles), tableVertices_(vertexCount) {
     start_.assign(vertexCount + 1, 0);
-    for (const Triangle& t : triangles)
-      for (int v : t) ++start_[std::size_t(v) + 1];
+    int* count = start_.data() + 1;
+    for (const Triangle& t : triangles) {
+      ++count[t[0]];
+      ++count[t[1]];
+      ++count[t[2]];
+    }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
-    faces_.resize(start_.back());
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t f = 0; f < triangles.size(); ++f)
-      for (int v : triangles[f]) faces_[fill[v]++] = int(f);
+    faces_.reset(new int[std::size_t(start_.back())]);
+    std::vector<int> next(start_.begin(), start_.end() - 1);
+    int* at = next.data();
+    int* faces = faces_.get();
+    const int faceCount = int(triangles.size());
+    for (int f = 0; f < faceCount; ++f) {
+      const Triangle& t = triangles[std::size_t(f)];
+      faces[at[t[0]]++] = f;
+      faces[at[t[1]]++] = f;
+      faces[at[t[2]]++] = f;
+    }
   }
 
   // The faces of the table at v, as built (before any add or change).
   std::pair<const int*, const int*> initial(int v) const {
-    return {faces_.data() + start_[v], faces_.data() + start_[v + 1]};
+    return {faces_.get() + start_[v], faces_.get() + start_[v + 1]};
   }
 
   // Face f is new, or has v as a new corner.
@@ -122,7 +133,8 @@ class VertexFaces {
  private:
   const std::vector<Triangle>& triangles_;
   std::size_t tableVertices_;
-  std::vector<int> start_, faces_;
+  std::vector<int> start_;
+  std::unique_ptr<int[]> faces_;  // not value-initialised: every entry is written
   std::unordered_map<int, std::vector<int>> extra_;
 };
 
@@ -259,24 +271,29 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
   // no sorting, in parallel.
   std::vector<std::vector<BorderEdge>> found(workerCount());
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-    std::vector<int> next, previous;
+    std::vector<int> after, before;  // the corners after / before v in each face
     for (std::size_t v = begin; v < end; ++v) {
-      const auto [first, last] = adjacency.initial(int(v));
+      const int me = int(v);
+      const auto [first, last] = adjacency.initial(me);
       const std::size_t count = std::size_t(last - first);
-      next.resize(count);
-      previous.resize(count);
-      for (std::size_t i = 0; i < count; ++i) {
-        const Triangle& t = T[first[i]];
-        const int k = t[0] == int(v) ? 0 : t[1] == int(v) ? 1 : 2;
-        next[i] = t[k == 2 ? 0 : k + 1];
-        previous[i] = t[k == 0 ? 2 : k - 1];
+      if (after.size() < count) {
+        after.resize(count);
+        before.resize(count);
       }
       for (std::size_t i = 0; i < count; ++i) {
-        const int b = next[i];
+        const Triangle& t = T[std::size_t(first[i])];
+        after[i] = t[0] == me ? t[1] : t[1] == me ? t[2] : t[0];
+        before[i] = t[0] == me ? t[2] : t[1] == me ? t[0] : t[1];
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        const int b = after[i];
         // Inside a consistently oriented surface the twin face has b before v.
-        bool once = std::find(previous.begin(), previous.end(), b) == previous.end();
-        for (std::size_t j = 0; once && j < count; ++j) once = j == i || next[j] != b;
-        if (once) found[worker].push_back({int(v), b, first[i]});
+        std::size_t j = 0;
+        while (j < count && before[j] != b) ++j;
+        if (j < count) continue;
+        bool once = true;
+        for (j = 0; once && j < count; ++j) once = j == i || after[j] != b;
+        if (once) found[worker].push_back({me, b, first[i]});
       }
     }
   });
@@ -411,6 +428,10 @@ bool withinBox(Vec2 p, Vec2 q, Vec2 r) {
 
 // Exact: do the closed segments ab and cd share a point?
 bool segmentsMeet(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  // Closed boxes apart: no common point (compared exactly, most pairs end here).
+  if (std::max(a.x, b.x) < std::min(c.x, d.x) || std::max(c.x, d.x) < std::min(a.x, b.x) ||
+      std::max(a.y, b.y) < std::min(c.y, d.y) || std::max(c.y, d.y) < std::min(a.y, b.y))
+    return false;
   const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
   if (o1 * o2 < 0 && o3 * o4 < 0) return true;
   return (o1 == 0 && withinBox(a, b, c)) || (o2 == 0 && withinBox(a, b, d)) ||
@@ -430,7 +451,8 @@ double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
 }
 
 // Uniform grid over a rectangle: ids registered in the cells their box
-// covers (points and boxes outside are clamped to the border cells).
+// covers (points and boxes outside are clamped to the border cells). Each
+// cell is a list threaded through one array of entries: no allocation per cell.
 class Grid {
  public:
   Grid(Vec2 lo, Vec2 hi, double cell, std::size_t maxCells) : lo_(lo) {
@@ -439,13 +461,18 @@ class Grid {
     inverse_ = 1 / cell;
     nx_ = std::max(1, std::min(4096, int(w * inverse_) + 1));
     ny_ = std::max(1, std::min(4096, int(h * inverse_) + 1));
-    cells_.resize(std::size_t(nx_) * std::size_t(ny_));
+    head_.assign(std::size_t(nx_) * std::size_t(ny_), -1);
+    entries_.reserve(2 * head_.size());
   }
   void insert(int id, Vec2 lo, Vec2 hi) {
     const auto [x0, y0] = cellOf(lo);
     const auto [x1, y1] = cellOf(hi);
     for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) cells_[std::size_t(y) * nx_ + x].push_back(id);
+      for (int x = x0; x <= x1; ++x) {
+        int& head = head_[std::size_t(y) * nx_ + x];
+        entries_.push_back({id, head});
+        head = int(entries_.size() - 1);
+      }
   }
   // Calls visit(id) for the ids in the cells the box covers (an id may come more than once).
   template <class Visit>
@@ -454,10 +481,14 @@ class Grid {
     const auto [x1, y1] = cellOf(hi);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x)
-        for (int id : cells_[std::size_t(y) * nx_ + x]) visit(id);
+        for (int e = head_[std::size_t(y) * nx_ + x]; e >= 0; e = entries_[std::size_t(e)].next)
+          visit(entries_[std::size_t(e)].id);
   }
 
  private:
+  struct Entry {
+    int id, next;
+  };
   std::pair<int, int> cellOf(Vec2 p) const {
     const double fx = (p.x - lo_.x) * inverse_, fy = (p.y - lo_.y) * inverse_;
     const int x = std::isfinite(fx) ? int(std::clamp(fx, 0.0, double(nx_ - 1))) : 0;
@@ -467,7 +498,8 @@ class Grid {
   Vec2 lo_;
   double inverse_ = 1;
   int nx_ = 1, ny_ = 1;
-  std::vector<std::vector<int>> cells_;
+  std::vector<int> head_;  // per cell: its last entry, or -1
+  std::vector<Entry> entries_;
 };
 
 Vec2 boxLo(Vec2 a, Vec2 b) {
@@ -1426,18 +1458,29 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
         },
         64);
   } else {
+    // Beyond which sides of the patch's bounds (rounded outwards) each
+    // point lies, a bit per side and axis: a face whose corners share a bit
+    // is away from the patch, as most of a large mesh is. (A face split
+    // since lies within its input face: its current corners decide that.)
+    std::vector<std::uint8_t> beyond(P.size());
+    parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t v = begin; v < end; ++v) {
+        const Point3& p = P[v];
+        unsigned code = 0;
+        for (int k = 0; k < 3; ++k)
+          code |= unsigned(p[k] < bounds.lo[k]) << k | unsigned(p[k] > bounds.hi[k]) << (k + 3);
+        beyond[v] = std::uint8_t(code);
+      }
+    });
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
       for (std::size_t f = begin; f < end; ++f) {
+        const Triangle& current = T[f];
+        if (beyond[std::size_t(current[0])] & beyond[std::size_t(current[1])] &
+            beyond[std::size_t(current[2])])
+          continue;
+        if (!other(f)) continue;
         const Triangle t = inputCorners(f);
-        const Point3 &a = P[t[0]], &b = P[t[1]], &c = P[t[2]];
-        // Beyond the patch's bounds on one side of an axis (they are
-        // rounded outwards): nothing to test. Most of a large mesh.
-        bool away = false;
-        for (int k = 0; k < 3 && !away; ++k)
-          away = (a[k] < bounds.lo[k] && b[k] < bounds.lo[k] && c[k] < bounds.lo[k]) ||
-                 (a[k] > bounds.hi[k] && b[k] > bounds.hi[k] && c[k] > bounds.hi[k]);
-        if (away || !other(f)) continue;
-        tree.query(boxOf(a, b, c), worker, [&](std::uint32_t i, unsigned) {
+        tree.query(boxOf(P[t[0]], P[t[1]], P[t[2]]), worker, [&](std::uint32_t i, unsigned) {
           if (intersect(checked[i], int(f))) ++pairs;
         });
       }
@@ -1513,6 +1556,10 @@ class HoleFiller {
     HoleFillResult::StageTimes twinTimes;
     std::exception_ptr twinError;
     if (domains.size() == 2) {
+      // The stage times stay wall times of this thread: the time spent
+      // waiting for the disk's patch counts as fairing.
+      const auto parallelStart = Clock::now();
+      const double triangulateBefore = times_.triangulate, fairBefore = times_.fair;
       HoleFiller twin(s_, options_, pinched_, twinTimes);
       twin.n_ = n_;
       twin.front_ = front_;
@@ -1529,8 +1576,7 @@ class HoleFiller {
       shapeOver(domains[0], modes[0], report, made[0], problem[0]);
       disk.join();
       if (twinError) std::rethrow_exception(twinError);
-      times_.triangulate += twinTimes.triangulate;
-      times_.fair += twinTimes.fair;
+      times_.fair = fairBefore + msSince(parallelStart) - (times_.triangulate - triangulateBefore);
     } else {
       for (std::size_t i = 0; i < domains.size(); ++i)
         shapeOver(domains[i], modes[0], report, made[i], problem[i]);
@@ -1572,6 +1618,7 @@ class HoleFiller {
   // A patch of at least this mean shape quality (1 = equilateral triangles)
   // over the hole's plane is used without trying the disk.
   static constexpr double kRoundPatchQuality = 0.85;
+  static constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
   // The triangulated patch over one domain (what prepare() leaves in the members).
   struct PatchState {
@@ -1586,7 +1633,10 @@ class HoleFiller {
   struct Candidate {
     Domain domain;
     PatchState state;
+    // The boundary, and the flat placement of the new vertices once known
+    // (over a disk it takes a solve of its own, made only when needed).
     std::vector<Point3> flat;
+    bool flatPlaced = false;
     PatchShape first;  // shaped in the first mode
     bool firstShaped = false;
     double quality = -1;
@@ -1628,7 +1678,8 @@ class HoleFiller {
                  std::string& problem) {
     c.domain = domain;
     report.reason.clear();
-    if (!prepare(domain, report, c.flat)) {
+    c.flatPlaced = domain.planar || mode == HoleFairing::Flat;
+    if (!prepare(domain, report, c.flat, c.flatPlaced)) {
       problem = report.reason.empty() ? "no patch" : report.reason;
       return;
     }
@@ -1644,8 +1695,10 @@ class HoleFiller {
   }
 
   // Triangulates the hole over `domain` into the members; `flat` gets the
-  // flat placement. False (reason in the report) when it cannot.
-  bool prepare(const Domain& domain, HoleReport& report, std::vector<Point3>& flat) {
+  // boundary and, with `placeFlat`, the flat placement of the new vertices.
+  // False (reason in the report) when it cannot.
+  bool prepare(const Domain& domain, HoleReport& report, std::vector<Point3>& flat,
+               bool placeFlat) {
     auto clock = Clock::now();
     const bool covered = triangulate(domain, report);
     times_.triangulate += msSince(clock);
@@ -1660,10 +1713,15 @@ class HoleFiller {
       patchTriangles_.push_back(g);
     }
     buildRows();
+    if (!placeFlat) {
+      flat.assign(uv_.size(), Point3(0, 0, 0));
+      for (std::size_t k = 0; k < n_; ++k) flat[k] = s_.points[front_[k]];
+      return true;
+    }
     clock = Clock::now();
     const bool placed = flatPositions(domain, flat);
     times_.fair += msSince(clock);
-    if (!placed) report.reason = "the membrane over the disk could not be solved";
+    if (!placed) report.reason = kNoMembrane;
     return placed;
   }
 
@@ -1683,9 +1741,13 @@ class HoleFiller {
       report.reason = c.firstNote;
       report.training_samples = c.trainingSamples;
     } else {
+      const auto clock = Clock::now();
+      if (mode == HoleFairing::Flat && !c.flatPlaced) {
+        if (!flatPositions(c.domain, c.flat)) return fail(std::string(": ") + kNoMembrane);
+        c.flatPlaced = true;
+      }
       shape.positions = c.flat;
       shape.fairing = mode;
-      const auto clock = Clock::now();
       faired = mode == HoleFairing::Flat || fair(mode, shape, report);
       times_.fair += msSince(clock);
     }
@@ -1840,7 +1902,8 @@ class HoleFiller {
       return true;
     }
     double residual = 0;
-    return membrane(x, MembraneWeights::Uniform, residual);
+    Membrane m;
+    return membrane(m, x, MembraneWeights::Uniform, residual);
   }
 
   // Normal (area weighted) and a third of the area of the faces around local vertex v.
@@ -1868,35 +1931,97 @@ class HoleFiller {
   // new vertices (unknowns), with (L x)_r = (1 / 2 A_r) sum_j omega_rj (x_j -
   // x_r) the cotangent Laplacian (Eq. 1-3 with Eq. 4's area): the sum
   // discretises the integral of |Laplacian|^2 whatever the local triangle
-  // size. Normal equations factorised once per weight set.
+  // size. The rows' vertices, the pattern of the normal equations and its
+  // ordering follow from the triangulation alone: they are worked out at the
+  // first weight set, and each later one only refills the numbers and
+  // factorises again.
   struct System {
-    Eigen::SparseMatrix<double> A;  // rows x unknowns: sqrt(A_r) x the Laplacian rows
-    Eigen::MatrixXd fixedPart;      // rows x 3: the fixed vertices' contribution
-    Eigen::VectorXd rowWeight;      // 1 / (2 sqrt(A_r)): row r of A is omega_rj x this
-    std::vector<double> rowLength;  // sum_j |omega_rj|: turns a row's residual into a length
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+    // Row r's entries are [start[r], start[r + 1]): a key (local vertex, or
+    // -(global + 1) outside the patch) and its coefficient, omega_rj times
+    // the row's weight; the row's own vertex comes first.
+    std::vector<int> start, key;
+    std::vector<double> coefficient;
+    // Per row, from pairStart[r]: where the product of each pair (i <= j)
+    // of its unknown entries goes in the values of normal.
+    std::vector<int> pairStart, pairSlot;
+    Eigen::SparseMatrix<double> normal;  // A^T A, lower triangle
+    Eigen::MatrixXd fixedPart;           // rows x 3: the fixed vertices' contribution
+    Eigen::VectorXd rowWeight;           // 1 / (2 sqrt(A_r))
+    std::vector<double> rowLength;       // sum_j |omega_rj|: turns a row's residual into a length
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> solver;
     bool analysed = false, ok = false;
   };
+
+  // The lower triangle of a symmetric pattern over `size` unknowns, from
+  // the pairs (row >= column) it holds (repeats allowed): bucketed by
+  // column, each column's few rows then sorted.
+  static Eigen::SparseMatrix<double> lowerPattern(std::size_t size,
+                                                  const std::vector<std::pair<int, int>>& pairs) {
+    std::vector<int> start(size + 1, 0);
+    for (const auto& [row, column] : pairs) ++start[std::size_t(column) + 1];
+    for (std::size_t c = 0; c < size; ++c) start[c + 1] += start[c];
+    std::vector<int> rows(pairs.size());
+    {
+      std::vector<int> fill(start.begin(), start.end() - 1);
+      for (const auto& [row, column] : pairs) rows[std::size_t(fill[std::size_t(column)]++)] = row;
+    }
+    Eigen::SparseMatrix<double> m(static_cast<Eigen::Index>(size), static_cast<Eigen::Index>(size));
+    m.resizeNonZeros(Eigen::Index(pairs.size()));
+    int* outer = m.outerIndexPtr();
+    int* inner = m.innerIndexPtr();
+    int count = 0;
+    outer[0] = 0;
+    for (std::size_t c = 0; c < size; ++c) {
+      int* begin = rows.data() + start[c];
+      int* end = rows.data() + start[c + 1];
+      std::sort(begin, end);
+      end = std::unique(begin, end);
+      for (const int* r = begin; r != end; ++r) inner[count++] = *r;
+      outer[c + 1] = count;
+    }
+    m.resizeNonZeros(count);
+    std::fill(m.valuePtr(), m.valuePtr() + count, 0.0);
+    return m;
+  }
+
+  // Where entry (row, column), row >= column, is in the values of a compressed lower pattern.
+  static int slotOf(const Eigen::SparseMatrix<double>& m, int row, int column) {
+    const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[column];
+    const int* end = m.innerIndexPtr() + m.outerIndexPtr()[column + 1];
+    return int(std::lower_bound(begin, end, row) - m.innerIndexPtr());
+  }
 
   void assemble(System& sys, const std::vector<int>& rows, const std::vector<Point3>& x,
                 bool planarWeights) const {
     const std::size_t unknowns = uv_.size() - n_;
-    std::vector<Eigen::Triplet<double>> entries;
+    const int first = int(n_);
     sys.fixedPart = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), 3);
     sys.rowLength.assign(rows.size(), 0);
     sys.rowWeight.resize(Eigen::Index(rows.size()));
     const std::vector<TriangleWeights> weights = patchWeights(x, planarWeights);
+    const bool symbolic = !sys.analysed;
+    if (symbolic) {
+      sys.start.assign(1, 0);
+      sys.key.clear();
+      sys.coefficient.clear();
+    }
     LaplacianRow row;
     for (std::size_t r = 0; r < rows.size(); ++r) {
       const int v = rows[r];
       rowOf(v, weights, row);
       const double weight = row.area > 0 ? 1 / (2 * std::sqrt(row.area)) : 1.0;
       sys.rowWeight[Eigen::Index(r)] = weight;
+      if (symbolic) {
+        sys.key.push_back(v);
+        for (const auto& [key, w] : row.weights) sys.key.push_back(key);
+        sys.start.push_back(int(sys.key.size()));
+        sys.coefficient.resize(sys.key.size());
+      }
+      int at = sys.start[r];
       auto put = [&](int key, double coefficient) {
         coefficient *= weight;
-        if (key >= int(n_)) {
-          entries.push_back({int(r), key - int(n_), coefficient});
-        } else {
+        sys.coefficient[std::size_t(at++)] = coefficient;
+        if (key < first) {
           const Point3& p = fixedPosition(key, x);
           for (int d = 0; d < 3; ++d) sys.fixedPart(Eigen::Index(r), d) += coefficient * p[d];
         }
@@ -1907,35 +2032,74 @@ class HoleFiller {
         sys.rowLength[r] += std::abs(w);
       }
     }
-    sys.A.resize(Eigen::Index(rows.size()), Eigen::Index(unknowns));
-    sys.A.setFromTriplets(entries.begin(), entries.end());
-    const Eigen::SparseMatrix<double> normal =
-        Eigen::SparseMatrix<double>(sys.A.transpose()) * sys.A;
-    // Both weight sets give the same pattern: it is ordered once.
-    if (!sys.analysed) {
-      sys.solver.analyzePattern(normal);
+    if (symbolic) {
+      // The pattern of A^T A: every pair of unknowns that share a row.
+      std::vector<std::pair<int, int>> pairs;
+      for (std::size_t r = 0; r < rows.size(); ++r)
+        for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
+          for (int j = sys.start[r]; j < sys.start[r + 1]; ++j)
+            if (sys.key[i] >= first && sys.key[j] >= sys.key[i])
+              pairs.push_back({sys.key[j] - first, sys.key[i] - first});
+      sys.normal = lowerPattern(unknowns, pairs);
+      sys.pairStart.assign(1, 0);
+      sys.pairSlot.clear();
+      for (std::size_t r = 0; r < rows.size(); ++r) {
+        for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
+          for (int j = sys.start[r]; j < sys.start[r + 1]; ++j)
+            if (sys.key[i] >= first && sys.key[j] >= first)
+              sys.pairSlot.push_back(
+                  sys.key[j] >= sys.key[i]
+                      ? slotOf(sys.normal, sys.key[j] - first, sys.key[i] - first)
+                      : -1);
+        sys.pairStart.push_back(int(sys.pairSlot.size()));
+      }
+    }
+    // A^T A, row by row.
+    double* values = sys.normal.valuePtr();
+    std::fill(values, values + sys.normal.nonZeros(), 0.0);
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const int* slot = sys.pairSlot.data() + sys.pairStart[r];
+      for (int i = sys.start[r]; i < sys.start[r + 1]; ++i) {
+        if (sys.key[i] < first) continue;
+        for (int j = sys.start[r]; j < sys.start[r + 1]; ++j) {
+          if (sys.key[j] < first) continue;
+          const int s = *slot++;
+          if (s >= 0) values[s] += sys.coefficient[i] * sys.coefficient[j];
+        }
+      }
+    }
+    if (symbolic) {
+      sys.solver.analyzePattern(sys.normal);
       sys.analysed = true;
     }
-    sys.solver.factorize(normal);
+    sys.solver.factorize(sys.normal);
     sys.ok = sys.solver.info() == Eigen::Success;
   }
 
   // Solves for the new vertices given the target Laplacians delta (rows x 3,
   // sum_j omega_rj (x_j - x_r)); returns the RMS residual as a length, or -1.
   double solve(System& sys, const Eigen::MatrixXd& delta, std::vector<Point3>& x) const {
-    const Eigen::MatrixXd weighted = sys.rowWeight.asDiagonal() * delta;
-    const Eigen::MatrixXd rhs = Eigen::MatrixXd(sys.A.transpose() * (weighted - sys.fixedPart));
+    const int first = int(n_);
+    const Eigen::Index rows = Eigen::Index(sys.start.size() - 1);
+    // The rows' targets less what the fixed vertices give, weighted as the rows.
+    const Eigen::MatrixXd target = sys.rowWeight.asDiagonal() * delta - sys.fixedPart;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(uv_.size() - n_), 3);
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
+        if (sys.key[i] >= first) rhs.row(sys.key[i] - first) += sys.coefficient[i] * target.row(r);
     const Eigen::MatrixXd sol = sys.solver.solve(rhs);
     if (sys.solver.info() != Eigen::Success || !sol.allFinite()) return -1;
     for (std::size_t v = n_; v < uv_.size(); ++v)
       for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
-    const Eigen::MatrixXd residual = Eigen::MatrixXd(sys.A * sol + sys.fixedPart - weighted);
     double sum = 0;
-    for (Eigen::Index r = 0; r < residual.rows(); ++r) {
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      Eigen::RowVector3d residual = -target.row(r);
+      for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
+        if (sys.key[i] >= first) residual += sys.coefficient[i] * sol.row(sys.key[i] - first);
       const double length = sys.rowLength[std::size_t(r)] * sys.rowWeight[r];
-      if (length > 0) sum += residual.row(r).squaredNorm() / (length * length);
+      if (length > 0) sum += residual.squaredNorm() / (length * length);
     }
-    return std::sqrt(sum / double(std::max<Eigen::Index>(1, residual.rows())));
+    return std::sqrt(sum / double(std::max<Eigen::Index>(1, rows)));
   }
 
   enum class MembraneWeights {
@@ -1947,11 +2111,32 @@ class HoleFiller {
   // The membrane L x = 0 over the new vertices, boundary fixed (symmetric
   // form, weights raised to kPositiveWeightFloor): the harmonic shape, and
   // the flat placement over a disk. Its rows are those of the new vertices
-  // alone: the membrane does not see the surface beyond the boundary.
-  bool membrane(std::vector<Point3>& x, MembraneWeights kind, double& residual) const {
+  // alone: the membrane does not see the surface beyond the boundary. Its
+  // pattern is the patch's edges between new vertices, ordered once for
+  // every weight set.
+  struct Membrane {
+    Eigen::SparseMatrix<double> matrix;  // lower triangle
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> solver;
+    bool analysed = false;
+  };
+
+  bool membrane(Membrane& m, std::vector<Point3>& x, MembraneWeights kind, double& residual) const {
     const std::size_t unknowns = uv_.size() - n_;
     if (unknowns == 0) return true;
-    std::vector<Eigen::Triplet<double>> entries;
+    const int first = int(n_);
+    if (!m.analysed) {
+      std::vector<std::pair<int, int>> pairs;
+      for (std::size_t r = 0; r < unknowns; ++r) {
+        const int v = int(n_ + r);
+        pairs.push_back({int(r), int(r)});
+        for (int t : localAround_[v])
+          for (int c : localTriangles_[t])
+            if (c > v) pairs.push_back({c - first, int(r)});
+      }
+      m.matrix = lowerPattern(unknowns, pairs);
+    }
+    double* values = m.matrix.valuePtr();
+    std::fill(values, values + m.matrix.nonZeros(), 0.0);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(Eigen::Index(unknowns), 3);
     std::vector<TriangleWeights> weights;
     if (kind != MembraneWeights::Uniform)
@@ -1969,25 +2154,26 @@ class HoleFiller {
       } else {
         rowOf(v, weights, row, kPositiveWeightFloor);
       }
-      entries.push_back({int(r), int(r), row.total});
+      values[slotOf(m.matrix, int(r), int(r))] = row.total;
       diagonal += row.total;
       for (const auto& [key, w] : row.weights) {
-        if (key >= int(n_))
-          entries.push_back({int(r), key - int(n_), -w});
-        else
+        if (key > v)
+          values[slotOf(m.matrix, key - first, int(r))] -= w;
+        else if (key < first)
           for (int d = 0; d < 3; ++d) rhs(Eigen::Index(r), d) += w * x[key][d];
       }
     }
-    Eigen::SparseMatrix<double> M(static_cast<Eigen::Index>(unknowns),
-                                  static_cast<Eigen::Index>(unknowns));
-    M.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(M);
-    if (solver.info() != Eigen::Success) return false;
-    const Eigen::MatrixXd sol = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !sol.allFinite()) return false;
+    if (!m.analysed) {
+      m.solver.analyzePattern(m.matrix);
+      m.analysed = true;
+    }
+    m.solver.factorize(m.matrix);
+    if (m.solver.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd sol = m.solver.solve(rhs);
+    if (m.solver.info() != Eigen::Success || !sol.allFinite()) return false;
     for (std::size_t v = n_; v < uv_.size(); ++v)
       for (int d = 0; d < 3; ++d) x[v][d] = sol(Eigen::Index(v - n_), d);
-    const Eigen::MatrixXd res = M * sol - rhs;
+    const Eigen::MatrixXd res = m.matrix.selfadjointView<Eigen::Lower>() * sol - rhs;
     residual = std::sqrt(res.squaredNorm() / double(unknowns)) /
                std::max(1e-300, diagonal / double(unknowns));
     return true;
@@ -2064,9 +2250,10 @@ class HoleFiller {
     if (uv_.size() == n_) return true;  // nothing to place
     if (mode == HoleFairing::Harmonic) {
       double residual = 0;
-      if (!membrane(x, MembraneWeights::Domain, residual)) return false;
+      Membrane m;
+      if (!membrane(m, x, MembraneWeights::Domain, residual)) return false;
       // Weights from the membrane's own shape, then solved again.
-      if (!membrane(x, MembraneWeights::Shape, residual)) return false;
+      if (!membrane(m, x, MembraneWeights::Shape, residual)) return false;
       shape.residual = residual;
       return true;
     }
@@ -2191,11 +2378,16 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   // With room for the patches: each is appended for its check, and a
   // reallocation would copy the whole mesh.
   s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
-  for (const Vertex& v : mesh.vert) s.points.push_back(v.cP());
+  s.points.resize(mesh.vert.size());
+  for (std::size_t v = 0; v < mesh.vert.size(); ++v) s.points[v] = mesh.vert[v].cP();
   s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
-  for (const Face& f : mesh.face)
-    s.triangles.push_back({int(vcg::tri::Index(mesh, f.cV(0))), int(vcg::tri::Index(mesh, f.cV(1))),
-                           int(vcg::tri::Index(mesh, f.cV(2)))});
+  s.triangles.resize(mesh.face.size());
+  const Vertex* firstVertex = mesh.vert.data();
+  for (std::size_t f = 0; f < mesh.face.size(); ++f) {
+    const Face& face = mesh.face[f];
+    s.triangles[f] = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                      int(face.cV(2) - firstVertex)};
+  }
   s.inputVertices = s.points.size();
   s.inputFaces = s.triangles.size();
   s.adjacency = std::make_unique<VertexFaces>(s.triangles, s.points.size());
@@ -2212,14 +2404,17 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     for (std::size_t i = 0; i < loop.faces.size(); ++i)
       s.borderOwner[directedKey(loop.vertices[i], loop.vertices[(i + 1) % count])] = loop.faces[i];
   }
-  // Which holes to fill.
-  Point3 lo = s.points[0], hi = s.points[0];
-  for (const Point3& p : s.points)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  const double diagonal = (hi - lo).Norm();
-  std::vector<char> selected(s.points.size(), 0);
+  // Which holes to fill (the bounding box and the selection only when a limit needs them).
+  double diagonal = 0;
+  if (options.max_diameter > 0) {
+    Point3 lo = s.points[0], hi = s.points[0];
+    for (const Point3& p : s.points)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    diagonal = (hi - lo).Norm();
+  }
   const bool bySelection =
       !options.selected_vertices.empty() || !options.selected_vertex_indices.empty();
+  std::vector<char> selected(bySelection ? s.points.size() : 0, 0);
   for (std::size_t v = 0; v < options.selected_vertices.size(); ++v)
     if (options.selected_vertices[v]) selected[v] = 1;
   for (int v : options.selected_vertex_indices) selected[v] = 1;
@@ -2328,6 +2523,12 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       if (f >= 0) inputOrigins.emplace(f, fo[f]);
     const std::size_t newVertices = s.points.size() - s.inputVertices;
     const std::size_t newFaces = s.triangles.size() - s.inputFaces;
+    // Growing the vertex array moves it, and vcglib would then correct
+    // every face's corner pointers one by one; instead it grows here, once,
+    // and the faces' corners are set afresh from the indices held below.
+    const Vertex* before = mesh.vert.data();
+    mesh.vert.reserve(s.points.size());
+    const bool moved = mesh.vert.data() != before;
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
       for (std::size_t v = s.inputVertices; v < s.points.size(); ++v, ++vi) {
@@ -2374,8 +2575,14 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         if (border[i] >= 0 && inPatch(int(s.inputVertices + i)))
           vo[s.inputVertices + i] = vo[border[i]];
     }
-    for (const auto& [f, corners] : s.inputCorners)
-      for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
+    if (moved) {
+      Vertex* first = mesh.vert.data();
+      for (std::size_t f = 0; f < s.inputFaces; ++f)
+        for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+    } else {
+      for (const auto& [f, corners] : s.inputCorners)
+        for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
+    }
     if (newFaces > 0) {
       auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, newFaces);
       for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f, ++fi) {

@@ -138,7 +138,10 @@ struct HoleFillResult {
   // patch or split face: 0 unless verification found a problem.
   std::size_t remaining_intersecting_pairs = 0;
   double time_ms = 0;
-  // Where the time went, in milliseconds, summed over the holes.
+  // Where the time went, in milliseconds of wall time on the calling
+  // thread, summed over the holes (they add up to about time_ms). While a
+  // hole's disk patch is made on the second core, the wait for it counts as
+  // fair.
   struct StageTimes {
     double find = 0, split = 0, triangulate = 0, fair = 0, check = 0, verify = 0, write = 0;
   } stage_ms;
