@@ -1136,54 +1136,73 @@ void applyPlan(Mesh& mesh, const StitchPlan& plan, StitchResult& r) {
   r.max_aspect_ratio = plan.maxAspect;
 }
 
+// Border edges (edges used by exactly one face) counted in two passes over
+// the faces: tally() for every face, which lets a caller count while it
+// reads the faces for its own purpose, then count(). Each edge's other end
+// is listed at its smaller end (a counting sort: the tallies size the
+// lists). While placing, the few ends already listed at that vertex are
+// searched: an end listed once is turned into its complement (a second
+// use), and a third use changes nothing. The count follows as the edges are
+// placed: no sort, no pass over the lists.
+class BorderEdgeCounter {
+ public:
+  explicit BorderEdgeCounter(const Mesh& mesh)
+      : mesh_(mesh), base_(mesh.vert.data()), fill_(mesh.vert.size() + 1, 0) {}
+
+  void tally(const Face& f) {
+    const std::array<int, 3> c = cornersOf(f);
+    ++fill_[std::min(c[0], c[1]) + 1];
+    ++fill_[std::min(c[1], c[2]) + 1];
+    ++fill_[std::min(c[2], c[0]) + 1];
+  }
+
+  std::size_t count() {
+    // fill_[v]: where v's list starts, then where its next end goes.
+    const std::size_t n = mesh_.vert.size();
+    for (std::size_t v = 0; v < n; ++v) fill_[v + 1] += fill_[v];
+    const std::vector<int> start(fill_.begin(), fill_.end() - 1);
+    const std::unique_ptr<int[]> other(new int[std::size_t(fill_[n])]);  // written before read
+    std::size_t border = 0;
+    auto place = [&](int a, int b) {
+      const int low = std::min(a, b), high = std::max(a, b);  // ~high < 0 <= high
+      int* const first = other.get() + start[low];
+      int* const last = other.get() + fill_[low];
+      for (int* e = first; e != last; ++e) {
+        if (*e == high) {  // the second use: no longer a border edge
+          *e = ~high;
+          --border;
+          return;
+        }
+        if (*e == ~high) return;  // a third or later use
+      }
+      *last = high;
+      ++fill_[low];
+      ++border;
+    };
+    for (const Face& f : mesh_.face) {
+      const std::array<int, 3> c = cornersOf(f);
+      place(c[0], c[1]);
+      place(c[1], c[2]);
+      place(c[2], c[0]);
+    }
+    return border;
+  }
+
+ private:
+  std::array<int, 3> cornersOf(const Face& f) const {
+    return {int(f.cV(0) - base_), int(f.cV(1) - base_), int(f.cV(2) - base_)};
+  }
+  const Mesh& mesh_;
+  const Vertex* base_;
+  std::vector<int> fill_;
+};
+
 }  // namespace
 
 std::size_t countBorderEdges(const Mesh& mesh) {
-  // Each edge's other end is listed at its smaller end (a counting sort:
-  // one pass to count, one to place). While placing, the few ends already
-  // listed at that vertex are searched: an end listed once is turned into
-  // its complement (a second use), and a third use changes nothing. The
-  // count follows as the edges are placed: no sort, no pass over the lists.
-  const Vertex* base = mesh.vert.data();
-  const std::size_t n = mesh.vert.size();
-  auto cornersOf = [base](const Face& f) {
-    return std::array<int, 3>{int(f.cV(0) - base), int(f.cV(1) - base), int(f.cV(2) - base)};
-  };
-  std::vector<int> fill(n + 1, 0);
-  for (const Face& f : mesh.face) {
-    const std::array<int, 3> c = cornersOf(f);
-    ++fill[std::min(c[0], c[1]) + 1];
-    ++fill[std::min(c[1], c[2]) + 1];
-    ++fill[std::min(c[2], c[0]) + 1];
-  }
-  // fill[v]: where v's list starts, then where its next end goes.
-  for (std::size_t v = 0; v < n; ++v) fill[v + 1] += fill[v];
-  std::vector<int> start(fill.begin(), fill.end() - 1);
-  const std::unique_ptr<int[]> other(new int[std::size_t(fill[n])]);  // every slot written first
-  std::size_t border = 0;
-  auto place = [&](int a, int b) {
-    const int low = std::min(a, b), high = std::max(a, b);  // ~high < 0 <= high
-    int* const first = other.get() + start[low];
-    int* const last = other.get() + fill[low];
-    for (int* e = first; e != last; ++e) {
-      if (*e == high) {  // the second use: no longer a border edge
-        *e = ~high;
-        --border;
-        return;
-      }
-      if (*e == ~high) return;  // a third or later use
-    }
-    *last = high;
-    ++fill[low];
-    ++border;
-  };
-  for (const Face& f : mesh.face) {
-    const std::array<int, 3> c = cornersOf(f);
-    place(c[0], c[1]);
-    place(c[1], c[2]);
-    place(c[2], c[0]);
-  }
-  return border;
+  BorderEdgeCounter counter(mesh);
+  for (const Face& f : mesh.face) counter.tally(f);
+  return counter.count();
 }
 
 StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
@@ -1195,11 +1214,12 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
   StitchResult r;
   // On the second core, while the plan reads the faces around the paths:
   // the coordinates are checked (the plan waits for that before it reads
-  // one), the mesh's border edges are counted (for the report), then, once
-  // the faces are no longer read, room is made for the new faces and their
-  // provenance (the copy into larger arrays is most of the cost of adding
-  // them), its memory touched by a resize up and back, so that writing the
-  // new faces does not stop at every fresh page.
+  // one), the mesh's border edges are counted (for the report), and a
+  // larger copy of the faces is made, with room for the new ones and their
+  // provenance, its memory touched (a resize up and back) so that writing
+  // the new faces does not stop at every fresh page; the copy is swapped in
+  // once the plan no longer reads the faces (copying into a larger array is
+  // most of the cost of adding faces).
   std::promise<void> coordinatesChecked, facesFree;
   const std::shared_future<void> coordinates = coordinatesChecked.get_future().share();
   bool freed = false;
@@ -1216,18 +1236,26 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
       coordinatesChecked.set_exception(std::current_exception());
       return std::make_pair(std::size_t(0), 0.0);
     }
+    // One reading of the faces makes the copy and the border count's first pass.
     const auto t = Clock::now();
-    const std::size_t count = countBorderEdges(mesh);
+    BorderEdgeCounter counter(mesh);
+    std::vector<Face> larger;
+    larger.reserve(room);
+    for (const Face& f : mesh.face) {
+      larger.push_back(f);
+      counter.tally(f);
+    }
+    const std::size_t count = counter.count();
     const double ms = msSince(t);
-    free.wait();
     const std::size_t faces = mesh.face.size();
-    mesh.face.reserve(room);
-    mesh.face.resize(room);
-    mesh.face.resize(faces);
+    larger.resize(room);
+    larger.resize(faces);
     auto& origins = faceOrigins(mesh)._handle->data;
     origins.reserve(room);
     origins.resize(room);
     origins.resize(faces);
+    free.wait();
+    mesh.face.swap(larger);
     return std::make_pair(count, ms);
   };
   auto background = std::async(std::launch::async, std::move(secondCore));

@@ -126,8 +126,8 @@ struct StitchResult {
   double time_ms = 0;
   // Where the time went, in milliseconds: triangulating (with the border
   // and orientation checks), the exact intersection check, counting the
-  // mesh's border edges (on a second thread, during the triangulation),
-  // writing the new elements.
+  // mesh's border edges while copying the faces into a larger array (on a
+  // second thread, during the triangulation), writing the new elements.
   struct StageTimes {
     double plan = 0, check = 0, count = 0, write = 0;
   } stage_ms;
