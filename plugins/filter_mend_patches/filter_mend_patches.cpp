@@ -310,6 +310,9 @@ void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList&
           ? "When not empty, the result is also written to this path as one JSON object: "
             "patches, patches_removed, faces_out, non_manifold_edges, border_edges, "
             "remaining_intersecting_pairs, is_closed, volume and time_ms."
+      : ID(a) == SELECT_PATCHES
+          ? "When not empty, the result is also written to this path as one JSON object: "
+            "patches, patches_selected, faces_selected, selected_ids and time_ms."
           : "When not empty, the result is also written to this path as one JSON object: "
             "patches (count), parts, patch_list (id, part, faces, area, status, winding "
             "numbers) and time_ms."));
@@ -386,6 +389,7 @@ void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
 
 void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters,
                            vcg::CallBackPos* cb) {
+  const auto start = Clock::now();
   reportProgress(progressFrom(cb), 0, "Selecting patches");
   const Assembly a = assemble(md, parameters.getEnum("layers"));
   Patches p = patchesOf(a);
@@ -444,6 +448,16 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
       }
     });
   Log("MeshMend: selected %zu of %zu patches (%zu faces)", patches, p.patches.size(), faces);
+  std::vector<double> ids;  // JSON numbers
+  for (std::size_t id = 0; id < chosen.size(); ++id)
+    if (chosen[id]) ids.push_back(double(id));
+  JsonObject report;
+  report.set("patches", p.patches.size())
+      .set("patches_selected", patches)
+      .set("faces_selected", faces)
+      .set("selected_ids", ids)
+      .set("time_ms", std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  publishReport(parameters, report);
 }
 
 void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters,

@@ -194,15 +194,18 @@ def test_select_patches_touching_the_selected_faces(tmp_path):
     b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
     script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1}),
                  (PAINT, {"report_file": "{report0}"}),
-                 (SELECT, {"by": 1}))
+                 (SELECT, {"by": 1, "report_file": "{report1}"}))
     partial = ('<filter name="Conditional Face Selection">\n'
                '  <Param type="RichString" value="(fq == 2) &amp;&amp; (x0 &gt; 0.75)" '
                'name="condSelect" description="" tooltip=""/>\n </filter>\n')
     script = script.replace(f' <filter name="{SELECT}">', partial + f' <filter name="{SELECT}">', 1)
     run = run_server(tmp_path, [a, b], script)
     assert run.returncode == 0, run.log
-    patch = run.report["patch_list"][2]
+    painted, selected = run.reports
+    patch = painted["patch_list"][2]
     import re
     clicked = int(re.search(r"selected (\d+) faces in", run.log).group(1))  # MeshLab's own log
     assert 0 < clicked < patch["faces"]
     assert f"selected 1 of 4 patches ({patch['faces']} faces)" in run.log
+    assert selected["patches"] == 4 and selected["patches_selected"] == 1
+    assert selected["faces_selected"] == patch["faces"] and selected["selected_ids"] == [2]
