@@ -220,9 +220,11 @@ QString StitchPlugin::filterInfo(FilterIDType id) const {
            "<b>Two layers:</b> by default the result is a new layer 'stitched' holding both "
            "layers joined by the strip (it becomes the current layer; the two inputs are kept "
            "and hidden); or, as chosen, the first layer receives the result and the second "
-           "layer is deleted (it is merged into the first).<br>"
-           "With subdivision, new vertices are computed in double precision and stored by "
-           "MeshLab in float; the exact check is made on the double ones." +
+           "layer is deleted (it is merged into the first).<br>" +
+           QString(
+               "With subdivision, new vertices are computed in double precision and stored "
+               "by MeshLab in %1; the exact check is made on the double ones.")
+               .arg(kHostPrecision) +
            paper;
   return "Closes the gaps between borders automatically. Step 1 (what CGAL's stitch_borders "
          "does, with a tolerance): faces that face against their neighbours are flipped (a "
@@ -316,9 +318,10 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "to by either number."));
     parameters.addParam(RichFloat(
         "max_aspect_ratio", 0, "Subdivide above aspect ratio (0 = never)",
-        "When a rung across the gap is longer than this many times the mean edge length of "
-        "the two paths, rows of new vertices are inserted across the strip; 0 adds no vertex. "
-        "New vertices are stored in float."));
+        QString("When a rung across the gap is longer than this many times the mean edge "
+                "length of the two paths, rows of new vertices are inserted across the strip; "
+                "0 adds no vertex. New vertices are stored in %1.")
+            .arg(kHostPrecision)));
     parameters.addParam(RichInt("max_rows", 64, "Max rows of new vertices",
                                 "At most this many rows of new vertices across a wide strip."));
     parameters.addParam(RichBool(
@@ -366,8 +369,10 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
                 "Runs of fewer border vertices facing another border are left open."));
     parameters.addParam(
         RichFloat("max_aspect_ratio", 0, "Subdivide above aspect ratio (0 = never)",
-                  "Stitched strips whose rungs are longer than this many times the mean path edge "
-                  "length get rows of new vertices (stored in float); 0 adds no vertex."));
+                  QString("Stitched strips whose rungs are longer than this many times the mean "
+                          "path edge length get rows of new vertices (stored in %1); 0 adds no "
+                          "vertex.")
+                      .arg(kHostPrecision)));
     parameters.addParam(
         RichBool("check_intersections", true, "Check intersections",
                  "Tests every stitch exactly against the mesh; one whose faces would intersect is "
@@ -638,8 +643,8 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
       Log("  warning: %zu border edges run against the orientation of the new faces",
           r.orientation_conflicts);
     if (r.vertices_added)
-      Log("  note: the %zu new vertices are stored in float (computed in double)",
-          r.vertices_added);
+      Log("  note: the %zu new vertices are stored in %s (computed in double)", r.vertices_added,
+          kHostPrecision);
   }
   const int output = parameters.getEnum("output");
   std::vector<std::string> names;
@@ -742,7 +747,8 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
     Log("  %zu faces flipped to agree with their neighbours, %zu collapsed faces removed",
         r.faces_flipped, r.degenerate_faces_removed);
   if (r.vertices_added)
-    Log("  note: the %zu new vertices are stored in float (computed in double)", r.vertices_added);
+    Log("  note: the %zu new vertices are stored in %s (computed in double)", r.vertices_added,
+        kHostPrecision);
   if (r.vertices_merged == 0 && r.faces_added == 0 && r.faces_flipped == 0 &&
       r.degenerate_faces_removed == 0 && !allVisible) {
     Log("MeshMend: nothing to merge or stitch; the layer is unchanged");
