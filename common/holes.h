@@ -69,7 +69,7 @@ struct HoleFillOptions {
   // length: a round hole of n boundary edges needs ~n^2/12 uniform
   // triangles, a graded patch a few times n.
   std::size_t uniform_face_limit = 4000;
-  double size_growth = 1.4;
+  double size_growth = 1.5;
   double max_size_factor = 16;
   // A new front vertex closer than merge_distance x its target size to
   // another front vertex is merged into it (step 4 of §3.2).
