@@ -952,6 +952,37 @@ class AdvancingFront {
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap_;
 };
 
+// The triangles around each vertex of a patch, in one array (ascending).
+class TrianglesAround {
+ public:
+  struct Range {
+    const int *first, *last;
+    const int* begin() const { return first; }
+    const int* end() const { return last; }
+  };
+  TrianglesAround() = default;
+  TrianglesAround(const std::vector<Triangle>& triangles, std::size_t vertexCount) {
+    start_.assign(vertexCount + 1, 0);
+    for (const Triangle& t : triangles)
+      for (int v : t) ++start_[std::size_t(v) + 1];
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    triangles_.resize(std::size_t(start_.back()));
+    std::vector<int> next(start_.begin(), start_.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (int v : triangles[t]) triangles_[std::size_t(next[std::size_t(v)]++)] = int(t);
+  }
+  Range operator[](std::size_t v) const {
+    return {triangles_.data() + start_[v], triangles_.data() + start_[v + 1]};
+  }
+  void swap(TrianglesAround& other) {
+    start_.swap(other.start_);
+    triangles_.swap(other.triangles_);
+  }
+
+ private:
+  std::vector<int> start_, triangles_;
+};
+
 // Moves each new vertex towards the centroid of its neighbours (a few rounds)
 // where no triangle around it turns over (exact): rounder triangles for the
 // fairing's cotangent weights. `height` moves along.
@@ -959,9 +990,7 @@ void relaxInterior(std::vector<Vec2>& uv, std::vector<double>& height, std::size
                    const std::vector<Triangle>& triangles, int rounds) {
   const std::size_t n = uv.size();
   if (n == fixed) return;
-  std::vector<std::vector<int>> around(n);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (int v : triangles[t]) around[v].push_back(int(t));
+  const TrianglesAround around(triangles, n);
   for (int round = 0; round < rounds; ++round)
     for (std::size_t v = fixed; v < n; ++v) {
       Vec2 centroid;
@@ -1625,7 +1654,7 @@ class HoleFiller {
     std::vector<Vec2> uv;
     std::vector<double> height;
     std::vector<Triangle> localTriangles, patchTriangles;
-    std::vector<std::vector<int>> localAround;
+    TrianglesAround localAround;
     std::vector<int> rowVertex;
     std::vector<LaplacianRow> outsideRows;
     std::vector<char> hasOutsideRow;
@@ -1816,9 +1845,7 @@ class HoleFiller {
       }
     }
     relaxInterior(uv_, height_, n_, localTriangles_, 3);
-    localAround_.assign(uv_.size(), {});
-    for (std::size_t t = 0; t < localTriangles_.size(); ++t)
-      for (int v : localTriangles_[t]) localAround_[v].push_back(int(t));
+    localAround_ = TrianglesAround(localTriangles_, uv_.size());
     return true;
   }
 
@@ -2329,15 +2356,15 @@ class HoleFiller {
   HoleFillResult::StageTimes& times_;
   std::size_t n_ = 0;
   double meanEdge_ = 0;
-  std::vector<int> front_;                     // boundary vertices (mesh indices), front order
-  std::unordered_map<int, int> local_;         // boundary vertex -> local index
-  std::vector<Vec2> uv_;                       // patch vertices in the domain
-  std::vector<double> height_;                 // over the plane (planar domains)
-  std::vector<Triangle> localTriangles_;       // patch faces, local indices
-  std::vector<Triangle> patchTriangles_;       // the same in mesh numbering
-  std::vector<std::vector<int>> localAround_;  // patch faces around each local vertex
-  std::vector<int> rowVertex_;                 // Laplacian rows: new vertices, then boundary ones
-  std::vector<LaplacianRow> outsideRows_;      // boundary rows' mesh part
+  std::vector<int> front_;                 // boundary vertices (mesh indices), front order
+  std::unordered_map<int, int> local_;     // boundary vertex -> local index
+  std::vector<Vec2> uv_;                   // patch vertices in the domain
+  std::vector<double> height_;             // over the plane (planar domains)
+  std::vector<Triangle> localTriangles_;   // patch faces, local indices
+  std::vector<Triangle> patchTriangles_;   // the same in mesh numbering
+  TrianglesAround localAround_;            // patch faces around each local vertex
+  std::vector<int> rowVertex_;             // Laplacian rows: new vertices, then boundary ones
+  std::vector<LaplacianRow> outsideRows_;  // boundary rows' mesh part
   std::vector<char> hasOutsideRow_;
 };
 
