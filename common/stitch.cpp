@@ -753,9 +753,9 @@ void rotate(std::vector<T>& v, std::size_t first) {
   std::rotate(v.begin(), v.begin() + first, v.end());
 }
 
-// topologyRead is called once the mesh's faces are no longer read and
-// before any coordinate is (from then on the plan reads the path vertices'
-// coordinates and what it gathered).
+// topologyRead is called once the mesh's faces are no longer read (from
+// then on the plan reads the path vertices' coordinates and what it
+// gathered).
 StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
                       const std::function<void()>& topologyRead = {}) {
   StitchPlan plan;
@@ -1207,36 +1207,35 @@ std::size_t countBorderEdges(const Mesh& mesh) {
 
 StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
   const auto start = Clock::now();
+  requireFacesAndFiniteCoordinates(mesh, "the mesh");
   requireCompact(mesh);
   if (options.max_aspect_ratio < 0 || options.max_rows < 0)
     throw InvalidInputError("max_aspect_ratio and max_rows must not be negative");
   reportProgress(options.progress, 0, "Planning the stitch");
   StitchResult r;
-  // On the second core, while the plan reads the faces around the paths:
-  // the coordinates are checked (the plan waits for that before it reads
-  // one), the mesh's border edges are counted (for the report), and a
-  // larger copy of the faces is made, with room for the new ones and their
-  // provenance, its memory touched (a resize up and back) so that writing
-  // the new faces does not stop at every fresh page; the copy is swapped in
-  // once the plan no longer reads the faces (copying into a larger array is
-  // most of the cost of adding faces).
-  std::promise<void> coordinatesChecked, facesFree;
-  const std::shared_future<void> coordinates = coordinatesChecked.get_future().share();
+  // Room for the new faces (at most one per path vertex) and their
+  // provenance, its memory touched by a resize up and back, so that writing
+  // them does not stop at every fresh page: the provenance here, the faces
+  // on the second core while the plan reads the faces around the paths. A
+  // larger copy of the faces is made there (the mesh's border edges counted
+  // in the same reading, for the report) and swapped in once the plan no
+  // longer reads the faces: copying into a larger array is most of the cost
+  // of adding faces.
+  const std::size_t faces = mesh.face.size();
+  const std::size_t room = faces + options.a.vertices.size() + options.b.vertices.size();
+  {
+    auto& origins = faceOrigins(mesh)._handle->data;
+    origins.reserve(room);
+    origins.resize(room);
+    origins.resize(faces);
+  }
+  std::promise<void> facesFree;
   bool freed = false;
   auto release = [&] {
     if (!freed) facesFree.set_value();
     freed = true;
   };
-  const std::size_t room = mesh.face.size() + options.a.vertices.size() + options.b.vertices.size();
-  auto secondCore = [&mesh, &coordinatesChecked, free = facesFree.get_future(), room] {
-    try {
-      requireFacesAndFiniteCoordinates(mesh, "the mesh");
-      coordinatesChecked.set_value();
-    } catch (...) {
-      coordinatesChecked.set_exception(std::current_exception());
-      return std::make_pair(std::size_t(0), 0.0);
-    }
-    // One reading of the faces makes the copy and the border count's first pass.
+  auto secondCore = [&mesh, free = facesFree.get_future(), faces, room] {
     const auto t = Clock::now();
     BorderEdgeCounter counter(mesh);
     std::vector<Face> larger;
@@ -1247,13 +1246,8 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
     }
     const std::size_t count = counter.count();
     const double ms = msSince(t);
-    const std::size_t faces = mesh.face.size();
     larger.resize(room);
     larger.resize(faces);
-    auto& origins = faceOrigins(mesh)._handle->data;
-    origins.reserve(room);
-    origins.resize(room);
-    origins.resize(faces);
     free.wait();
     mesh.face.swap(larger);
     return std::make_pair(count, ms);
@@ -1264,7 +1258,6 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
     auto clock = Clock::now();
     plan = planStitch(mesh, options, [&] {
       if (!options.check_intersections) release();
-      coordinates.get();
     });
     r.stage_ms.plan = msSince(clock);
     if (options.check_intersections) {
@@ -1275,8 +1268,7 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
       r.stage_ms.check = msSince(clock);
     }
   } catch (...) {
-    release();          // the second thread finishes before the error leaves
-    coordinates.get();  // an empty mesh or a bad coordinate is reported first
+    release();  // the second thread finishes before the error leaves
     throw;
   }
   release();
