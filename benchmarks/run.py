@@ -528,12 +528,11 @@ def stitch(repeat):
            "sheet's first row. Each run stitches its own copy of the mesh, made beforehand. No "
            "peer library does this (CGAL's `stitch_borders` only merges borders that already "
            "coincide, MeshLab has no such filter), so ours is measured alone, without and with "
-           "the exact check of the new faces against the faces near the gap. The stitch checks "
-           "the coordinates, counts the mesh's border edges (for its report) and makes room for "
-           "the new faces on a second thread while it plans; *CPU* is the time one untimed run "
-           "kept the calling "
-           "thread and the whole process busy (on a loaded machine the wall time also waits "
-           "for other programs).",
+           "the exact check of the new faces against the faces near the gap. The stitch counts "
+           "the mesh's border edges (for its report) and makes a larger copy of the faces, with "
+           "room for the new ones, on a second thread while it plans; *CPU* is the time one "
+           "untimed run kept the calling thread and the whole process busy (on a loaded machine "
+           "the wall time also waits for other programs).",
            "",
            "| method | ms | min ms | CPU ms, calling thread | CPU ms, process | peak MB | "
            "faces added |",
