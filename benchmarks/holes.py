@@ -989,7 +989,9 @@ def tables(holes, sp, repeat, machine, elapsed):
     if "cgal" in sp:
         facts.append(f"CGAL {sp['cgal']['faces_added']:,}")
     out += ["",
-            f"On the sphere hole {', '.join(facts)}. Ours' stages (ms, medians): " +
+            f"On the sphere hole {', '.join(facts)}. Ours' stages (ms of wall time on the calling "
+            f"thread, medians; the wait for the disk's patch made on the other core counts as "
+            f"fair): " +
             ", ".join(f"{k} {v:.1f}" for k, v in rep["median_stage_ms"].items() if v >= 0.05) +
             "."]
     if sp.get("ours", {}).get("mean") is not None and sp.get("cgal", {}).get("mean") is not None:
