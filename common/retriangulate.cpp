@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/predicates.h"
@@ -104,11 +105,16 @@ class Retriangulator {
     if (key[0] > key[1]) std::swap(key[0], key[1]), parity = -parity;
     if (key[1] > key[2]) std::swap(key[1], key[2]), parity = -parity;
     if (key[0] > key[1]) std::swap(key[0], key[1]), parity = -parity;
-    for (const auto& [known, sign] : exactOrientations_)
-      if (known == key) return parity * sign;
+    const std::uint64_t packed =
+        (std::uint64_t(key[0]) << 42) | (std::uint64_t(key[1]) << 21) | std::uint64_t(key[2]);
+    const bool packable = key[2] < (1 << 21);  // else not remembered
+    if (packable) {
+      const auto known = exactOrientations_.find(packed);
+      if (known != exactOrientations_.end()) return parity * known->second;
+    }
     const int sign =
         sgn(orient2dValue(V_[key[0]].exact(), V_[key[1]].exact(), V_[key[2]].exact(), axis_));
-    exactOrientations_.push_back({key, sign});
+    if (packable) exactOrientations_.emplace(packed, sign);
     return parity * sign;
   }
 
@@ -225,7 +231,9 @@ class Retriangulator {
     // A vertex on the segment splits it.
     int nearest = -1;
     for (int v = 0; v < int(V_.size()); ++v) {
-      if (v == a || v == b || orient(a, b, v) != 0 || !between(a, b, v)) continue;
+      // The coordinate comparisons first: they turn away most vertices
+      // without the orientation, which is exact work for points on a line.
+      if (v == a || v == b || !between(a, b, v) || orient(a, b, v) != 0) continue;
       if (nearest < 0 || between(a, nearest, v)) nearest = v;
     }
     if (nearest >= 0) {
@@ -341,7 +349,7 @@ class Retriangulator {
   std::vector<std::array<int, 3>> T_;
   std::set<Edge> constrained_;
   int axis_ = 2, sign_ = 1;
-  mutable std::vector<std::pair<std::array<int, 3>, int>> exactOrientations_;
+  mutable std::unordered_map<std::uint64_t, int> exactOrientations_;  // sorted triple -> sign
 };
 
 }  // namespace
