@@ -25,16 +25,19 @@ void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4
     body(std::size_t(0), n, 0u);
     return;
   }
-  std::vector<std::thread> threads;
   std::vector<std::exception_ptr> errors(workers);
-  for (std::size_t w = 0; w < workers; ++w)
-    threads.emplace_back([&, w] {
-      try {
-        body(n * w / workers, n * (w + 1) / workers, unsigned(w));
-      } catch (...) {
-        errors[w] = std::current_exception();
-      }
-    });
+  auto run = [&](std::size_t w) {
+    try {
+      body(n * w / workers, n * (w + 1) / workers, unsigned(w));
+    } catch (...) {
+      errors[w] = std::current_exception();
+    }
+  };
+  // The calling thread takes the first chunk: one thread fewer to start.
+  std::vector<std::thread> threads;
+  threads.reserve(workers - 1);
+  for (std::size_t w = 1; w < workers; ++w) threads.emplace_back(run, w);
+  run(0);
   for (std::thread& t : threads) t.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
