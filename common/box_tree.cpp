@@ -64,7 +64,7 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kC
       bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
     }
   for (int k = 0; k < 3; ++k)
-    cellSize_[k] = std::max((bounds_.hi[k] - bounds_.lo[k]) / kCells, 1e-30f);
+    cellsPerUnit_[k] = 1 / std::max((bounds_.hi[k] - bounds_.lo[k]) / kCells, 1e-30f);
   for (const Box& b : boxes) {
     int lo[3], hi[3];
     for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
@@ -81,8 +81,11 @@ bool BoxGrid::inside(const Box& b) const {
 }
 
 void BoxGrid::cellRange(const Box& b, int k, int& lo, int& hi) const {
-  lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) / cellSize_[k]), 0, kCells - 1);
-  hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) / cellSize_[k]), 0, kCells - 1);
+  // A multiplication, not a division: any map that never decreases with
+  // the coordinate keeps overlapping boxes in overlapping cell ranges, as
+  // marking and testing use this one.
+  lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
+  hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
 }
 
 bool BoxGrid::touches(const Box& b) const {

@@ -48,7 +48,7 @@ class BoxGrid {
   bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
 
   Box bounds_{{1, 1, 1}, {0, 0, 0}};
-  float cellSize_[3] = {1, 1, 1};
+  float cellsPerUnit_[3] = {1, 1, 1};
   std::vector<char> occupied_;
 };
 
