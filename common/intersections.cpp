@@ -223,20 +223,23 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
     r.degenerate_faces.push_back(
         std::size_t(std::count(soups[m].degenerate.begin(), soups[m].degenerate.end(), true)));
   }
+  // Distinct faces are counted as they are first met (counting the bits
+  // afterwards walked every face of every mesh).
   for (const IntersectingPair& p : r.pairs) {
-    auto& flags = p.a.mesh == p.b.mesh ? inSelf : inCross;
-    if (p.a.mesh == p.b.mesh)
+    const bool self = p.a.mesh == p.b.mesh;
+    auto& flags = self ? inSelf : inCross;
+    auto& distinct = self ? r.self_faces : r.cross_faces;
+    if (self)
       ++r.self_pairs[p.a.mesh];
     else
       ++r.cross_pairs;
     for (const FaceRef& f : {p.a, p.b}) {
-      flags[f.mesh][f.face] = true;
+      if (!flags[f.mesh][f.face]) {
+        flags[f.mesh][f.face] = true;
+        ++distinct[f.mesh];
+      }
       r.face_involved[f.mesh][f.face] = true;
     }
-  }
-  for (std::size_t m = 0; m < n; ++m) {
-    r.self_faces[m] = std::size_t(std::count(inSelf[m].begin(), inSelf[m].end(), true));
-    r.cross_faces[m] = std::size_t(std::count(inCross[m].begin(), inCross[m].end(), true));
   }
 
   if (options.contacts) {
