@@ -8,6 +8,7 @@
 #include <memory>
 #include <numeric>
 #include <set>
+#include <thread>
 #include <tuple>
 #include <unordered_map>
 
@@ -214,24 +215,31 @@ class MeshSplitter {
       std::uint8_t edges;
     };
     // The faces around the corners of the faces that received points
-    // (compressed rows): two reading passes over the faces, where rows for
-    // every vertex would write three entries per face of the whole mesh.
+    // (compressed rows), where rows for every vertex would write three
+    // entries per face of the whole mesh.
     std::vector<int> row(points_.size(), -1);
     int rows = 0;
     for (const auto& [f, w] : work_)
       for (int v : triangles_[f])
         if (row[v] < 0) row[v] = rows++;
+    // One pass over all faces finds the few that touch such a corner (-1 in
+    // all three rows: none); the rows are made from those.
+    std::vector<std::uint32_t> near;
+    for (std::size_t f = 0; f < triangles_.size(); ++f) {
+      const Triangle& t = triangles_[f];
+      if ((row[t[0]] & row[t[1]] & row[t[2]]) != -1) near.push_back(std::uint32_t(f));
+    }
     std::vector<std::uint32_t> offsets(std::size_t(rows) + 1, 0), faces;
-    for (const Triangle& t : triangles_)
-      for (int v : t)
+    for (std::uint32_t f : near)
+      for (int v : triangles_[f])
         if (row[v] >= 0) ++offsets[row[v] + 1];
     for (int r = 0; r < rows; ++r) offsets[r + 1] += offsets[r];
     faces.resize(offsets.back());
     {
       std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
-      for (std::size_t f = 0; f < triangles_.size(); ++f)
+      for (std::uint32_t f : near)
         for (int v : triangles_[f])
-          if (row[v] >= 0) faces[next[row[v]]++] = std::uint32_t(f);
+          if (row[v] >= 0) faces[next[row[v]]++] = f;
     }
     std::vector<Shared> shared;
     for (auto& [f, w] : work_) {
@@ -1041,6 +1049,28 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
 
   reportProgress(options.progress, 90, "Welding along the curves");
+  // Without snapping, each input's output is final here: on a large input
+  // its vcglib mesh is built on a second thread while the merged one is made.
+  std::size_t outputFaces = 0;
+  for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
+  std::thread separateBuilder;
+  std::exception_ptr separateError;
+  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 65536) {
+    r.meshes.resize(meshes.size());
+    separateBuilder = std::thread([&] {
+      try {
+        for (std::size_t m = 0; m < outputs.size(); ++m) outputs[m].toMesh(r.meshes[m]);
+      } catch (...) {
+        separateError = std::current_exception();
+      }
+    });
+  }
+  struct JoinOnExit {  // also when the merged output throws
+    std::thread& thread;
+    ~JoinOnExit() {
+      if (thread.joinable()) thread.join();
+    }
+  } joinOnExit{separateBuilder};
   {
     // All meshes in one; curve vertices with the same exact position merge:
     // those at one curve point by its id, the others (crossings of two
@@ -1159,7 +1189,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       r.new_faces_below_1deg = slivers();
     }
     merged.toMesh(r.merged);
-    if (options.separate_meshes) {
+    if (separateBuilder.joinable()) {
+      separateBuilder.join();
+      if (separateError) std::rethrow_exception(separateError);
+    } else if (options.separate_meshes) {
       r.meshes.resize(meshes.size());
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
