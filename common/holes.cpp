@@ -1549,12 +1549,16 @@ class HoleFiller {
     std::vector<Point3> boundary;
     meanEdge_ = 0;
     Point3 faceNormals(0, 0, 0);
+    std::vector<Point3> borderNormals;  // unit normals of the faces along the border
     for (std::size_t k = 0; k < n_; ++k) {
       boundary.push_back(s_.points[front_[k]]);
       meanEdge_ += (s_.points[front_[(k + 1) % n_]] - s_.points[front_[k]]).Norm();
       const auto owner = s_.borderOwner.find(directedKey(front_[(k + 1) % n_], front_[k]));
-      if (owner != s_.borderOwner.end())
-        faceNormals += faceNormal(s_.points, s_.triangles[owner->second]);
+      if (owner != s_.borderOwner.end()) {
+        const Point3 n = faceNormal(s_.points, s_.triangles[owner->second]);
+        faceNormals += n;
+        if (n.Norm() > 0) borderNormals.push_back(n / n.Norm());
+      }
     }
     meanEdge_ /= double(n_);
     if (!(meanEdge_ > 0)) {
@@ -1579,7 +1583,35 @@ class HoleFiller {
     // competes and the rounder of the two is tried first. The disk's is
     // made on a second thread meanwhile (the machine's other core), by a
     // filler of its own: both only read the surface.
-    const std::vector<Domain> domains = domainsOf(boundary, faceNormals);
+    std::vector<Domain> domains = domainsOf(boundary, faceNormals);
+    // Where the surface along the border turns more than 60 degrees away
+    // from the plane on average (a cap, a tube's end), the plane squeezes
+    // the patch next to the border: the disk's patch is tried first, alone
+    // and in the first mode, and both domains compete as below only when it
+    // does not fit.
+    if (domains.size() == 2 && !borderNormals.empty()) {
+      double cosine = 0;
+      for (const Point3& n : borderNormals) cosine += std::abs(n * domains[0].N);
+      if (cosine < kSteepCosine * double(borderNormals.size())) {
+        Candidate c;
+        std::string problem, failed;
+        HoleReport trial = report;
+        shapeOver(domains[1], modes[0], trial, c, problem);
+        if (problem.empty()) {
+          swapState(c.state);
+          const bool filled = fillAs(modes[0], modes[0], c, splitFaces, trial, failed);
+          swapState(c.state);
+          if (filled) {
+            report = std::move(trial);
+            if (report.fairing != modes[0])
+              report.reason = "fell back to biharmonic: " + report.reason;
+            else
+              report.reason.clear();
+            return true;
+          }
+        }
+      }
+    }
     std::vector<Candidate> made(domains.size());
     std::vector<std::string> problem(domains.size());
     HoleFillResult::StageTimes twinTimes;
@@ -1647,6 +1679,9 @@ class HoleFiller {
   // A patch of at least this mean shape quality (1 = equilateral triangles)
   // over the hole's plane is used without trying the disk.
   static constexpr double kRoundPatchQuality = 0.85;
+  // Mean |cos| between the border's faces and the hole's plane below which
+  // the disk is tried first (60 degrees).
+  static constexpr double kSteepCosine = 0.5;
   static constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
   // The triangulated patch over one domain (what prepare() leaves in the members).
