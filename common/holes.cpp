@@ -1584,7 +1584,7 @@ class HoleFiller {
     // made on a second thread meanwhile (the machine's other core), by a
     // filler of its own: both only read the surface.
     std::vector<Domain> domains = domainsOf(boundary, faceNormals);
-    // Where the surface along the border turns more than 60 degrees away
+    // Where the surface along the border turns more than 45 degrees away
     // from the plane on average (a cap, a tube's end), the plane squeezes
     // the patch next to the border: the disk's patch is tried first, alone
     // and in the first mode, and both domains compete as below only when it
@@ -1680,8 +1680,9 @@ class HoleFiller {
   // over the hole's plane is used without trying the disk.
   static constexpr double kRoundPatchQuality = 0.85;
   // Mean |cos| between the border's faces and the hole's plane below which
-  // the disk is tried first (60 degrees).
-  static constexpr double kSteepCosine = 0.5;
+  // the disk is tried first: 45 degrees, where projecting onto the plane
+  // shortens the patch's first layer by more than a factor 1 / sqrt(2).
+  static constexpr double kSteepCosine = 0.70710678118654752;
   static constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
   // The triangulated patch over one domain (what prepare() leaves in the members).
