@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
+#include <map>
 #include <unordered_map>
 
 #include "common/errors.h"
@@ -26,6 +26,7 @@ class Retriangulator {
     const std::size_t vertices = 3 + in.points.size() + in.segments.size();
     V_.reserve(vertices);
     edges_.reserve(vertices);
+    lines_.reserve(vertices);
     T_.reserve(2 * vertices);
     for (int i = 0; i < 3; ++i) add(in.corners[i], std::uint8_t((1 << i) | (1 << ((i + 2) % 3))));
     chooseProjection();
@@ -44,12 +45,19 @@ class Retriangulator {
     for (const auto& s : in.segments) {
       if (s[0] < 0 || s[0] >= inputs || s[1] < 0 || s[1] >= inputs)
         throw InvalidInputError("retriangulate: segment refers to a point that does not exist");
-      insertSegment(out.vertex_of_input[s[0]], out.vertex_of_input[s[1]]);
+      const int a = out.vertex_of_input[s[0]], b = out.vertex_of_input[s[1]];
+      if (a == b) continue;  // a point, inserted already
+      lineEnds_.push_back({a, b});
+      lines_[a].add(int(lineEnds_.size()) - 1);
+      lines_[b].add(int(lineEnds_.size()) - 1);
     }
+    for (std::size_t s = 0; s < lineEnds_.size(); ++s)
+      insertSegment(lineEnds_[s].first, lineEnds_[s].second, int(s));
     if (in.improve) improve();
     out.vertices = std::move(V_);
     out.triangles = std::move(T_);
-    for (const Edge& e : constrained_) out.constrained_edges.push_back({e.first, e.second});
+    for (const auto& piece : constrained_)
+      out.constrained_edges.push_back({piece.first.first, piece.first.second});
     return out;
   }
 
@@ -57,6 +65,7 @@ class Retriangulator {
   int add(const ExactPoint& p, std::uint8_t edges = 0) {
     V_.push_back(p);
     edges_.push_back(edges);
+    lines_.emplace_back();
     return int(V_.size()) - 1;
   }
 
@@ -90,7 +99,8 @@ class Retriangulator {
     return sign_ > 0 ? r : mpq_class(-r);
   }
   int orient(int a, int b, int c) const {
-    if (edges_[a] & edges_[b] & edges_[c]) return 0;  // on one edge of the input triangle
+    if (edges_[a] & edges_[b] & edges_[c]) return 0;           // on one edge of the input triangle
+    if (lines_[a].sharedWith(lines_[b], lines_[c])) return 0;  // on one input segment
     const int sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
     return sign_ * (sign != kUndecided ? sign : exactOrient(a, b, c));
   }
@@ -213,9 +223,12 @@ class Retriangulator {
       T_[t] = {x, q, c};
       T_.push_back({q, y, c});
     }
-    if (constrained_.erase(key(a, b))) {
-      constrained_.insert(key(a, q));
-      constrained_.insert(key(q, b));
+    const auto piece = constrained_.find(key(a, b));
+    if (piece != constrained_.end()) {
+      const int support = piece->second;
+      constrained_.erase(piece);
+      constrained_.emplace(key(a, q), support);
+      constrained_.emplace(key(q, b), support);
     }
   }
 
@@ -226,7 +239,8 @@ class Retriangulator {
     return !samePoint(V_[a], V_[v]) && !samePoint(V_[b], V_[v]);
   }
 
-  void insertSegment(int a, int b) {
+  // Inserts the constraint a-b, a piece of input segment number `support`.
+  void insertSegment(int a, int b, int support) {
     if (a == b) return;
     // A vertex on the segment splits it.
     int nearest = -1;
@@ -237,12 +251,13 @@ class Retriangulator {
       if (nearest < 0 || between(a, nearest, v)) nearest = v;
     }
     if (nearest >= 0) {
-      insertSegment(a, nearest);
-      insertSegment(nearest, b);
+      lines_[nearest].add(support);
+      insertSegment(a, nearest, support);
+      insertSegment(nearest, b, support);
       return;
     }
     if (triangleWith(a, b) >= 0 || triangleWith(b, a) >= 0) {
-      constrained_.insert(key(a, b));
+      constrained_.emplace(key(a, b), support);
       return;
     }
     // The edges the segment crosses in both interiors.
@@ -258,20 +273,28 @@ class Retriangulator {
         if (u < w && crosses(u, w)) queue.push_back({u, w});
       }
     if (queue.empty()) throw InvalidInputError("retriangulate: a constraint leaves the triangle");
-    for (const Edge& e : queue)
-      if (constrained_.count(e)) {  // two constraints cross: insert their crossing point
-        const mpq_class oa = orientValue(e.first, e.second, a);
-        const mpq_class ob = orientValue(e.first, e.second, b);
-        const mpq_class t = oa / (oa - ob);
-        RationalPoint x;
-        const RationalPoint &A = V_[a].exact(), &B = V_[b].exact();
-        for (int k = 0; k < 3; ++k) x.x[k] = A.x[k] + t * (B.x[k] - A.x[k]);
-        const int q = add(ExactPoint(x));
-        splitEdge(e.first, e.second, q);
-        insertSegment(a, q);
-        insertSegment(q, b);
-        return;
-      }
+    for (const Edge& e : queue) {
+      const auto other = constrained_.find(e);
+      if (other == constrained_.end()) continue;
+      // Two constraints cross: insert their crossing point, computed from
+      // the two input segments they lie on, not from the pieces, whose ends
+      // may be earlier crossings: where dozens of curves cross in one face,
+      // crossings of crossings would grow the numbers without bound.
+      const Edge line = lineEnds_[support], across = lineEnds_[other->second];
+      const mpq_class oa = orientValue(across.first, across.second, line.first);
+      const mpq_class ob = orientValue(across.first, across.second, line.second);
+      const mpq_class t = oa / (oa - ob);
+      RationalPoint x;
+      const RationalPoint &A = V_[line.first].exact(), &B = V_[line.second].exact();
+      for (int k = 0; k < 3; ++k) x.x[k] = A.x[k] + t * (B.x[k] - A.x[k]);
+      const int q = add(ExactPoint(x));
+      lines_[q].add(support);
+      lines_[q].add(other->second);
+      splitEdge(e.first, e.second, q);
+      insertSegment(a, q, support);
+      insertSegment(q, b, support);
+      return;
+    }
     // Sloan's edge recovery: flip crossing edges whose quadrilateral is
     // convex; a flipped edge that still crosses goes back in the queue.
     for (std::size_t guard = 0; next < queue.size(); ++guard) {
@@ -288,7 +311,7 @@ class Retriangulator {
     }
     if (triangleWith(a, b) < 0 && triangleWith(b, a) < 0)
       throw InvalidInputError("retriangulate: could not recover a constraint");
-    constrained_.insert(key(a, b));
+    constrained_.emplace(key(a, b), support);
   }
 
   // Flips edge (u, w) if the two triangles around it form a strictly convex
@@ -347,7 +370,31 @@ class Retriangulator {
   std::vector<ExactPoint> V_;
   std::vector<std::uint8_t> edges_;  // per vertex: edges of the input triangle it lies on (bits)
   std::vector<std::array<int, 3>> T_;
-  std::set<Edge> constrained_;
+  // The constrained edges, each with the number of the input segment it is
+  // a piece of.
+  std::map<Edge, int> constrained_;
+  // The input segments' end points, and for each vertex the input segments
+  // it lies on, exactly (end points, crossings, vertices found on a
+  // segment): three points on one segment are collinear without asking the
+  // numbers, which cannot tell that from "almost" (the exact rational
+  // orientation is the slow path, and points on one curve ask it often).
+  struct Lines {
+    std::array<int, 4> id;
+    int n = 0;  // a vertex on more segments keeps the first four: the rest are computed
+    void add(int line) {
+      if (n < 4 && !has(line)) id[n++] = line;
+    }
+    bool has(int line) const {
+      return std::find(id.begin(), id.begin() + n, line) != id.begin() + n;
+    }
+    bool sharedWith(const Lines& b, const Lines& c) const {
+      for (int i = 0; i < n; ++i)
+        if (b.has(id[i]) && c.has(id[i])) return true;
+      return false;
+    }
+  };
+  std::vector<Edge> lineEnds_;
+  std::vector<Lines> lines_;
   int axis_ = 2, sign_ = 1;
   mutable std::unordered_map<std::uint64_t, int> exactOrientations_;  // sorted triple -> sign
 };
