@@ -277,9 +277,10 @@ class Retriangulator {
       const auto other = constrained_.find(e);
       if (other == constrained_.end()) continue;
       // Two constraints cross: insert their crossing point, computed from
-      // the two input segments they lie on, not from the pieces, whose ends
-      // may be earlier crossings: where dozens of curves cross in one face,
-      // crossings of crossings would grow the numbers without bound.
+      // the end points of the two input segments they lie on, not from the
+      // pieces, whose ends may be earlier crossings with far longer numbers
+      // (the same point, at many times the cost where dozens of curves cross
+      // in one face).
       const Edge line = lineEnds_[support], across = lineEnds_[other->second];
       const mpq_class oa = orientValue(across.first, across.second, line.first);
       const mpq_class ob = orientValue(across.first, across.second, line.second);

@@ -128,6 +128,49 @@ TEST(Retriangulate, RejectsPointsOffTheTriangle) {
   EXPECT_THROW(retriangulate(input({on(mpq_class(1, 4), 0)}, {{0, 9}})), InvalidInputError);
 }
 
+// A star of chords that all pass close to one point, as many curves do
+// where a surface folds through itself: every pair crosses, and each
+// crossing is the exact crossing of the two chords' lines (computed here
+// directly in barycentric terms).
+TEST(Retriangulate, StarOfChordsGetsEveryPairwiseCrossing) {
+  const int n = 10;
+  std::vector<RationalPoint> points;
+  std::vector<std::array<mpq_class, 4>> chords;  // (s0, t0) -> (s1, t1)
+  for (int i = 0; i < n; ++i) {
+    // From edge t = 0 to edge s = 0, both ends moving the same way: every
+    // two chords cross near (1/4, 1/4), none three in one point.
+    const mpq_class a(1 + 3 * i, 8 * n), b(2 * n - 1 - 2 * i, 4 * n + i);
+    chords.push_back({a, 0, 0, b});
+    points.push_back(on(a, 0));
+    points.push_back(on(0, b));
+  }
+  std::vector<std::array<int, 2>> segments;
+  for (int i = 0; i < n; ++i) segments.push_back({3 + 2 * i, 4 + 2 * i});
+  const Patch p = retriangulate(input(points, segments));
+  expectValidTiling(p);
+  std::set<std::array<mpq_class, 3>> want, got;
+  for (std::size_t i = 0; i < chords.size(); ++i)
+    for (std::size_t j = i + 1; j < chords.size(); ++j) {
+      // Line i: s / a_i + t / b_i = 1 (ends (a_i, 0) and (0, b_i)).
+      const mpq_class ai = chords[i][0], bi = chords[i][3], aj = chords[j][0], bj = chords[j][3];
+      const mpq_class det = 1 / (ai * bj) - 1 / (aj * bi);
+      ASSERT_NE(sgn(det), 0);
+      const mpq_class s = (1 / bj - 1 / bi) / det, t = (1 / ai - 1 / aj) / det;
+      ASSERT_TRUE(s > 0 && t > 0 && s + t < 1);
+      RationalPoint x = on(s, t);
+      for (mpq_class& c : x.x) c.canonicalize();  // compared as values
+      want.insert({x.x[0], x.x[1], x.x[2]});
+    }
+  for (std::size_t v = 3 + 2 * n; v < p.vertices.size(); ++v) {
+    RationalPoint x = p.vertices[v].exact();
+    for (mpq_class& c : x.x) c.canonicalize();
+    got.insert({x.x[0], x.x[1], x.x[2]});
+  }
+  EXPECT_EQ(want.size(), std::size_t(n * (n - 1) / 2));
+  EXPECT_EQ(got, want);
+  EXPECT_EQ(p.vertices.size(), 3 + 2 * n + want.size());
+}
+
 // Random points and segments (crossing each other freely): always a valid
 // tiling in which every segment is a chain of constrained edges.
 TEST(Retriangulate, RandomConstraintsAlwaysGiveValidTilings) {
