@@ -1683,6 +1683,11 @@ class HoleFiller {
   // the disk is tried first: 45 degrees, where projecting onto the plane
   // shortens the patch's first layer by more than a factor 1 / sqrt(2).
   static constexpr double kSteepCosine = 0.70710678118654752;
+  // Patch edges that the shape stretches beyond this factor of their length
+  // in the domain are split (refineStretched): twice the size the front meant.
+  static constexpr double kMaxStretch = 2;
+  static constexpr int kRefinePasses = 3;
+  static constexpr int kFlipPasses = 4;
   static constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
   // The triangulated patch over one domain (what prepare() leaves in the members).
@@ -1752,6 +1757,12 @@ class HoleFiller {
     c.first.fairing = mode;
     const auto clock = Clock::now();
     c.firstShaped = mode == HoleFairing::Flat || fair(mode, c.first, report);
+    // The domain sized the triangles; where the shape in space stretches
+    // them far beyond that (the plane foreshortens a part of the hole that
+    // turns away from it), the patch is refined there and shaped again,
+    // starting from where it is.
+    if (c.firstShaped && smoothWithTangents(mode) && refineStretched(c.first.positions, c.flat) > 0)
+      c.firstShaped = fair(mode, c.first, report, true);
     times_.fair += msSince(clock);
     c.quality = c.firstShaped ? meanShapeQuality(c.first.positions) : -1;
     c.trainingSamples = report.training_samples;
@@ -1768,16 +1779,7 @@ class HoleFiller {
     const bool covered = triangulate(domain, report);
     times_.triangulate += msSince(clock);
     if (!covered) return false;
-    // Patch faces in mesh numbering; new vertices follow the surface's.
-    const std::size_t base = s_.points.size();
-    patchTriangles_.clear();
-    for (const Triangle& t : localTriangles_) {
-      Triangle g;
-      for (int k = 0; k < 3; ++k)
-        g[k] = std::size_t(t[k]) < n_ ? front_[t[k]] : int(base + std::size_t(t[k]) - n_);
-      patchTriangles_.push_back(g);
-    }
-    buildRows();
+    numberPatch();
     if (!placeFlat) {
       flat.assign(uv_.size(), Point3(0, 0, 0));
       for (std::size_t k = 0; k < n_; ++k) flat[k] = s_.points[front_[k]];
@@ -1788,6 +1790,145 @@ class HoleFiller {
     times_.fair += msSince(clock);
     if (!placed) report.reason = kNoMembrane;
     return placed;
+  }
+
+  // Patch faces in mesh numbering (new vertices follow the surface's) and
+  // the Laplacian rows.
+  void numberPatch() {
+    const std::size_t base = s_.points.size();
+    patchTriangles_.clear();
+    for (const Triangle& t : localTriangles_) {
+      Triangle g;
+      for (int k = 0; k < 3; ++k)
+        g[k] = std::size_t(t[k]) < n_ ? front_[t[k]] : int(base + std::size_t(t[k]) - n_);
+      patchTriangles_.push_back(g);
+    }
+    buildRows();
+  }
+
+  static bool smoothWithTangents(HoleFairing mode) {
+    return mode == HoleFairing::Biharmonic || mode == HoleFairing::LaplacianRegression;
+  }
+
+  // The patch's inner edges (local key) and the two triangles on each.
+  std::unordered_map<std::uint64_t, std::pair<int, int>> innerEdgeSides() const {
+    std::unordered_map<std::uint64_t, std::pair<int, int>> sides;
+    sides.reserve(localTriangles_.size() * 2);
+    for (std::size_t t = 0; t < localTriangles_.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int a = localTriangles_[t][k], b = localTriangles_[t][(k + 1) % 3];
+        auto [it, added] = sides.try_emplace(edgeKey(a, b), int(t), -1);
+        if (!added) it->second.second = int(t);
+      }
+    for (auto it = sides.begin(); it != sides.end();)
+      it = it->second.second < 0 ? sides.erase(it) : std::next(it);
+    return sides;
+  }
+
+  // Splits, at their midpoints in the domain and in space, the patch's
+  // inner edges that the shape `x` made longer than kMaxStretch times their
+  // length in the domain and than the boundary's mean edge (longest first,
+  // each triangle once per pass, a few passes), so that the triangles in
+  // space get back about the size the domain gave them; then flips the
+  // edges the splits left non-Delaunay in space. `flat` (the flat placement,
+  // as far as known) follows. Returns the number of edges split; with any,
+  // the patch is renumbered and its rows rebuilt.
+  std::size_t refineStretched(std::vector<Point3>& x, std::vector<Point3>& flat) {
+    auto isStretched = [&](int a, int b, double& length) {
+      length = (x[a] - x[b]).Norm();
+      return length > meanEdge_ && length > kMaxStretch * norm(uv_[a] - uv_[b]);
+    };
+    // Most patches have no such edge: a plain scan finds that out.
+    bool any = false;
+    double length = 0;
+    for (const Triangle& t : localTriangles_)
+      for (int k = 0; k < 3 && !any; ++k) any = isStretched(t[k], t[(k + 1) % 3], length);
+    if (!any) return 0;
+    std::size_t splits = 0;
+    for (int pass = 0; pass < kRefinePasses; ++pass) {
+      struct Edge {
+        double length;
+        int first, second, a, b;
+      };
+      std::vector<Edge> stretched;
+      for (const auto& [key, side] : innerEdgeSides()) {
+        const Triangle& t = localTriangles_[std::size_t(side.first)];
+        int k = 0;
+        while (edgeKey(t[k], t[(k + 1) % 3]) != key) ++k;
+        const int a = t[k], b = t[(k + 1) % 3];
+        if (isStretched(a, b, length)) stretched.push_back({length, side.first, side.second, a, b});
+      }
+      if (stretched.empty()) break;
+      std::sort(stretched.begin(), stretched.end(), [](const Edge& p, const Edge& q) {
+        return p.length != q.length ? p.length > q.length : p.first < q.first;
+      });
+      std::vector<char> touched(localTriangles_.size(), 0);
+      for (const Edge& e : stretched) {
+        if (touched[std::size_t(e.first)] || touched[std::size_t(e.second)]) continue;
+        touched[std::size_t(e.first)] = touched[std::size_t(e.second)] = 1;
+        const int m = int(uv_.size());
+        uv_.push_back(0.5 * (uv_[e.a] + uv_[e.b]));
+        height_.push_back((height_[e.a] + height_[e.b]) / 2);
+        x.push_back((x[e.a] + x[e.b]) / 2);
+        flat.push_back((flat[e.a] + flat[e.b]) / 2);
+        // (from, to, apex) -> (from, m, apex) + (m, to, apex), in both triangles:
+        // m lies on the edge in the domain, so both halves keep their orientation.
+        for (const int t : {e.first, e.second}) {
+          Triangle& tri = localTriangles_[std::size_t(t)];
+          int k = 0;
+          while (edgeKey(tri[k], tri[(k + 1) % 3]) != edgeKey(e.a, e.b)) ++k;
+          const int from = tri[k], to = tri[(k + 1) % 3], apex = tri[(k + 2) % 3];
+          tri = {from, m, apex};
+          localTriangles_.push_back({m, to, apex});
+        }
+        ++splits;
+      }
+    }
+    if (splits > 0) {
+      flipToDelaunay(x);
+      localAround_ = TrianglesAround(localTriangles_, uv_.size());
+      numberPatch();
+    }
+    return splits;
+  }
+
+  // Flips the patch's inner edges whose opposite angles at x add up to more
+  // than pi (Delaunay in space: rounder triangles, positive cotangent
+  // weights), where the flipped pair stays counter-clockwise in the domain
+  // and the new edge is not there yet. A few passes.
+  void flipToDelaunay(const std::vector<Point3>& x) {
+    auto angleAt = [&](int apex, int a, int b) {
+      const Point3 u = x[a] - x[apex], v = x[b] - x[apex];
+      return std::atan2((u ^ v).Norm(), u * v);
+    };
+    for (int pass = 0; pass < kFlipPasses; ++pass) {
+      const auto sides = innerEdgeSides();
+      // In key order, so that the result does not depend on the hash table's.
+      std::vector<std::pair<std::uint64_t, std::pair<int, int>>> edges(sides.begin(), sides.end());
+      std::sort(edges.begin(), edges.end());
+      std::vector<char> touched(localTriangles_.size(), 0);
+      std::size_t flips = 0;
+      for (const auto& [key, side] : edges) {
+        if (touched[std::size_t(side.first)] || touched[std::size_t(side.second)]) continue;
+        Triangle& t1 = localTriangles_[std::size_t(side.first)];
+        Triangle& t2 = localTriangles_[std::size_t(side.second)];
+        int k = 0;
+        while (edgeKey(t1[k], t1[(k + 1) % 3]) != key) ++k;
+        const int a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
+        int j = 0;
+        while (t2[j] == a || t2[j] == b) ++j;
+        const int d = t2[j];
+        if (c == d || sides.count(edgeKey(c, d))) continue;
+        if (angleAt(c, a, b) + angleAt(d, b, a) <= M_PI) continue;
+        // (a, b, c) + (b, a, d) -> (a, d, c) + (d, b, c).
+        if (orient(uv_[a], uv_[d], uv_[c]) <= 0 || orient(uv_[d], uv_[b], uv_[c]) <= 0) continue;
+        t1 = {a, d, c};
+        t2 = {d, b, c};
+        touched[std::size_t(side.first)] = touched[std::size_t(side.second)] = 1;
+        ++flips;
+      }
+      if (flips == 0) break;
+    }
   }
 
   // Shapes the candidate's patch (its state swapped in) in `mode` and
@@ -2308,7 +2449,9 @@ class HoleFiller {
     return model.fit(xs, ys, 2.5, options_.regression_gamma);
   }
 
-  bool fair(HoleFairing mode, PatchShape& shape, HoleReport& report) {
+  // `fromShape`: the positions given are already near the shape (the first
+  // weights come from them, not from the domain).
+  bool fair(HoleFairing mode, PatchShape& shape, HoleReport& report, bool fromShape = false) {
     std::vector<Point3>& x = shape.positions;
     if (uv_.size() == n_) return true;  // nothing to place
     if (mode == HoleFairing::Harmonic) {
@@ -2320,9 +2463,9 @@ class HoleFiller {
       shape.residual = residual;
       return true;
     }
-    // First weights from the patch in its domain, then from the shape.
+    // First weights from the patch in its domain (or from the shape given), then from the shape.
     System sys;
-    assemble(sys, rowVertex_, x, true);
+    assemble(sys, rowVertex_, x, !fromShape);
     if (!sys.ok) return false;
     Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(Eigen::Index(rowVertex_.size()), 3);
     if (solve(sys, zero, x) < 0) return false;

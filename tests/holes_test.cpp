@@ -427,6 +427,52 @@ TEST(HoleShape, HoleInATubeOfSliversFollowsTheCylinder) {
   EXPECT_LT(worst, 0.1);  // raised to a floor of 0.05, the weights give 0.44
 }
 
+// A narrow band cut two thirds of the way around a tube: its border
+// projects simply onto the plane facing the band's middle, but towards the
+// band's ends the tube turns up to 70 degrees away from that plane, where
+// the front, sized by the foreshortened border, makes triangles that come
+// out several times longer in space than the border's edges. The patch is
+// refined where the shape stretched it and shaped again: no long edges or
+// slivers, no fold, and the cylinder followed closely.
+TEST(HoleShape, BandAroundATubeIsRefinedWhereTheShapeStretchesIt) {
+  Mesh m = withHole(openTube(64, 64, 1, 4), [](const Point3& c) {
+    return std::abs(std::atan2(c[1], c[0])) < 1.22 && std::abs(c[2] - 2) < 0.15;
+  });
+  HoleFillOptions o = withFairing(HoleFairing::Biharmonic);
+  // The band only (not the tube's open ends): the vertices near its middle.
+  const std::vector<Point3> before = positionsOf(m);
+  for (std::size_t v = 0; v < before.size(); ++v)
+    if (std::abs(before[v][2] - 2) < 0.2 && before[v][0] > 0.99)
+      o.selected_vertex_indices.push_back(int(v));
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_found, 3u);
+  ASSERT_EQ(r.holes_filled, 1u);
+  const HoleReport& band =
+      *std::find_if(r.holes.begin(), r.holes.end(), [](const HoleReport& h) { return h.filled; });
+  EXPECT_EQ(band.fairing, HoleFairing::Biharmonic) << band.reason;
+  EXPECT_TRUE(band.planar_domain);
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  expectSound(m, 2 * 64);
+  const std::vector<Point3> P = positionsOf(m);
+  const std::vector<Triangle> T = trianglesOf(m);
+  double longestBorderEdge = 0;
+  for (std::size_t k = 0; k < band.boundary.size(); ++k)
+    longestBorderEdge =
+        std::max(longestBorderEdge,
+                 (P[band.boundary[(k + 1) % band.boundary.size()]] - P[band.boundary[k]]).Norm());
+  double longest = 0, worst = 0;
+  for (int f : r.new_faces)
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (P[T[f][k]] - P[T[f][(k + 1) % 3]]).Norm());
+  for (int v : r.new_vertices) worst = std::max(worst, std::abs(std::hypot(P[v][0], P[v][1]) - 1));
+  std::cout << "band around a tube: " << r.faces_added << " faces, longest edge "
+            << longest / longestBorderEdge << " x the border's longest, smallest angle "
+            << smallestNewAngle(m, r) << ", max distance to the cylinder " << worst << "\n";
+  EXPECT_LT(longest, 1.5 * longestBorderEdge);
+  EXPECT_GT(smallestNewAngle(m, r), 10);
+  EXPECT_LT(worst, 5e-4);  // unrefined, the long triangles leave it 0.0009 away
+}
+
 // A round hole around the rim of a thin plate: its border folds over the
 // rim, so every plane squeezes part of it. The patch over the disk competes
 // with the plane's, and whichever is taken, the shape is biharmonic and
