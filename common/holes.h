@@ -25,7 +25,10 @@ namespace meshmend {
 // cotangent weights, each row weighted by its vertex's area) of the new
 // vertices and of the boundary vertices, whose outer neighbours stay fixed:
 // that is what joins the patch to the surface with a continuous tangent
-// plane. Biharmonic is the default: on the fidelity benchmark
+// plane. Where their shape stretches the patch's triangles to more than
+// twice the size the domain gave them (a plane foreshortens the part of a
+// hole that turns away from it), the patch is refined there and shaped
+// again. Biharmonic is the default: on the fidelity benchmark
 // (docs/BENCHMARKS.md) it is closer to the removed surface than the
 // paper's regression on most holes.
 enum class HoleFairing {
