@@ -82,7 +82,8 @@ struct SplitResult {
   double time_ms = 0;
 };
 
-// Throws InvalidInputError for empty meshes or non-finite coordinates.
+// Throws InvalidInputError for empty meshes, non-finite coordinates or when
+// neither output (separate_meshes, merged_output) is asked for.
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options = {});
 
