@@ -2,16 +2,23 @@
 // intersect-and-split, ours against CGAL 5.5 on the same inputs in the same
 // run. Prints one JSON object.
 //
-// Ours: splitAlongIntersections (curves inserted into both meshes, both
-// refined meshes and the welded one built). With --sample, ours runs the
-// configuration of samples/intersect_split.mlx instead (seams welded,
-// duplicate faces removed, self-intersections split too, merged output,
-// rounded to float): the filter's own work. CGAL: PMP::corefine on two
-// Surface_mesh copies (the same job: both meshes refined along their
-// intersection), which needs valid, non-self-intersecting inputs near the
-// intersection; with --autorefine also PMP::experimental::autorefine of the
-// two joined into one mesh (CGAL 5.5's only way to refine a mesh along its
-// own self-intersections). Each method runs under a time limit (--limit).
+// Ours: splitAlongIntersections with the merged output off
+// (meshmend_split_refine: the curves inserted into both meshes, the two
+// refined meshes built: what corefine does), and as a second line the default
+// (meshmend_split: the welded merged mesh built too). With --sample, ours
+// runs the configuration of samples/intersect_split.mlx instead (seams
+// welded, duplicate faces removed, self-intersections split too, merged
+// output, rounded to float): the filter's own work. CGAL: PMP::corefine on
+// two Surface_mesh copies (the same job: both meshes refined along their
+// intersection, in place, so the copies are timed as ours times reading its
+// input into arrays), with its default parameters (cgal_corefine) and with
+// throw_on_self_intersection (cgal_corefine_checked, which first searches
+// each mesh for self-intersections near the curves and throws on one;
+// corefine's result is unspecified on such inputs without it). With --sample
+// only the checked one runs (the dragon self-intersects). With --autorefine
+// also PMP::experimental::autorefine of the two joined into one mesh (CGAL
+// 5.5's only way to refine a mesh along its own self-intersections). Each
+// method runs under a time limit (--limit).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -54,29 +61,43 @@ int main(int argc, char** argv) {
   }
   const std::string a = files[0], b = files[1];
   std::vector<Method> methods;
-  methods.push_back({sample ? "meshmend_split_sample" : "meshmend_split", "ours", [=] {
-                       auto ma = std::make_shared<Mesh>(readMesh(a));
-                       auto mb = std::make_shared<Mesh>(readMesh(b));
-                       return std::function<long()>([=] {
-                         SplitOptions o;
-                         if (sample) {
-                           o.self = o.weld_duplicates = o.remove_duplicate_faces = true;
-                           o.separate_meshes = false;
-                         }
-                         SplitResult r = splitAlongIntersections({ma.get(), mb.get()}, o);
-                         if (sample && roundToFloat(r) != 0) return -1L;
-                         return long(r.faces_split);
-                       });
-                     }});
-  methods.push_back({"cgal_corefine", "peer", [=] {
-                       auto ta = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(a)));
-                       auto tb = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(b)));
-                       return std::function<long()>([=] {
-                         SurfaceMesh x = *ta, y = *tb;  // corefine works in place
-                         PMP::corefine(x, y, CGAL::parameters::throw_on_self_intersection(true));
-                         return long(x.number_of_faces() + y.number_of_faces());
-                       });
-                     }});
+  auto ours = [&](const char* name, const char* role, bool merged) {
+    methods.push_back({name, role, [=] {
+                         auto ma = std::make_shared<Mesh>(readMesh(a));
+                         auto mb = std::make_shared<Mesh>(readMesh(b));
+                         return std::function<long()>([=] {
+                           SplitOptions o;
+                           o.merged_output = merged;
+                           if (sample) {
+                             o.self = o.weld_duplicates = o.remove_duplicate_faces = true;
+                             o.separate_meshes = false;
+                           }
+                           SplitResult r = splitAlongIntersections({ma.get(), mb.get()}, o);
+                           if (sample && roundToFloat(r) != 0) return -1L;
+                           return long(r.faces_split);
+                         });
+                       }});
+  };
+  if (sample) {
+    ours("meshmend_split_sample", "ours", true);
+  } else {
+    ours("meshmend_split_refine", "ours", false);
+    ours("meshmend_split", "alternative", true);
+  }
+  auto corefine = [&](const char* name, bool checked) {
+    methods.push_back({name, "peer", [=] {
+                         auto ta = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(a)));
+                         auto tb = std::make_shared<SurfaceMesh>(toSurfaceMesh(readMesh(b)));
+                         return std::function<long()>([=] {
+                           SurfaceMesh x = *ta, y = *tb;  // corefine works in place
+                           PMP::corefine(x, y,
+                                         CGAL::parameters::throw_on_self_intersection(checked));
+                           return long(x.number_of_faces() + y.number_of_faces());
+                         });
+                       }});
+  };
+  if (!sample) corefine("cgal_corefine", false);
+  corefine("cgal_corefine_checked", true);
   if (autorefine)
     methods.push_back({"cgal_autorefine", "peer", [=] {
                          auto joined = std::make_shared<SurfaceMesh>(

@@ -254,33 +254,53 @@ def split(repeat):
              data_file("stanford/dragon_vrip.ply", tmp), ["--sample", "--autorefine", "--limit", "300"])]
     out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; medians of {repeat} runs in one "
            "`bench_split` run per pair (`benchmarks/run.py split`), each method in a child process. "
-           "Ours: `splitAlongIntersections` (the curves inserted into both meshes; both refined "
-           "meshes and the welded one built). CGAL: `PMP::corefine` on two `Surface_mesh` copies, "
-           "the same job. The spheres are generated UV spheres crossing each other, at the sizes "
+           "Ours: `splitAlongIntersections` with `merged_output` off (the curves inserted into both "
+           "meshes, the two refined meshes built: the job `PMP::corefine` does), and in the next "
+           "column the default (the welded merged mesh built too). CGAL: `PMP::corefine` on two "
+           "`Surface_mesh` copies (it refines in place; the copies are timed, as ours times "
+           "reading its input into arrays), with its default parameters and with "
+           "`throw_on_self_intersection(true)` (checked: it first searches both meshes for "
+           "self-intersections near the curves); CGAL / ours compares ours with the faster of the "
+           "two. The spheres are generated UV spheres crossing each other, at the sizes "
            "of the bunny and the dragon. On bunny + dragon ours runs the configuration of "
            "`samples/intersect_split.mlx` (seams welded, duplicate faces removed, the dragon's own "
            "self-intersections split too, merged output rounded to float: the filter's work); "
-           "`PMP::corefine` refuses the pair (the dragon self-intersects), and CGAL's only "
+           "checked `PMP::corefine` refuses the pair (the dragon self-intersects; unchecked, "
+           "its result is unspecified there), and CGAL's only "
            "alternative, `PMP::experimental::autorefine` of the two joined, runs under a "
            "5-minute limit.",
            "",
-           "| pair | faces split (ours) | ours ms | ours peak MB | CGAL ms | CGAL peak MB | "
-           "CGAL / ours |",
-           "|---|---:|---:|---:|---:|---:|---:|"]
+           "| pair | faces split (ours) | ours ms | ours + merged ms | ours peak MB | "
+           "CGAL ms | CGAL checked ms | CGAL peak MB | CGAL / ours |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+
+    def cell(m):
+        if m is None:
+            return "–"
+        return fmt(m["median_ms"]) if m.get("ok") else m.get("error", "?").strip()
+
     for name, a, b, extra in rows:
         text = subprocess.run([str(BUILD / "benchmarks" / "bench_split"), "--repeat", str(repeat),
                                *extra, str(a), str(b)], capture_output=True, text=True,
                               check=True).stdout
-        methods = json.loads(text)["methods"]
-        o = methods[0]
-        for c in methods[1:]:
-            ratio = f"{c['median_ms'] / o['median_ms']:.1f}×" if o.get("ok") and c.get("ok") else "–"
-            peer = "corefine" if c["method"] == "cgal_corefine" else "autorefine"
-            out.append(f"| {name} ({peer}) | {o.get('result', '–')} | "
-                       f"{fmt(o['median_ms']) if o.get('ok') else o.get('error')} | "
-                       f"{o.get('peak_rss_mb', 0):.0f} | "
-                       f"{fmt(c['median_ms']) if c.get('ok') else c.get('error')} | "
-                       f"{c.get('peak_rss_mb', 0):.0f} | {ratio} |")
+        methods = {m["method"]: m for m in json.loads(text)["methods"]}
+        o = methods.get("meshmend_split_refine") or methods["meshmend_split_sample"]
+        merged = methods.get("meshmend_split")
+        plain, checked = methods.get("cgal_corefine"), methods.get("cgal_corefine_checked")
+        peers = [c for c in (plain, checked) if c and c.get("ok")]
+        best = min(peers, key=lambda c: c["median_ms"]) if peers else None
+        ratio = f"{best['median_ms'] / o['median_ms']:.1f}×" if best and o.get("ok") else "–"
+        peak = max((c.get("peak_rss_mb", 0) for c in (plain, checked) if c), default=0)
+        out.append(f"| {name} (corefine) | {o.get('result', '–')} | {cell(o)} | {cell(merged)} | "
+                   f"{o.get('peak_rss_mb', 0):.0f} | {cell(plain)} | {cell(checked)} | "
+                   f"{peak:.0f} | {ratio} |")
+        auto = methods.get("cgal_autorefine")
+        if auto:
+            ratio = (f"{auto['median_ms'] / o['median_ms']:.1f}×"
+                     if auto.get("ok") and o.get("ok") else "–")
+            out.append(f"| {name} (autorefine) | {o.get('result', '–')} | {cell(o)} | – | "
+                       f"{o.get('peak_rss_mb', 0):.0f} | {cell(auto)} | – | "
+                       f"{auto.get('peak_rss_mb', 0):.0f} | {ratio} |")
     return "\n".join(out)
 
 
@@ -626,9 +646,10 @@ def main():
                                  "stitch"])
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
-    # Self-intersection removal needs its runner only (no MeshLab plugin).
+    # Intersect and split, self-intersection removal need their runner only (no MeshLab plugin).
     # Hole filling needs its runner only (MeshLab's filter runs from the prefix).
-    build_runners({"selfintersect": ["bench_selfintersect"],
+    build_runners({"split": ["bench_split"],
+                   "selfintersect": ["bench_selfintersect"],
                    "holes": ["bench_holes"],
                    "clearance": ["bench_clearance"],
                    "stitch": ["bench_stitch"]}.get(args.benchmark, RUNNERS))

@@ -55,6 +55,15 @@ Box boxOf(const Point3& a, const Point3& b, const Point3& c) {
   return box;
 }
 
+Box boxOf(const Point3& p) {
+  Box box;
+  for (int k = 0; k < 3; ++k) {
+    box.lo[k] = down(p[k]);
+    box.hi[k] = up(p[k]);
+  }
+  return box;
+}
+
 BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kCells, 0) {
   if (boxes.empty()) return;
   bounds_ = boxes[0];
@@ -78,14 +87,6 @@ bool BoxGrid::inside(const Box& b) const {
   for (int k = 0; k < 3; ++k)
     if (!(b.lo[k] >= bounds_.lo[k] && b.hi[k] <= bounds_.hi[k])) return false;
   return true;
-}
-
-void BoxGrid::cellRange(const Box& b, int k, int& lo, int& hi) const {
-  // A multiplication, not a division: any map that never decreases with
-  // the coordinate keeps overlapping boxes in overlapping cell ranges, as
-  // marking and testing use this one.
-  lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
-  hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
 }
 
 bool BoxGrid::touches(const Box& b) const {

@@ -6,6 +6,7 @@
 // traffic of doubles; touching boxes count as overlapping.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -22,6 +23,18 @@ struct Box {
 
 // The smallest float box containing the three points (rounded outward).
 Box boxOf(const Point3& a, const Point3& b, const Point3& c);
+// The smallest float box containing the point. Rounding outward never
+// reverses an order, so hull() of the corners' boxes is boxOf() of the
+// corners, exactly: cheaper for faces that share corners.
+Box boxOf(const Point3& p);
+inline Box hull(const Box& a, const Box& b, const Box& c) {
+  Box h;
+  for (int k = 0; k < 3; ++k) {
+    h.lo[k] = std::min({a.lo[k], b.lo[k], c.lo[k]});
+    h.hi[k] = std::max({a.hi[k], b.hi[k], c.hi[k]});
+  }
+  return h;
+}
 
 inline bool overlap(const Box& x, const Box& y) {
   return x.lo[0] <= y.hi[0] && y.lo[0] <= x.hi[0] && x.lo[1] <= y.hi[1] && y.lo[1] <= x.hi[1] &&
@@ -44,7 +57,14 @@ class BoxGrid {
  private:
   static constexpr int kCells = 64;
   bool inside(const Box& b) const;
-  void cellRange(const Box& b, int k, int& lo, int& hi) const;
+  // A multiplication, not a division: any map that never decreases with
+  // the coordinate keeps overlapping boxes in overlapping cell ranges, as
+  // marking and testing use this one. (Here, inlined: a call per axis was
+  // a third of turning a large mesh's faces away.)
+  void cellRange(const Box& b, int k, int& lo, int& hi) const {
+    lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
+    hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
+  }
   bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
 
   Box bounds_{{1, 1, 1}, {0, 0, 0}};

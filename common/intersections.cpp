@@ -33,6 +33,12 @@ struct Soup {
   // `withPlanes`: also prepare the exact plane sides of every face (needed
   // for faces that are tested against many others).
   Soup(const MeshArrays& mesh, bool withPlanes) : points(mesh.points), triangles(mesh.triangles) {
+    // Each point rounded to float once (about six faces share it), then
+    // each face's box from its corners'.
+    std::vector<Box> pointBoxes(points.size());
+    parallelChunks(points.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t v = begin; v < end; ++v) pointBoxes[v] = boxOf(points[v]);
+    });
     boxes.resize(triangles.size());
     degenerate.resize(triangles.size());
     if (withPlanes) planes.resize(triangles.size());
@@ -40,7 +46,7 @@ struct Soup {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
         const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
-        boxes[f] = boxOf(a, b, c);
+        boxes[f] = hull(pointBoxes[t[0]], pointBoxes[t[1]], pointBoxes[t[2]]);
         degenerate[f] = collinear(a, b, c);
         if (withPlanes) planes[f] = PlaneSide(a, b, c);
       }

@@ -298,9 +298,12 @@ class MeshSplitter {
     std::vector<FaceOrigin>& birthFaces = out.face_origin;
     std::vector<VertexOrigin>& origins = out.vertex_origin;
     positions = points_;
+    // The input's vertices and kept faces (nearly all of a large mesh)
+    // written by index: a third fewer instructions than a push_back each.
     origins.reserve(points_.size() + 4 * work_.size());
+    origins.resize(points_.size());
     for (std::size_t v = 0; v < points_.size(); ++v)
-      origins.push_back({int(index_), vertexOrigin_[v], -1, {}});
+      origins[v] = {int(index_), vertexOrigin_[v], -1, Point3(0, 0, 0)};  // (vcg leaves {} unset)
     triangles.reserve(triangles_.size() + 8 * work_.size());
     birthFaces.reserve(triangles.capacity());
     std::unordered_map<int, int> vertexOfPoint;              // curve point id -> output vertex
@@ -314,14 +317,20 @@ class MeshSplitter {
       return int(positions.size()) - 1;
     };
     std::vector<char> split(triangles_.size(), 0);
-    for (std::size_t i = 0; i < order_.size(); ++i)
+    std::size_t splitCount = 0;
+    for (std::size_t i = 0; i < order_.size(); ++i) {
       split[order_[i]] = !patches_[i].triangles.empty();
-    for (std::size_t f = 0; f < triangles_.size(); ++f)
+      splitCount += split[order_[i]];
+    }
+    keptFaces_ = triangles_.size() - splitCount;
+    triangles.resize(keptFaces_);
+    birthFaces.resize(keptFaces_);
+    for (std::size_t f = 0, k = 0; f < triangles_.size(); ++f)
       if (!split[f]) {
-        triangles.push_back(triangles_[f]);
-        birthFaces.push_back({int(index_), faceOrigin_[f]});
+        triangles[k] = triangles_[f];
+        birthFaces[k] = {int(index_), faceOrigin_[f]};
+        ++k;
       }
-    keptFaces_ = triangles.size();
     std::set<std::array<int, 2>> curveSet;
     for (std::size_t i = 0; i < order_.size(); ++i) {
       const std::uint32_t f = order_[i];
@@ -978,6 +987,9 @@ void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& ed
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options) {
   const auto start = Clock::now();
+  if (!options.separate_meshes && !options.merged_output)
+    throw InvalidInputError(
+        "nothing to output: ask for the separate meshes, the merged mesh or both");
   SplitResult r;
   // The inputs as arrays, with their seams closed when asked; each keeps
   // the input index of its vertices and faces.
@@ -1049,17 +1061,25 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
 
   reportProgress(options.progress, 90, "Welding along the curves");
+  // Snapping works on the merged arrays (and rebuilds each input's output
+  // from them), so it needs them even when the merged mesh is not asked for.
+  const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
+  const bool mergedArrays = options.merged_output || snapping;
   // Without snapping, each input's output is final here: on a large input
-  // its vcglib mesh is built on a second thread while the merged one is made.
+  // vcglib meshes are built on a second thread while the merged one is made
+  // (without it, while the last input's is built here).
   std::size_t outputFaces = 0;
   for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
+  const std::size_t builtAside =
+      mergedArrays ? meshes.size() : meshes.size() - 1;  // separate meshes the thread builds
   std::thread separateBuilder;
   std::exception_ptr separateError;
-  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 65536) {
+  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 65536 &&
+      builtAside > 0) {
     r.meshes.resize(meshes.size());
     separateBuilder = std::thread([&] {
       try {
-        for (std::size_t m = 0; m < outputs.size(); ++m) outputs[m].toMesh(r.meshes[m]);
+        for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
       } catch (...) {
         separateError = std::current_exception();
       }
@@ -1071,6 +1091,18 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       if (thread.joinable()) thread.join();
     }
   } joinOnExit{separateBuilder};
+  // The separate meshes not built on the thread (all of them when snapping
+  // rebuilt them), once the thread has finished.
+  auto finishSeparate = [&] {
+    if (separateBuilder.joinable()) {
+      separateBuilder.join();
+      if (separateError) std::rethrow_exception(separateError);
+      for (std::size_t m = builtAside; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
+    } else if (options.separate_meshes) {
+      r.meshes.resize(meshes.size());
+      for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
+    }
+  };
   {
     // All meshes in one; curve vertices with the same exact position merge:
     // those at one curve point by its id, the others (crossings of two
@@ -1103,6 +1135,36 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     std::vector<const ExactPoint*> curvePointers;
     for (const ExactPoint& p : curvePoints) curvePointers.push_back(&p);
     const std::vector<int> weldedTo = coincidentGroups(curvePointers);
+    r.smallest_new_angle_deg_unsnapped = r.smallest_new_angle_deg;
+    if (!mergedArrays) {
+      // Only what the merged output would tell: its slivers (the new faces
+      // of each mesh, positions as they are there) and its curves, a graph
+      // on the welded curve points (the merged output's curve vertices).
+      std::size_t slivers = 0;
+      for (std::size_t m = 0; m < meshes.size(); ++m) {
+        const OutputArrays& mesh = outputs[m];
+        for (std::size_t f = splitters[m].keptFaces(); f < mesh.triangles.size(); ++f) {
+          const Triangle& t = mesh.triangles[f];
+          slivers += meshmend::smallestAngle(mesh.positions[t[0]], mesh.positions[t[1]],
+                                             mesh.positions[t[2]]) < M_PI / 180;
+        }
+      }
+      r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers;
+      std::set<std::array<int, 2>> curves;
+      for (std::size_t m = 0; m < meshes.size(); ++m)
+        for (const auto& e : r.curve_edges[m]) {
+          std::array<int, 2> g{weldedTo[curveIndex[m][e[0]]], weldedTo[curveIndex[m][e[1]]]};
+          if (g[0] > g[1]) std::swap(g[0], g[1]);
+          curves.insert(g);
+        }
+      finishSeparate();
+      r.curve_edges_welded = curves.size();
+      countCurves(curvePoints.size(), {curves.begin(), curves.end()}, r.curve_loops, r.open_curves);
+      if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});
+      reportProgress(options.progress, 100, "Done");
+      r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+      return r;
+    }
     std::vector<int> mergedOfCurvePoint(curvePoints.size(), -1);
     OutputArrays merged;
     std::vector<Point3>& positions = merged.positions;
@@ -1157,7 +1219,6 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       }
       return n;
     };
-    r.smallest_new_angle_deg_unsnapped = r.smallest_new_angle_deg;
     r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers();
     if (options.snap_tolerance > 0 && r.faces_split > 0) {
       reportProgress(options.progress, 95, "Snapping curve points");
@@ -1188,24 +1249,37 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       r.smallest_new_angle_deg = smallest * 180 / M_PI;
       r.new_faces_below_1deg = slivers();
     }
-    merged.toMesh(r.merged);
-    if (separateBuilder.joinable()) {
-      separateBuilder.join();
-      if (separateError) std::rethrow_exception(separateError);
-    } else if (options.separate_meshes) {
-      r.meshes.resize(meshes.size());
-      for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
-    }
+    if (options.merged_output) merged.toMesh(r.merged);
+    finishSeparate();
     r.merged_curve_edges.assign(curves.begin(), curves.end());
     if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});  // they go with `meshes`
+    r.curve_edges_welded = curves.size();
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
+    if (!options.merged_output) {  // made for snapping only
+      r.merged_curve_edges.clear();
+      r.merged_vertex.clear();
+      r.merged_new_face.clear();
+    }
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   return r;
 }
 
+namespace {
+
+// Rounding and the check work on the merged output: where the meshes meet
+// it holds each curve point once, so all meshes round it alike.
+void requireMergedOutput(const SplitResult& result, const char* operation) {
+  if (result.merged.fn == 0 && !result.meshes.empty())
+    throw InvalidInputError(std::string(operation) +
+                            " needs the merged output: split with SplitOptions::merged_output");
+}
+
+}  // namespace
+
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
+  requireMergedOutput(result, "counting the intersections left");
   return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat);
 }
 
@@ -1223,6 +1297,7 @@ float above(double x) {
 }  // namespace
 
 std::size_t roundToFloat(SplitResult& r, int passes) {
+  requireMergedOutput(r, "rounding to float");
   Mesh& merged = r.merged;
   if (merged.fn == 0) return 0;
   const std::vector<Point3> exact = positionsOf(merged);
@@ -1337,12 +1412,9 @@ std::vector<std::uint8_t> curveEdgeFlags(const Mesh& mesh,
 }
 
 JsonObject toJson(const SplitResult& r) {
-  std::size_t curveEdges = r.merged_curve_edges.size();
-  if (curveEdges == 0)
-    for (const auto& c : r.curve_edges) curveEdges += c.size();
   JsonObject j;
   j.set("intersecting_pairs", r.intersecting_pairs)
-      .set("curve_edges", curveEdges)
+      .set("curve_edges", r.curve_edges_welded)
       .set("curve_loops", r.curve_loops)
       .set("open_curves", r.open_curves)
       .set("faces_split", r.faces_split)

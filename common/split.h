@@ -23,7 +23,13 @@ struct SplitOptions {
   // mesh (after welding): the same surface twice, intersecting itself
   // everywhere (decimated scans have them). The first of each group stays.
   bool remove_duplicate_faces = false;
-  bool separate_meshes = true;  // also build `meshes` (one output per input); else merged only
+  bool separate_meshes = true;  // build `meshes` (one output per input)
+  // Build `merged` (all meshes in one, welded along the curves) with
+  // merged_curve_edges, merged_vertex and merged_new_face. Without it the
+  // split does what refining the meshes in place does, and the counts (curve
+  // loops, slivers) are the same; roundToFloat and remainingIntersections
+  // need it. At least one of the two outputs must be asked for.
+  bool merged_output = true;
   // Quality snapping (intersection paper §2.7), 0 = off. A new curve vertex
   // closer than snap_tolerance × the longest edge around it to an input
   // vertex it shares an edge with, or to the next curve vertex along its
@@ -47,7 +53,8 @@ struct SplitResult {
   std::vector<Mesh> meshes;
   std::vector<std::vector<std::array<int, 2>>> curve_edges;
   // All meshes in one, welded along the curves: the curves become
-  // non-manifold edges; provenance keeps the input mesh.
+  // non-manifold edges; provenance keeps the input mesh. These four are
+  // empty unless options.merged_output.
   Mesh merged;
   std::vector<std::array<int, 2>> merged_curve_edges;
   std::vector<std::vector<int>> merged_vertex;  // per mesh, per vertex: its vertex in `merged`
@@ -69,16 +76,20 @@ struct SplitResult {
   std::size_t new_faces_below_1deg_unsnapped = 0;  // the same before quality snapping
   std::size_t vertices_snapped = 0;                // new vertices merged into input vertices
   std::size_t edges_snapped = 0;                   // input edges split at a new vertex
+  std::size_t curve_edges_welded = 0;              // curve edges, each once (as in `merged`)
   std::size_t curve_loops = 0;                     // closed curve components (merged output)
   std::size_t open_curves = 0;                     // curve components with end points
   double time_ms = 0;
 };
 
-// Throws InvalidInputError for empty meshes or non-finite coordinates.
+// Throws InvalidInputError for empty meshes, non-finite coordinates or when
+// neither output (separate_meshes, merged_output) is asked for.
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options = {});
 
-// Prepares the output for float storage (MeshLab's): every coordinate is
+// Prepares the output for float storage (MeshLab's), which needs the merged
+// output (SplitOptions::merged_output; throws InvalidInputError without
+// it): every coordinate is
 // rounded to float, and where that makes faces that met only along a curve
 // cross, the new vertices of those faces are rounded the other way (each
 // coordinate to the float just below or above its exact value), choosing the
@@ -89,7 +100,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 // intersecting pair of the rounded output.
 std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
-// Intersecting pairs left in the merged output, by the self-intersection
+// Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not
 // count), with coordinates as stored in double or, with `asFloat`, rounded
 // to float as MeshLab stores them.

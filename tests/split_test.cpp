@@ -280,6 +280,55 @@ TEST(Split, NoIntersectionLeavesTheMeshes) {
   EXPECT_EQ(trianglesOf(r.meshes[0]), trianglesOf(a));
 }
 
+TEST(Split, WithoutTheMergedOutputEachMeshIsTheSame) {
+  // Three spheres (their curves cross each other), with and without
+  // snapping, and a pair large enough that the meshes are built on a second
+  // thread: without the merged output, each mesh, its curve edges and the
+  // counts are exactly those of the default run, and `merged` is empty.
+  const Mesh a = uvSphere(24, 32), b = uvSphere(40, 52, 0.8, {0.5, 0.31, 0.011}),
+             c = uvSphere(20, 28, 0.7, {0.2, 0.6, 0.05}), large = uvSphere(180, 200),
+             near = uvSphere(30, 40, 0.5, {0.9, 0.2, 0.1});
+  const std::vector<std::vector<const Mesh*>> cases{{&a, &b, &c}, {&a, &b, &c}, {&large, &near}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    SCOPED_TRACE(i);
+    SplitOptions withMerged;
+    withMerged.snap_tolerance = i == 1 ? 0.1 : 0;
+    SplitOptions separateOnly = withMerged;
+    separateOnly.merged_output = false;
+    const SplitResult full = splitAlongIntersections(cases[i], withMerged);
+    SplitResult r = splitAlongIntersections(cases[i], separateOnly);
+    EXPECT_EQ(r.merged.vn, 0);
+    EXPECT_EQ(r.merged.fn, 0);
+    EXPECT_TRUE(r.merged_curve_edges.empty());
+    EXPECT_TRUE(r.merged_vertex.empty());
+    EXPECT_TRUE(r.merged_new_face.empty());
+    ASSERT_EQ(r.meshes.size(), cases[i].size());
+    for (std::size_t m = 0; m < r.meshes.size(); ++m) {
+      EXPECT_EQ(positionsOf(r.meshes[m]), positionsOf(full.meshes[m]));
+      EXPECT_EQ(trianglesOf(r.meshes[m]), trianglesOf(full.meshes[m]));
+      EXPECT_EQ(r.curve_edges[m], full.curve_edges[m]);
+      FaceOriginHandle birth = faceOrigins(r.meshes[m]);
+      FaceOriginHandle fullBirth = faceOrigins(const_cast<Mesh&>(full.meshes[m]));
+      for (std::size_t f = 0; f < r.meshes[m].face.size(); ++f)
+        EXPECT_EQ(birth[f].face, fullBirth[f].face);
+    }
+    EXPECT_GT(full.faces_split, 0u);
+    EXPECT_EQ(r.curve_edges_welded, full.merged_curve_edges.size());
+    EXPECT_EQ(r.curve_loops, full.curve_loops);
+    EXPECT_EQ(r.open_curves, full.open_curves);
+    EXPECT_EQ(r.faces_split, full.faces_split);
+    EXPECT_EQ(r.new_faces_below_1deg, full.new_faces_below_1deg);
+    EXPECT_EQ(r.vertices_snapped, full.vertices_snapped);
+    EXPECT_EQ(toJson(r).str(), toJson(full).set("time_ms", r.time_ms).str());
+    // Rounding and the check need the merged output.
+    EXPECT_THROW(roundToFloat(r), InvalidInputError);
+    EXPECT_THROW(remainingIntersections(r, true), InvalidInputError);
+  }
+  SplitOptions none;
+  none.separate_meshes = none.merged_output = false;
+  EXPECT_THROW(splitAlongIntersections({&a, &b}, none), InvalidInputError);
+}
+
 TEST(Split, BadInput) {
   const Mesh empty, a = box();
   EXPECT_THROW(splitAlongIntersections({&a, &empty}), InvalidInputError);
