@@ -71,24 +71,24 @@ class VertexFaces {
  public:
   VertexFaces(const std::vector<Triangle>& triangles, std::size_t vertexCount)
       : triangles_(triangles), tableVertices_(vertexCount) {
+    // Counted per vertex, summed into each vertex's end, then filled from
+    // the last face backwards: each end steps down to its start (and the
+    // last slot keeps the total).
     start_.assign(vertexCount + 1, 0);
-    int* count = start_.data() + 1;
+    int* end = start_.data();
     for (const Triangle& t : triangles) {
-      ++count[t[0]];
-      ++count[t[1]];
-      ++count[t[2]];
+      ++end[t[0]];
+      ++end[t[1]];
+      ++end[t[2]];
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     faces_.reset(new int[std::size_t(start_.back())]);
-    std::vector<int> next(start_.begin(), start_.end() - 1);
-    int* at = next.data();
     int* faces = faces_.get();
-    const int faceCount = int(triangles.size());
-    for (int f = 0; f < faceCount; ++f) {
+    for (int f = int(triangles.size()) - 1; f >= 0; --f) {
       const Triangle& t = triangles[std::size_t(f)];
-      faces[at[t[0]]++] = f;
-      faces[at[t[1]]++] = f;
-      faces[at[t[2]]++] = f;
+      faces[--end[t[0]]] = f;
+      faces[--end[t[1]]] = f;
+      faces[--end[t[2]]] = f;
     }
   }
 
@@ -2404,8 +2404,10 @@ class HoleFiller {
   std::vector<char> hasOutsideRow_;
 };
 
-void validate(const Mesh& mesh, const HoleFillOptions& o) {
-  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+// Everything but the coordinates, which are checked as they are copied
+// (requireFacesAndFiniteCoordinates first when that finds one that is not
+// finite, so the errors come in the same order as before).
+void validateCompactnessAndOptions(const Mesh& mesh, const HoleFillOptions& o) {
   if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
     throw InvalidInputError(
         "the mesh has deleted vertices or faces; compact it first (MeshLab does when saving, or "
@@ -2432,28 +2434,49 @@ void validate(const Mesh& mesh, const HoleFillOptions& o) {
 
 HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   const auto start = Clock::now();
-  validate(mesh, options);
+  // A mesh without faces or with deleted elements is refused before
+  // anything is read from its faces.
+  if (mesh.fn == 0 || std::size_t(mesh.vn) != mesh.vert.size() ||
+      std::size_t(mesh.fn) != mesh.face.size()) {
+    requireFacesAndFiniteCoordinates(mesh, "the mesh");
+    validateCompactnessAndOptions(mesh, options);
+  }
   HoleFillResult result;
   reportProgress(options.progress, 0, "Finding holes");
 
   Surface s;
   s.roundToFloat = options.round_to_float;
-  // With room for the patches: each is appended for its check, and a
-  // reallocation would copy the whole mesh.
+  // The copy of the mesh, with room for the patches (each is appended for
+  // its check, and a reallocation would copy the whole mesh): the points,
+  // checked on the way, on one core; the faces and the faces around each
+  // vertex on the other.
   s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
-  s.points.resize(mesh.vert.size());
-  for (std::size_t v = 0; v < mesh.vert.size(); ++v) s.points[v] = mesh.vert[v].cP();
   s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
-  s.triangles.resize(mesh.face.size());
-  const Vertex* firstVertex = mesh.vert.data();
-  for (std::size_t f = 0; f < mesh.face.size(); ++f) {
-    const Face& face = mesh.face[f];
-    s.triangles[f] = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
-                      int(face.cV(2) - firstVertex)};
-  }
+  double notFinite = 0;  // x - x is 0 for a finite x, NaN otherwise: the sum stays 0 if all are
+  parallelChunks(
+      2,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t part = begin; part < end; ++part) {
+          if (part == 0) {
+            for (const Vertex& v : mesh.vert) {
+              const Point3& p = v.cP();
+              notFinite += (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]);
+              s.points.push_back(p);
+            }
+            continue;
+          }
+          const Vertex* firstVertex = mesh.vert.data();
+          for (const Face& face : mesh.face)
+            s.triangles.push_back({int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                                   int(face.cV(2) - firstVertex)});
+          s.adjacency = std::make_unique<VertexFaces>(s.triangles, mesh.vert.size());
+        }
+      },
+      1);
+  if (notFinite != 0) requireFacesAndFiniteCoordinates(mesh, "the mesh");  // throws, naming it
+  validateCompactnessAndOptions(mesh, options);
   s.inputVertices = s.points.size();
   s.inputFaces = s.triangles.size();
-  s.adjacency = std::make_unique<VertexFaces>(s.triangles, s.points.size());
   const BorderLoops found = findBorderLoops(s.points, s.triangles, *s.adjacency);
   result.holes_found = found.loops.size();
   if (found.loops.empty()) {
@@ -2589,8 +2612,24 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     // Growing the vertex array moves it, and vcglib would then correct
     // every face's corner pointers one by one; instead it grows here, once,
     // and the faces' corners are set afresh from the indices held below.
+    // Each array grows once, to its final size: a move of the whole mesh
+    // into fresh memory, as costly as the rest of the write together, so the
+    // vertices with their origins move on one core and the faces with theirs
+    // on the other.
     const Vertex* before = mesh.vert.data();
-    mesh.vert.reserve(s.points.size());
+    parallelChunks(
+        2,
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t part = begin; part < end; ++part)
+            if (part == 0) {
+              mesh.vert.reserve(s.points.size());
+              vo._handle->data.reserve(s.points.size());
+            } else {
+              mesh.face.reserve(s.triangles.size());
+              fo._handle->data.reserve(s.triangles.size());
+            }
+        },
+        1);
     const bool moved = mesh.vert.data() != before;
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
@@ -2640,8 +2679,10 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     }
     if (moved) {
       Vertex* first = mesh.vert.data();
-      for (std::size_t f = 0; f < s.inputFaces; ++f)
-        for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+      parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t f = begin; f < end; ++f)
+          for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+      });
     } else {
       for (const auto& [f, corners] : s.inputCorners)
         for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
