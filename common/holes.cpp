@@ -83,18 +83,34 @@ class VertexFaces {
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     faces_.reset(new int[std::size_t(start_.back())]);
+    corners_.reset(new std::uint8_t[std::size_t(start_.back())]);
     int* faces = faces_.get();
+    std::uint8_t* corners = corners_.get();
     for (int f = int(triangles.size()) - 1; f >= 0; --f) {
       const Triangle& t = triangles[std::size_t(f)];
-      faces[--end[t[0]]] = f;
-      faces[--end[t[1]]] = f;
-      faces[--end[t[2]]] = f;
+      // A corner repeated in a degenerate face is its first one each time.
+      int at = --end[t[2]];
+      faces[at] = f;
+      corners[at] = t[2] == t[0] ? 0 : t[2] == t[1] ? 1 : 2;
+      at = --end[t[1]];
+      faces[at] = f;
+      corners[at] = t[1] == t[0] ? 0 : 1;
+      at = --end[t[0]];
+      faces[at] = f;
+      corners[at] = 0;
     }
   }
 
-  // The faces of the table at v, as built (before any add or change).
-  std::pair<const int*, const int*> initial(int v) const {
-    return {faces_.get() + start_[v], faces_.get() + start_[v + 1]};
+  // The faces of the table at v as built (before any add or change), and
+  // v's corner in each (its first, should a degenerate face repeat it).
+  struct Fan {
+    const int* faces;
+    const std::uint8_t* corners;
+    std::size_t count;
+  };
+  Fan initial(int v) const {
+    return {faces_.get() + start_[v], corners_.get() + start_[v],
+            std::size_t(start_[v + 1] - start_[v])};
   }
 
   // Face f is new, or has v as a new corner.
@@ -135,6 +151,7 @@ class VertexFaces {
   std::size_t tableVertices_;
   std::vector<int> start_;
   std::unique_ptr<int[]> faces_;  // not value-initialised: every entry is written
+  std::unique_ptr<std::uint8_t[]> corners_;
   std::unordered_map<int, std::vector<int>> extra_;
 };
 
@@ -274,16 +291,17 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
     std::vector<int> after, before;  // the corners after / before v in each face
     for (std::size_t v = begin; v < end; ++v) {
       const int me = int(v);
-      const auto [first, last] = adjacency.initial(me);
-      const std::size_t count = std::size_t(last - first);
+      const VertexFaces::Fan fan = adjacency.initial(me);
+      const std::size_t count = fan.count;
       if (after.size() < count) {
         after.resize(count);
         before.resize(count);
       }
+      static constexpr int kNext[3] = {1, 2, 0}, kPrevious[3] = {2, 0, 1};
       for (std::size_t i = 0; i < count; ++i) {
-        const Triangle& t = T[std::size_t(first[i])];
-        after[i] = t[0] == me ? t[1] : t[1] == me ? t[2] : t[0];
-        before[i] = t[0] == me ? t[2] : t[1] == me ? t[0] : t[1];
+        const Triangle& t = T[std::size_t(fan.faces[i])];
+        after[i] = t[kNext[fan.corners[i]]];
+        before[i] = t[kPrevious[fan.corners[i]]];
       }
       for (std::size_t i = 0; i < count; ++i) {
         const int b = after[i];
@@ -293,7 +311,7 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
         if (j < count) continue;
         bool once = true;
         for (j = 0; once && j < count; ++j) once = j == i || after[j] != b;
-        if (once) found[worker].push_back({me, b, first[i]});
+        if (once) found[worker].push_back({me, b, fan.faces[i]});
       }
     }
   });
@@ -2458,17 +2476,21 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t part = begin; part < end; ++part) {
           if (part == 0) {
+            s.points.resize(mesh.vert.size());
+            Point3* to = s.points.data();
             for (const Vertex& v : mesh.vert) {
               const Point3& p = v.cP();
               notFinite += (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]);
-              s.points.push_back(p);
+              *to++ = p;
             }
             continue;
           }
+          s.triangles.resize(mesh.face.size());
+          Triangle* to = s.triangles.data();
           const Vertex* firstVertex = mesh.vert.data();
           for (const Face& face : mesh.face)
-            s.triangles.push_back({int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
-                                   int(face.cV(2) - firstVertex)});
+            *to++ = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                     int(face.cV(2) - firstVertex)};
           s.adjacency = std::make_unique<VertexFaces>(s.triangles, mesh.vert.size());
         }
       },
