@@ -84,10 +84,12 @@ class VertexFaces {
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     faces_.reset(new int[std::size_t(start_.back())]);
     corners_.reset(new std::uint8_t[std::size_t(start_.back())]);
+    // All through locals: the byte stores could alias anything in memory.
     int* faces = faces_.get();
     std::uint8_t* corners = corners_.get();
+    const Triangle* triangle = triangles.data();
     for (int f = int(triangles.size()) - 1; f >= 0; --f) {
-      const Triangle& t = triangles[std::size_t(f)];
+      const Triangle& t = triangle[f];
       // A corner repeated in a degenerate face is its first one each time.
       int at = --end[t[2]];
       faces[at] = f;
@@ -1511,12 +1513,16 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
     // since lies within its input face: its current corners decide that.)
     std::vector<std::uint8_t> beyond(P.size());
     parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      // In locals: the byte stores could alias anything in memory.
+      const double lo0 = bounds.lo[0], lo1 = bounds.lo[1], lo2 = bounds.lo[2];
+      const double hi0 = bounds.hi[0], hi1 = bounds.hi[1], hi2 = bounds.hi[2];
+      const Point3* point = P.data();
+      std::uint8_t* code = beyond.data();
       for (std::size_t v = begin; v < end; ++v) {
-        const Point3& p = P[v];
-        unsigned code = 0;
-        for (int k = 0; k < 3; ++k)
-          code |= unsigned(p[k] < bounds.lo[k]) << k | unsigned(p[k] > bounds.hi[k]) << (k + 3);
-        beyond[v] = std::uint8_t(code);
+        const double x = point[v][0], y = point[v][1], z = point[v][2];
+        code[v] = std::uint8_t(unsigned(x < lo0) | unsigned(y < lo1) << 1 | unsigned(z < lo2) << 2 |
+                               unsigned(x > hi0) << 3 | unsigned(y > hi1) << 4 |
+                               unsigned(z > hi2) << 5);
       }
     });
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
@@ -2634,25 +2640,39 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     // Growing the vertex array moves it, and vcglib would then correct
     // every face's corner pointers one by one; instead it grows here, once,
     // and the faces' corners are set afresh from the indices held below.
-    // Each array grows once, to its final size: a move of the whole mesh
-    // into fresh memory, as costly as the rest of the write together, so the
-    // vertices with their origins move on one core and the faces with theirs
-    // on the other.
-    const Vertex* before = mesh.vert.data();
+    // Each array moves at most once, into room for its final size: a copy
+    // of the whole mesh into fresh memory, as costly as the rest of the
+    // write together. The vertices and both origin arrays move on one core;
+    // the faces on the other, where their corners are then set to where the
+    // vertices go (known as soon as that room is allocated) from the
+    // surface's corners, which also carry the splits' changes.
+    const bool moved = mesh.vert.capacity() < s.points.size();
+    const bool facesMove = mesh.face.capacity() < s.triangles.size();
+    std::vector<Vertex> movedVertices;
+    std::vector<Face> movedFaces;
+    if (moved) movedVertices.reserve(s.points.size());
+    if (facesMove) movedFaces.reserve(s.triangles.size());
+    Vertex* const first = moved ? movedVertices.data() : mesh.vert.data();
     parallelChunks(
         2,
         [&](std::size_t begin, std::size_t end, unsigned) {
-          for (std::size_t part = begin; part < end; ++part)
+          for (std::size_t part = begin; part < end; ++part) {
             if (part == 0) {
-              mesh.vert.reserve(s.points.size());
+              if (moved) movedVertices.assign(mesh.vert.begin(), mesh.vert.end());
               vo._handle->data.reserve(s.points.size());
-            } else {
-              mesh.face.reserve(s.triangles.size());
               fo._handle->data.reserve(s.triangles.size());
+              continue;
             }
+            if (facesMove) movedFaces.assign(mesh.face.begin(), mesh.face.end());
+            std::vector<Face>& faces = facesMove ? movedFaces : mesh.face;
+            if (moved)
+              for (std::size_t f = 0; f < s.inputFaces; ++f)
+                for (int k = 0; k < 3; ++k) faces[f].V(k) = first + s.triangles[f][k];
+          }
         },
         1);
-    const bool moved = mesh.vert.data() != before;
+    if (moved) mesh.vert.swap(movedVertices);
+    if (facesMove) mesh.face.swap(movedFaces);
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
       for (std::size_t v = s.inputVertices; v < s.points.size(); ++v, ++vi) {
@@ -2699,13 +2719,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         if (border[i] >= 0 && inPatch(int(s.inputVertices + i)))
           vo[s.inputVertices + i] = vo[border[i]];
     }
-    if (moved) {
-      Vertex* first = mesh.vert.data();
-      parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t f = begin; f < end; ++f)
-          for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
-      });
-    } else {
+    if (!moved) {
       for (const auto& [f, corners] : s.inputCorners)
         for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
     }
