@@ -1520,9 +1520,9 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
       std::uint8_t* code = beyond.data();
       for (std::size_t v = begin; v < end; ++v) {
         const double x = point[v][0], y = point[v][1], z = point[v][2];
-        code[v] = std::uint8_t(unsigned(x < lo0) | unsigned(y < lo1) << 1 | unsigned(z < lo2) << 2 |
-                               unsigned(x > hi0) << 3 | unsigned(y > hi1) << 4 |
-                               unsigned(z > hi2) << 5);
+        code[v] =
+            std::uint8_t(unsigned(x < lo0) | unsigned(y < lo1) << 1 | unsigned(z < lo2) << 2 |
+                         unsigned(x > hi0) << 3 | unsigned(y > hi1) << 4 | unsigned(z > hi2) << 5);
       }
     });
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
