@@ -2471,9 +2471,10 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   Surface s;
   s.roundToFloat = options.round_to_float;
   // The copy of the mesh, with room for the patches (each is appended for
-  // its check, and a reallocation would copy the whole mesh): the points,
-  // checked on the way, on one core; the faces and the faces around each
-  // vertex on the other.
+  // its check, and a reallocation would copy the whole mesh): the faces and
+  // the faces around each vertex on this core (the larger part: it goes
+  // on should the other core be busy), the points, checked on the way, on
+  // the other.
   s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
   s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
   double notFinite = 0;  // x - x is 0 for a finite x, NaN otherwise: the sum stays 0 if all are
@@ -2481,7 +2482,7 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       2,
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t part = begin; part < end; ++part) {
-          if (part == 0) {
+          if (part == 1) {
             s.points.resize(mesh.vert.size());
             Point3* to = s.points.data();
             for (const Vertex& v : mesh.vert) {
@@ -2640,39 +2641,25 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     // Growing the vertex array moves it, and vcglib would then correct
     // every face's corner pointers one by one; instead it grows here, once,
     // and the faces' corners are set afresh from the indices held below.
-    // Each array moves at most once, into room for its final size: a copy
-    // of the whole mesh into fresh memory, as costly as the rest of the
-    // write together. The vertices and both origin arrays move on one core;
-    // the faces on the other, where their corners are then set to where the
-    // vertices go (known as soon as that room is allocated) from the
-    // surface's corners, which also carry the splits' changes.
-    const bool moved = mesh.vert.capacity() < s.points.size();
-    const bool facesMove = mesh.face.capacity() < s.triangles.size();
-    std::vector<Vertex> movedVertices;
-    std::vector<Face> movedFaces;
-    if (moved) movedVertices.reserve(s.points.size());
-    if (facesMove) movedFaces.reserve(s.triangles.size());
-    Vertex* const first = moved ? movedVertices.data() : mesh.vert.data();
+    // Each array grows once, to its final size: a move of the whole mesh
+    // into fresh memory, as costly as the rest of the write together, so the
+    // faces with their origins move on this core and the vertices with
+    // theirs on the other.
+    const Vertex* before = mesh.vert.data();
     parallelChunks(
         2,
         [&](std::size_t begin, std::size_t end, unsigned) {
-          for (std::size_t part = begin; part < end; ++part) {
+          for (std::size_t part = begin; part < end; ++part)
             if (part == 0) {
-              if (moved) movedVertices.assign(mesh.vert.begin(), mesh.vert.end());
-              vo._handle->data.reserve(s.points.size());
+              mesh.face.reserve(s.triangles.size());
               fo._handle->data.reserve(s.triangles.size());
-              continue;
+            } else {
+              mesh.vert.reserve(s.points.size());
+              vo._handle->data.reserve(s.points.size());
             }
-            if (facesMove) movedFaces.assign(mesh.face.begin(), mesh.face.end());
-            std::vector<Face>& faces = facesMove ? movedFaces : mesh.face;
-            if (moved)
-              for (std::size_t f = 0; f < s.inputFaces; ++f)
-                for (int k = 0; k < 3; ++k) faces[f].V(k) = first + s.triangles[f][k];
-          }
         },
         1);
-    if (moved) mesh.vert.swap(movedVertices);
-    if (facesMove) mesh.face.swap(movedFaces);
+    const bool moved = mesh.vert.data() != before;
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
       for (std::size_t v = s.inputVertices; v < s.points.size(); ++v, ++vi) {
@@ -2719,7 +2706,13 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         if (border[i] >= 0 && inPatch(int(s.inputVertices + i)))
           vo[s.inputVertices + i] = vo[border[i]];
     }
-    if (!moved) {
+    if (moved) {
+      Vertex* first = mesh.vert.data();
+      parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t f = begin; f < end; ++f)
+          for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+      });
+    } else {
       for (const auto& [f, corners] : s.inputCorners)
         for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
     }
