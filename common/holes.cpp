@@ -69,18 +69,16 @@ bool hasCorner(const Triangle& t, int v) {
 // split face loses a corner, so its entry at that corner goes stale.
 class VertexFaces {
  public:
-  VertexFaces(const std::vector<Triangle>& triangles, std::size_t vertexCount)
-      : triangles_(triangles), tableVertices_(vertexCount) {
-    // Counted per vertex, summed into each vertex's end, then filled from
-    // the last face backwards: each end steps down to its start (and the
-    // last slot keeps the total).
-    start_.assign(vertexCount + 1, 0);
+  // `cornerCounts`: per vertex, the faces that have it as a corner (as
+  // often as they have it), then a 0; counted while the faces are copied,
+  // so that the faces are read once for both.
+  VertexFaces(const std::vector<Triangle>& triangles, std::vector<int> cornerCounts)
+      : triangles_(triangles), tableVertices_(cornerCounts.size() - 1) {
+    // Summed into each vertex's end, then filled from the last face
+    // backwards: each end steps down to its start (and the last slot keeps
+    // the total).
+    start_ = std::move(cornerCounts);
     int* end = start_.data();
-    for (const Triangle& t : triangles) {
-      ++end[t[0]];
-      ++end[t[1]];
-      ++end[t[2]];
-    }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     faces_.reset(new int[std::size_t(start_.back())]);
     corners_.reset(new std::uint8_t[std::size_t(start_.back())]);
@@ -2495,10 +2493,17 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
           s.triangles.resize(mesh.face.size());
           Triangle* to = s.triangles.data();
           const Vertex* firstVertex = mesh.vert.data();
-          for (const Face& face : mesh.face)
-            *to++ = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
-                     int(face.cV(2) - firstVertex)};
-          s.adjacency = std::make_unique<VertexFaces>(s.triangles, mesh.vert.size());
+          std::vector<int> cornerCounts(mesh.vert.size() + 1, 0);
+          int* count = cornerCounts.data();
+          for (const Face& face : mesh.face) {
+            const Triangle t = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                                int(face.cV(2) - firstVertex)};
+            *to++ = t;
+            ++count[t[0]];
+            ++count[t[1]];
+            ++count[t[2]];
+          }
+          s.adjacency = std::make_unique<VertexFaces>(s.triangles, std::move(cornerCounts));
         }
       },
       1);
