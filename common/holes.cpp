@@ -2426,9 +2426,9 @@ class HoleFiller {
   std::vector<char> hasOutsideRow_;
 };
 
-// Everything but the coordinates, which are checked as they are copied
-// (requireFacesAndFiniteCoordinates first when that finds one that is not
-// finite, so the errors come in the same order as before).
+// Everything but the coordinates, which fillHoles checks as it copies them
+// (and reports first, through requireFacesAndFiniteCoordinates, when one is
+// not finite).
 void validateCompactnessAndOptions(const Mesh& mesh, const HoleFillOptions& o) {
   if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
     throw InvalidInputError(
@@ -2643,13 +2643,13 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       if (f >= 0) inputOrigins.emplace(f, fo[f]);
     const std::size_t newVertices = s.points.size() - s.inputVertices;
     const std::size_t newFaces = s.triangles.size() - s.inputFaces;
-    // Growing the vertex array moves it, and vcglib would then correct
-    // every face's corner pointers one by one; instead it grows here, once,
-    // and the faces' corners are set afresh from the indices held below.
-    // Each array grows once, to its final size: a move of the whole mesh
-    // into fresh memory, as costly as the rest of the write together, so the
-    // faces with their origins move on this core and the vertices with
-    // theirs on the other.
+    // Each array grows here, once, to its final size: a move of the whole
+    // mesh into fresh memory, as costly as the rest of the write together,
+    // so the faces with their origins move on this core and the vertices
+    // with theirs on the other. (Grown by AddVertices, the vertex array
+    // would move with vcglib correcting every face's corner pointers one by
+    // one; instead the faces' corners are set afresh, in parallel, from the
+    // indices held below.)
     const Vertex* before = mesh.vert.data();
     parallelChunks(
         2,
