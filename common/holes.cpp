@@ -2469,44 +2469,34 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   Surface s;
   s.roundToFloat = options.round_to_float;
   // The copy of the mesh, with room for the patches (each is appended for
-  // its check, and a reallocation would copy the whole mesh): the faces and
-  // the faces around each vertex on this core (the larger part: it goes
-  // on should the other core be busy), the points, checked on the way, on
-  // the other.
+  // its check, and a reallocation would copy the whole mesh); one pass over
+  // the points also checks them, one over the faces also counts the faces
+  // at each vertex. (Copying on two cores gains nothing: both threads
+  // wait on the page faults of the fresh arrays.)
   s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
   s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
   double notFinite = 0;  // x - x is 0 for a finite x, NaN otherwise: the sum stays 0 if all are
-  parallelChunks(
-      2,
-      [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t part = begin; part < end; ++part) {
-          if (part == 1) {
-            s.points.resize(mesh.vert.size());
-            Point3* to = s.points.data();
-            for (const Vertex& v : mesh.vert) {
-              const Point3& p = v.cP();
-              notFinite += (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]);
-              *to++ = p;
-            }
-            continue;
-          }
-          s.triangles.resize(mesh.face.size());
-          Triangle* to = s.triangles.data();
-          const Vertex* firstVertex = mesh.vert.data();
-          std::vector<int> cornerCounts(mesh.vert.size() + 1, 0);
-          int* count = cornerCounts.data();
-          for (const Face& face : mesh.face) {
-            const Triangle t = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
-                                int(face.cV(2) - firstVertex)};
-            *to++ = t;
-            ++count[t[0]];
-            ++count[t[1]];
-            ++count[t[2]];
-          }
-          s.adjacency = std::make_unique<VertexFaces>(s.triangles, std::move(cornerCounts));
-        }
-      },
-      1);
+  s.points.resize(mesh.vert.size());
+  Point3* toPoint = s.points.data();
+  for (const Vertex& v : mesh.vert) {
+    const Point3& p = v.cP();
+    notFinite += (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]);
+    *toPoint++ = p;
+  }
+  s.triangles.resize(mesh.face.size());
+  Triangle* toTriangle = s.triangles.data();
+  const Vertex* firstVertex = mesh.vert.data();
+  std::vector<int> cornerCounts(mesh.vert.size() + 1, 0);
+  int* count = cornerCounts.data();
+  for (const Face& face : mesh.face) {
+    const Triangle t = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                        int(face.cV(2) - firstVertex)};
+    *toTriangle++ = t;
+    ++count[t[0]];
+    ++count[t[1]];
+    ++count[t[2]];
+  }
+  s.adjacency = std::make_unique<VertexFaces>(s.triangles, std::move(cornerCounts));
   if (notFinite != 0) requireFacesAndFiniteCoordinates(mesh, "the mesh");  // throws, naming it
   validateCompactnessAndOptions(mesh, options);
   s.inputVertices = s.points.size();
