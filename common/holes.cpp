@@ -2703,9 +2703,16 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     }
     if (moved) {
       Vertex* first = mesh.vert.data();
+      Face* const faces = mesh.face.data();
+      const Triangle* const corners = s.triangles.data();
       parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t f = begin; f < end; ++f)
-          for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+        for (std::size_t f = begin; f < end; ++f) {
+          const Triangle& t = corners[f];
+          Face& face = faces[f];
+          face.V(0) = first + t[0];
+          face.V(1) = first + t[1];
+          face.V(2) = first + t[2];
+        }
       });
     } else {
       for (const auto& [f, corners] : s.inputCorners)
