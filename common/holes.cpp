@@ -69,32 +69,48 @@ bool hasCorner(const Triangle& t, int v) {
 // split face loses a corner, so its entry at that corner goes stale.
 class VertexFaces {
  public:
-  VertexFaces(const std::vector<Triangle>& triangles, std::size_t vertexCount)
-      : triangles_(triangles), tableVertices_(vertexCount) {
-    start_.assign(vertexCount + 1, 0);
-    int* count = start_.data() + 1;
-    for (const Triangle& t : triangles) {
-      ++count[t[0]];
-      ++count[t[1]];
-      ++count[t[2]];
-    }
+  // `cornerCounts`: per vertex, the faces that have it as a corner (as
+  // often as they have it), then a 0; counted while the faces are copied,
+  // so that the faces are read once for both.
+  VertexFaces(const std::vector<Triangle>& triangles, std::vector<int> cornerCounts)
+      : triangles_(triangles), tableVertices_(cornerCounts.size() - 1) {
+    // Summed into each vertex's end, then filled from the last face
+    // backwards: each end steps down to its start (and the last slot keeps
+    // the total).
+    start_ = std::move(cornerCounts);
+    int* end = start_.data();
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     faces_.reset(new int[std::size_t(start_.back())]);
-    std::vector<int> next(start_.begin(), start_.end() - 1);
-    int* at = next.data();
+    corners_.reset(new std::uint8_t[std::size_t(start_.back())]);
+    // All through locals: the byte stores could alias anything in memory.
     int* faces = faces_.get();
-    const int faceCount = int(triangles.size());
-    for (int f = 0; f < faceCount; ++f) {
-      const Triangle& t = triangles[std::size_t(f)];
-      faces[at[t[0]]++] = f;
-      faces[at[t[1]]++] = f;
-      faces[at[t[2]]++] = f;
+    std::uint8_t* corners = corners_.get();
+    const Triangle* triangle = triangles.data();
+    for (int f = int(triangles.size()) - 1; f >= 0; --f) {
+      const Triangle& t = triangle[f];
+      // A corner repeated in a degenerate face is its first one each time.
+      int at = --end[t[2]];
+      faces[at] = f;
+      corners[at] = t[2] == t[0] ? 0 : t[2] == t[1] ? 1 : 2;
+      at = --end[t[1]];
+      faces[at] = f;
+      corners[at] = t[1] == t[0] ? 0 : 1;
+      at = --end[t[0]];
+      faces[at] = f;
+      corners[at] = 0;
     }
   }
 
-  // The faces of the table at v, as built (before any add or change).
-  std::pair<const int*, const int*> initial(int v) const {
-    return {faces_.get() + start_[v], faces_.get() + start_[v + 1]};
+  // The faces of the table at v as built (before any add or change), and
+  // v's corner in each (its first, should a degenerate face repeat it).
+  struct Fan {
+    const int* faces;
+    const std::uint8_t* corners;
+    std::size_t count;
+  };
+  Fan initial(int v) const {
+    return {faces_.get() + start_[v], corners_.get() + start_[v],
+            std::size_t(start_[v + 1] - start_[v])};
   }
 
   // Face f is new, or has v as a new corner.
@@ -135,6 +151,7 @@ class VertexFaces {
   std::size_t tableVertices_;
   std::vector<int> start_;
   std::unique_ptr<int[]> faces_;  // not value-initialised: every entry is written
+  std::unique_ptr<std::uint8_t[]> corners_;
   std::unordered_map<int, std::vector<int>> extra_;
 };
 
@@ -274,16 +291,17 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
     std::vector<int> after, before;  // the corners after / before v in each face
     for (std::size_t v = begin; v < end; ++v) {
       const int me = int(v);
-      const auto [first, last] = adjacency.initial(me);
-      const std::size_t count = std::size_t(last - first);
+      const VertexFaces::Fan fan = adjacency.initial(me);
+      const std::size_t count = fan.count;
       if (after.size() < count) {
         after.resize(count);
         before.resize(count);
       }
+      static constexpr int kNext[3] = {1, 2, 0}, kPrevious[3] = {2, 0, 1};
       for (std::size_t i = 0; i < count; ++i) {
-        const Triangle& t = T[std::size_t(first[i])];
-        after[i] = t[0] == me ? t[1] : t[1] == me ? t[2] : t[0];
-        before[i] = t[0] == me ? t[2] : t[1] == me ? t[0] : t[1];
+        const Triangle& t = T[std::size_t(fan.faces[i])];
+        after[i] = t[kNext[fan.corners[i]]];
+        before[i] = t[kPrevious[fan.corners[i]]];
       }
       for (std::size_t i = 0; i < count; ++i) {
         const int b = after[i];
@@ -293,7 +311,7 @@ BorderLoops findBorderLoops(const std::vector<Point3>& P, const std::vector<Tria
         if (j < count) continue;
         bool once = true;
         for (j = 0; once && j < count; ++j) once = j == i || after[j] != b;
-        if (once) found[worker].push_back({me, b, first[i]});
+        if (once) found[worker].push_back({me, b, fan.faces[i]});
       }
     }
   });
@@ -1493,12 +1511,16 @@ std::size_t patchIntersections(Surface& s, const std::vector<Triangle>& patch,
     // since lies within its input face: its current corners decide that.)
     std::vector<std::uint8_t> beyond(P.size());
     parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      // In locals: the byte stores could alias anything in memory.
+      const double lo0 = bounds.lo[0], lo1 = bounds.lo[1], lo2 = bounds.lo[2];
+      const double hi0 = bounds.hi[0], hi1 = bounds.hi[1], hi2 = bounds.hi[2];
+      const Point3* point = P.data();
+      std::uint8_t* code = beyond.data();
       for (std::size_t v = begin; v < end; ++v) {
-        const Point3& p = P[v];
-        unsigned code = 0;
-        for (int k = 0; k < 3; ++k)
-          code |= unsigned(p[k] < bounds.lo[k]) << k | unsigned(p[k] > bounds.hi[k]) << (k + 3);
-        beyond[v] = std::uint8_t(code);
+        const double x = point[v][0], y = point[v][1], z = point[v][2];
+        code[v] =
+            std::uint8_t(unsigned(x < lo0) | unsigned(y < lo1) << 1 | unsigned(z < lo2) << 2 |
+                         unsigned(x > hi0) << 3 | unsigned(y > hi1) << 4 | unsigned(z > hi2) << 5);
       }
     });
     parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned worker) {
@@ -2547,8 +2569,10 @@ class HoleFiller {
   std::vector<char> hasOutsideRow_;
 };
 
-void validate(const Mesh& mesh, const HoleFillOptions& o) {
-  requireFacesAndFiniteCoordinates(mesh, "the mesh");
+// Everything but the coordinates, which fillHoles checks as it copies them
+// (and reports first, through requireFacesAndFiniteCoordinates, when one is
+// not finite).
+void validateCompactnessAndOptions(const Mesh& mesh, const HoleFillOptions& o) {
   if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
     throw InvalidInputError(
         "the mesh has deleted vertices or faces; compact it first (MeshLab does when saving, or "
@@ -2575,28 +2599,51 @@ void validate(const Mesh& mesh, const HoleFillOptions& o) {
 
 HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   const auto start = Clock::now();
-  validate(mesh, options);
+  // A mesh without faces or with deleted elements is refused before
+  // anything is read from its faces.
+  if (mesh.fn == 0 || std::size_t(mesh.vn) != mesh.vert.size() ||
+      std::size_t(mesh.fn) != mesh.face.size()) {
+    requireFacesAndFiniteCoordinates(mesh, "the mesh");
+    validateCompactnessAndOptions(mesh, options);
+  }
   HoleFillResult result;
   reportProgress(options.progress, 0, "Finding holes");
 
   Surface s;
   s.roundToFloat = options.round_to_float;
-  // With room for the patches: each is appended for its check, and a
-  // reallocation would copy the whole mesh.
+  // The copy of the mesh, with room for the patches (each is appended for
+  // its check, and a reallocation would copy the whole mesh); one pass over
+  // the points also checks them, one over the faces also counts the faces
+  // at each vertex. (Copying on two cores gains nothing: both threads
+  // wait on the page faults of the fresh arrays.)
   s.points.reserve(mesh.vert.size() + mesh.vert.size() / 8 + 4096);
-  s.points.resize(mesh.vert.size());
-  for (std::size_t v = 0; v < mesh.vert.size(); ++v) s.points[v] = mesh.vert[v].cP();
   s.triangles.reserve(mesh.face.size() + mesh.face.size() / 8 + 8192);
-  s.triangles.resize(mesh.face.size());
-  const Vertex* firstVertex = mesh.vert.data();
-  for (std::size_t f = 0; f < mesh.face.size(); ++f) {
-    const Face& face = mesh.face[f];
-    s.triangles[f] = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
-                      int(face.cV(2) - firstVertex)};
+  double notFinite = 0;  // x - x is 0 for a finite x, NaN otherwise: the sum stays 0 if all are
+  s.points.resize(mesh.vert.size());
+  Point3* toPoint = s.points.data();
+  for (const Vertex& v : mesh.vert) {
+    const Point3& p = v.cP();
+    notFinite += (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]);
+    *toPoint++ = p;
   }
+  s.triangles.resize(mesh.face.size());
+  Triangle* toTriangle = s.triangles.data();
+  const Vertex* firstVertex = mesh.vert.data();
+  std::vector<int> cornerCounts(mesh.vert.size() + 1, 0);
+  int* count = cornerCounts.data();
+  for (const Face& face : mesh.face) {
+    const Triangle t = {int(face.cV(0) - firstVertex), int(face.cV(1) - firstVertex),
+                        int(face.cV(2) - firstVertex)};
+    *toTriangle++ = t;
+    ++count[t[0]];
+    ++count[t[1]];
+    ++count[t[2]];
+  }
+  s.adjacency = std::make_unique<VertexFaces>(s.triangles, std::move(cornerCounts));
+  if (notFinite != 0) requireFacesAndFiniteCoordinates(mesh, "the mesh");  // throws, naming it
+  validateCompactnessAndOptions(mesh, options);
   s.inputVertices = s.points.size();
   s.inputFaces = s.triangles.size();
-  s.adjacency = std::make_unique<VertexFaces>(s.triangles, s.points.size());
   const BorderLoops found = findBorderLoops(s.points, s.triangles, *s.adjacency);
   result.holes_found = found.loops.size();
   if (found.loops.empty()) {
@@ -2729,11 +2776,27 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
       if (f >= 0) inputOrigins.emplace(f, fo[f]);
     const std::size_t newVertices = s.points.size() - s.inputVertices;
     const std::size_t newFaces = s.triangles.size() - s.inputFaces;
-    // Growing the vertex array moves it, and vcglib would then correct
-    // every face's corner pointers one by one; instead it grows here, once,
-    // and the faces' corners are set afresh from the indices held below.
+    // Each array grows here, once, to its final size: a move of the whole
+    // mesh into fresh memory, as costly as the rest of the write together,
+    // so the faces with their origins move on this core and the vertices
+    // with theirs on the other. (Grown by AddVertices, the vertex array
+    // would move with vcglib correcting every face's corner pointers one by
+    // one; instead the faces' corners are set afresh, in parallel, from the
+    // indices held below.)
     const Vertex* before = mesh.vert.data();
-    mesh.vert.reserve(s.points.size());
+    parallelChunks(
+        2,
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t part = begin; part < end; ++part)
+            if (part == 0) {
+              mesh.face.reserve(s.triangles.size());
+              fo._handle->data.reserve(s.triangles.size());
+            } else {
+              mesh.vert.reserve(s.points.size());
+              vo._handle->data.reserve(s.points.size());
+            }
+        },
+        1);
     const bool moved = mesh.vert.data() != before;
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
@@ -2783,8 +2846,17 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     }
     if (moved) {
       Vertex* first = mesh.vert.data();
-      for (std::size_t f = 0; f < s.inputFaces; ++f)
-        for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = first + s.triangles[f][k];
+      Face* const faces = mesh.face.data();
+      const Triangle* const corners = s.triangles.data();
+      parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t f = begin; f < end; ++f) {
+          const Triangle& t = corners[f];
+          Face& face = faces[f];
+          face.V(0) = first + t[0];
+          face.V(1) = first + t[1];
+          face.V(2) = first + t[2];
+        }
+      });
     } else {
       for (const auto& [f, corners] : s.inputCorners)
         for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];

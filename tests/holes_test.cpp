@@ -605,6 +605,41 @@ TEST(HoleInput, NonFiniteCoordinateIsRefusedAndTheMeshKept) {
   EXPECT_EQ(std::size_t(m.fn), faces);
 }
 
+TEST(HoleInput, InfiniteCoordinateIsRefusedBeforeBadOptions) {
+  for (int axis = 0; axis < 3; ++axis) {
+    Mesh m = sphereWithCap();
+    m.vert[m.vert.size() - 1].P()[axis] = axis == 1 ? -INFINITY : INFINITY;
+    const std::vector<Triangle> t = trianglesOf(m);
+    HoleFillOptions o;
+    o.long_edge_factor = 0.5;  // also bad: the coordinate is named first
+    try {
+      fillHoles(m, o);
+      FAIL() << "no error";
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find("vertex " + std::to_string(m.vert.size() - 1) +
+                                           " has a non-finite"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(trianglesOf(m), t);
+  }
+}
+
+TEST(HoleInput, DeletedElementsAreRefused) {
+  Mesh m = sphereWithCap();
+  vcg::tri::Allocator<Mesh>::DeleteFace(m, m.face[3]);
+  try {
+    fillHoles(m);
+    FAIL() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("deleted"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(m.face.size(), std::size_t(m.fn) + 1);
+  Mesh n = sphereWithCap();
+  vcg::tri::Allocator<Mesh>::DeleteVertex(n, n.vert[0]);
+  EXPECT_THROW(fillHoles(n), InvalidInputError);
+}
+
 TEST(HoleInput, BadOptionsAreRefused) {
   Mesh m = sphereWithCap();
   HoleFillOptions o;
