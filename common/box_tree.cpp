@@ -1,4 +1,5 @@
 #include "common/box_tree.h"
+#include "common/parallel.h"
 
 #include <algorithm>
 #include <cstring>
@@ -155,9 +156,9 @@ void BoxTree::buildParallel(bool splitByMedian) {
         });
   }
   std::vector<Node> left, right;
-  std::thread worker([&] { one(0, mid, left); });
+  TaskAlongside worker([&] { one(0, mid, left); });
   one(mid, n, right);
-  worker.join();
+  worker.wait();
   nodes_.reserve(1 + left.size() + right.size());
   nodes_.push_back({all, 1, std::uint32_t(1 + left.size())});
   auto append = [&](const std::vector<Node>& part) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <functional>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -34,13 +36,55 @@ void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4
     }
   };
   // The calling thread takes the first chunk: one thread fewer to start.
+  // When no thread can be started (std::system_error) or the list of them
+  // cannot grow, the chunks left run here too: every chunk runs exactly
+  // once, so callers that must finish a job (re-pointing a moved mesh's
+  // faces) can rely on it, and no started thread is left unjoined.
   std::vector<std::thread> threads;
-  threads.reserve(workers - 1);
-  for (std::size_t w = 1; w < workers; ++w) threads.emplace_back(run, w);
+  std::size_t started = 1;
+  try {
+    threads.reserve(workers - 1);
+    for (; started < workers; ++started) threads.emplace_back(run, started);
+  } catch (...) {
+  }
   run(0);
+  for (std::size_t w = started; w < workers; ++w) run(w);
   for (std::thread& t : threads) t.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
 }
+
+// Runs a task on a second thread while the caller works on, or, when no
+// thread can be started, on the calling thread once it is waited for: the
+// task runs exactly once either way (if waited for). The destructor joins
+// a started thread (an error on the caller's side leaves nothing running).
+class TaskAlongside {
+ public:
+  explicit TaskAlongside(std::function<void()> task) : task_(std::move(task)) {
+    try {
+      thread_ = std::thread(task_);
+      task_ = nullptr;
+    } catch (const std::system_error&) {  // no thread to spare: wait() runs it
+    }
+  }
+  TaskAlongside(const TaskAlongside&) = delete;
+  TaskAlongside& operator=(const TaskAlongside&) = delete;
+  ~TaskAlongside() {
+    if (thread_.joinable()) thread_.join();
+  }
+  void wait() {
+    if (thread_.joinable()) {
+      thread_.join();
+    } else if (task_) {
+      std::function<void()> task = std::move(task_);
+      task_ = nullptr;
+      task();
+    }
+  }
+
+ private:
+  std::function<void()> task_;
+  std::thread thread_;
+};
 
 }  // namespace meshmend

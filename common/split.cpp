@@ -8,6 +8,7 @@
 #include <memory>
 #include <numeric>
 #include <set>
+#include <system_error>
 #include <thread>
 #include <tuple>
 #include <unordered_map>
@@ -1077,13 +1078,16 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 65536 &&
       builtAside > 0) {
     r.meshes.resize(meshes.size());
-    separateBuilder = std::thread([&] {
-      try {
-        for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
-      } catch (...) {
-        separateError = std::current_exception();
-      }
-    });
+    try {
+      separateBuilder = std::thread([&] {
+        try {
+          for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
+        } catch (...) {
+          separateError = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {  // no thread to spare: finishSeparate builds them all
+    }
   }
   struct JoinOnExit {  // also when the merged output throws
     std::thread& thread;
