@@ -1648,7 +1648,7 @@ class HoleFiller {
       twin.front_ = front_;
       twin.local_ = local_;
       twin.meanEdge_ = meanEdge_;
-      std::thread disk([&] {
+      TaskAlongside disk([&] {
         try {
           HoleReport scratch;
           twin.shapeOver(domains[1], modes[0], scratch, made[1], problem[1]);
@@ -1657,7 +1657,7 @@ class HoleFiller {
         }
       });
       shapeOver(domains[0], modes[0], report, made[0], problem[0]);
-      disk.join();
+      disk.wait();
       if (twinError) std::rethrow_exception(twinError);
       times_.fair = fairBefore + msSince(parallelStart) - (times_.triangulate - triangulateBefore);
     } else {
@@ -1850,8 +1850,11 @@ class HoleFiller {
   // Splits, at their midpoints in the domain and in space, the patch's
   // inner edges that the shape `x` made longer than kMaxStretch times their
   // length in the domain and than the boundary's mean edge (longest first,
-  // each triangle once per pass, a few passes), so that the triangles in
-  // space get back about the size the domain gave them; then flips the
+  // each triangle once per pass, a few passes). A half keeps its edge's
+  // stretch, so the pieces are split again until they are no longer than
+  // the boundary's mean edge or the passes run out: where the domain
+  // foreshortened the patch, its triangles in space come down towards the
+  // border's size. Then flips the
   // edges the splits left non-Delaunay in space. `flat` (the flat placement,
   // as far as known) follows. Returns the number of edges split; with any,
   // the patch is renumbered and its rows rebuilt.
@@ -1882,7 +1885,8 @@ class HoleFiller {
       }
       if (stretched.empty()) break;
       std::sort(stretched.begin(), stretched.end(), [](const Edge& p, const Edge& q) {
-        return p.length != q.length ? p.length > q.length : p.first < q.first;
+        if (p.length != q.length) return p.length > q.length;
+        return std::tie(p.first, p.a, p.b) < std::tie(q.first, q.a, q.b);
       });
       std::vector<char> touched(localTriangles_.size(), 0);
       for (const Edge& e : stretched) {
@@ -1914,6 +1918,19 @@ class HoleFiller {
     return splits;
   }
 
+  // Whether local vertices c and d are border vertices joined by an edge of
+  // the mesh (the patch must not add such an edge again: the front avoids
+  // them, and so must a flip).
+  bool isMeshChord(int c, int d) const {
+    if (std::size_t(c) >= n_ || std::size_t(d) >= n_) return false;
+    bool found = false;
+    s_.adjacency->forEach(front_[std::size_t(c)], [&](int f) {
+      for (int corner : s_.triangles[std::size_t(f)])
+        found = found || corner == front_[std::size_t(d)];
+    });
+    return found;
+  }
+
   // Flips the patch's inner edges whose opposite angles at x add up to more
   // than pi (Delaunay in space: rounder triangles, positive cotangent
   // weights), where the flipped pair stays counter-clockwise in the domain
@@ -1940,7 +1957,7 @@ class HoleFiller {
         int j = 0;
         while (t2[j] == a || t2[j] == b) ++j;
         const int d = t2[j];
-        if (c == d || sides.count(edgeKey(c, d))) continue;
+        if (c == d || sides.count(edgeKey(c, d)) || isMeshChord(c, d)) continue;
         if (angleAt(c, a, b) + angleAt(d, b, a) <= M_PI) continue;
         // (a, b, c) + (b, a, d) -> (a, d, c) + (d, b, c).
         if (orient(uv_[a], uv_[d], uv_[c]) <= 0 || orient(uv_[d], uv_[b], uv_[c]) <= 0) continue;
@@ -2783,21 +2800,55 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     // would move with vcglib correcting every face's corner pointers one by
     // one; instead the faces' corners are set afresh, in parallel, from the
     // indices held below.)
+    // The faces' corners are pointers: once the vertex array has moved,
+    // every input face is pointed at its input corners in the new array,
+    // before anything else can fail, so that an error in the reserves or
+    // later leaves the faces as they were.
     const Vertex* before = mesh.vert.data();
-    parallelChunks(
-        2,
-        [&](std::size_t begin, std::size_t end, unsigned) {
-          for (std::size_t part = begin; part < end; ++part)
-            if (part == 0) {
-              mesh.face.reserve(s.triangles.size());
-              fo._handle->data.reserve(s.triangles.size());
-            } else {
-              mesh.vert.reserve(s.points.size());
-              vo._handle->data.reserve(s.points.size());
-            }
-        },
-        1);
-    const bool moved = mesh.vert.data() != before;
+    auto pointFacesAtInputCorners = [&] {
+      Vertex* const first = mesh.vert.data();
+      if (first == before) return;
+      Face* const faces = mesh.face.data();
+      const Triangle* const corners = s.triangles.data();
+      auto repoint = [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f) {
+          const Triangle& t = corners[f];
+          Face& face = faces[f];
+          face.V(0) = first + t[0];
+          face.V(1) = first + t[1];
+          face.V(2) = first + t[2];
+        }
+      };
+      try {
+        parallelChunks(s.inputFaces,
+                       [&](std::size_t begin, std::size_t end, unsigned) { repoint(begin, end); });
+      } catch (...) {  // no memory for the workers' bookkeeping: the plain loop cannot fail
+        repoint(0, s.inputFaces);
+      }
+      // Faces a split changed keep their input corners until the new vertices exist.
+      for (const auto& [f, input] : s.inputCorners)
+        for (int k = 0; k < 3; ++k) faces[f].V(k) = first + input[k];
+      before = first;
+    };
+    try {
+      parallelChunks(
+          2,
+          [&](std::size_t begin, std::size_t end, unsigned) {
+            for (std::size_t part = begin; part < end; ++part)
+              if (part == 0) {
+                mesh.face.reserve(s.triangles.size());
+                fo._handle->data.reserve(s.triangles.size());
+              } else {
+                mesh.vert.reserve(s.points.size());
+                vo._handle->data.reserve(s.points.size());
+              }
+          },
+          1);
+    } catch (...) {
+      pointFacesAtInputCorners();
+      throw;
+    }
+    pointFacesAtInputCorners();
     if (newVertices > 0) {
       auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, newVertices);
       for (std::size_t v = s.inputVertices; v < s.points.size(); ++v, ++vi) {
@@ -2844,23 +2895,10 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
         if (border[i] >= 0 && inPatch(int(s.inputVertices + i)))
           vo[s.inputVertices + i] = vo[border[i]];
     }
-    if (moved) {
-      Vertex* first = mesh.vert.data();
-      Face* const faces = mesh.face.data();
-      const Triangle* const corners = s.triangles.data();
-      parallelChunks(s.inputFaces, [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t f = begin; f < end; ++f) {
-          const Triangle& t = corners[f];
-          Face& face = faces[f];
-          face.V(0) = first + t[0];
-          face.V(1) = first + t[1];
-          face.V(2) = first + t[2];
-        }
-      });
-    } else {
-      for (const auto& [f, corners] : s.inputCorners)
-        for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
-    }
+    // The faces a split changed take their new corners (the vertex array
+    // no longer moves: it was reserved above).
+    for (const auto& [f, corners] : s.inputCorners)
+      for (int k = 0; k < 3; ++k) mesh.face[f].V(k) = &mesh.vert[s.triangles[f][k]];
     if (newFaces > 0) {
       auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, newFaces);
       for (std::size_t f = s.inputFaces; f < s.triangles.size(); ++f, ++fi) {
