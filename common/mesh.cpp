@@ -72,7 +72,8 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
     for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[triangles[f][k]];
 
   VertexOriginHandle vo = vertexOrigins(mesh);
-  for (std::size_t i = 0; i < mesh.vert.size(); ++i) vo[i] = VertexOrigin{layer, int(i), -1, {}};
+  for (std::size_t i = 0; i < mesh.vert.size(); ++i)
+    vo[i] = VertexOrigin{layer, int(i), -1, {0, 0, 0}};
   FaceOriginHandle fo = faceOrigins(mesh);
   for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
 }

@@ -486,7 +486,7 @@ Mesh extractPatches(const Mesh& mesh, const Patches& patches, const std::vector<
   FaceOriginHandle inFace = faceOrigins(source);
   for (std::size_t v = 0; v < out.vert.size(); ++v) {
     const int input = birthVertex[welded.vertex_origin[v]];
-    vo[v] = hasOrigins ? inVertex[input] : VertexOrigin{0, input, -1, {}};
+    vo[v] = hasOrigins ? inVertex[input] : VertexOrigin{0, input, -1, {0, 0, 0}};
   }
   for (std::size_t f = 0; f < out.face.size(); ++f) {
     const int input = birthFace[welded.face_origin[f]];
