@@ -1832,6 +1832,13 @@ class HoleFiller {
     return mode == HoleFairing::Biharmonic || mode == HoleFairing::LaplacianRegression;
   }
 
+  // The corner k of `t` whose edge to corner k + 1 has `key` (t has that edge).
+  static int cornerBefore(const Triangle& t, std::uint64_t key) {
+    int k = 0;
+    while (edgeKey(t[k], t[(k + 1) % 3]) != key) ++k;
+    return k;
+  }
+
   // The patch's inner edges (local key) and the two triangles on each.
   std::unordered_map<std::uint64_t, std::pair<int, int>> innerEdgeSides() const {
     std::unordered_map<std::uint64_t, std::pair<int, int>> sides;
@@ -1878,8 +1885,7 @@ class HoleFiller {
       std::vector<Edge> stretched;
       for (const auto& [key, side] : innerEdgeSides()) {
         const Triangle& t = localTriangles_[std::size_t(side.first)];
-        int k = 0;
-        while (edgeKey(t[k], t[(k + 1) % 3]) != key) ++k;
+        const int k = cornerBefore(t, key);
         const int a = t[k], b = t[(k + 1) % 3];
         if (isStretched(a, b, length)) stretched.push_back({length, side.first, side.second, a, b});
       }
@@ -1901,8 +1907,7 @@ class HoleFiller {
         // m lies on the edge in the domain, so both halves keep their orientation.
         for (const int t : {e.first, e.second}) {
           Triangle& tri = localTriangles_[std::size_t(t)];
-          int k = 0;
-          while (edgeKey(tri[k], tri[(k + 1) % 3]) != edgeKey(e.a, e.b)) ++k;
+          const int k = cornerBefore(tri, edgeKey(e.a, e.b));
           const int from = tri[k], to = tri[(k + 1) % 3], apex = tri[(k + 2) % 3];
           tri = {from, m, apex};
           localTriangles_.push_back({m, to, apex});
@@ -1951,8 +1956,7 @@ class HoleFiller {
         if (touched[std::size_t(side.first)] || touched[std::size_t(side.second)]) continue;
         Triangle& t1 = localTriangles_[std::size_t(side.first)];
         Triangle& t2 = localTriangles_[std::size_t(side.second)];
-        int k = 0;
-        while (edgeKey(t1[k], t1[(k + 1) % 3]) != key) ++k;
+        const int k = cornerBefore(t1, key);
         const int a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
         int j = 0;
         while (t2[j] == a || t2[j] == b) ++j;
