@@ -12,8 +12,11 @@
 namespace meshmend {
 
 // Number of worker threads used by parallelChunks (at least 1).
+// hardware_concurrency reads /sys on every call (two file opens), which
+// costs more than a small job's work: asked once.
 inline unsigned workerCount() {
-  return std::max(1u, std::thread::hardware_concurrency());
+  static const unsigned count = std::max(1u, std::thread::hardware_concurrency());
+  return count;
 }
 
 // Splits [0, n) into one contiguous chunk per worker and calls

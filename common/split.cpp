@@ -47,6 +47,22 @@ Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Poin
   return {wa, wb, 1 - wa - wb};
 }
 
+// A measure that grows with the smallest angle of triangle (a, b, c): the
+// squared sine of the angle opposite the shortest side (at most 60°, where
+// the sine still grows), 0 when degenerate. Cheaper than the angle.
+double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
+  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
+  const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
+  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
+  return others > 0 ? cross / others : 0;
+}
+
+// Has the triangle an angle under 1°?
+bool isSliver(const Point3& a, const Point3& b, const Point3& c) {
+  static const double below = std::pow(std::sin(M_PI / 180), 2);
+  return smallestAngleMeasure(a, b, c) < below;
+}
+
 // An input edge: mesh and its two vertices, smaller first.
 struct EdgeRef {
   std::uint32_t mesh, u, v;
@@ -63,24 +79,31 @@ EdgeRef edgeRef(std::uint32_t mesh, int a, int b) {
 // exactly (degenerate inputs) are merged afterwards.
 class CurvePoints {
  public:
+  explicit CurvePoints(std::size_t expected) {
+    points_.reserve(expected);
+    names_.reserve(expected);
+    std::size_t slots = 64;  // a power of two, at least twice the points
+    while (slots < 2 * expected) slots *= 2;
+    slots_.assign(slots, -1);
+  }
+
   // The id of the point `tag` of the pair's contact (its ExactPoint `point`).
   int add(const ContactPoint& tag, const ExactPoint& point, const FaceRef faces[2],
           const std::vector<const std::vector<Triangle>*>& triangles) {
     const FaceRef& own = faces[tag.triangle];
     const Triangle& t = (*triangles[own.mesh])[own.face];
-    Key key{};
-    std::vector<EdgeRef> edges;
-    std::int64_t vertex = -1;
+    Name name;
     switch (tag.kind) {
       case ContactPoint::Kind::kVertex:
-        key = {0, own.mesh, std::uint32_t(t[tag.index]), 0, 0, 0, 0};
-        vertex = t[tag.index];
+        name.key = {0, own.mesh, std::uint32_t(t[tag.index]), 0, 0, 0, 0};
+        name.vertex_mesh = own.mesh;
+        name.vertex = t[tag.index];
         break;
       case ContactPoint::Kind::kEdgeFace: {
         const FaceRef& other = faces[1 - tag.triangle];
         const EdgeRef e = edgeRef(own.mesh, t[tag.index], t[(tag.index + 1) % 3]);
-        key = {1, e.mesh, e.u, e.v, other.mesh, other.face, 0};
-        edges.push_back(e);
+        name.key = {1, e.mesh, e.u, e.v, other.mesh, other.face, 0};
+        name.edges[name.edge_count++] = e;
         break;
       }
       case ContactPoint::Kind::kEdgeEdge: {
@@ -88,63 +111,87 @@ class CurvePoints {
         EdgeRef e = edgeRef(faces[0].mesh, t[tag.index], t[(tag.index + 1) % 3]);
         EdgeRef g = edgeRef(faces[1].mesh, tb[tag.other_index], tb[(tag.other_index + 1) % 3]);
         if (std::tie(g.mesh, g.u, g.v) < std::tie(e.mesh, e.u, e.v)) std::swap(e, g);
-        key = {2, e.mesh, e.u, e.v, g.mesh, g.u, g.v};
-        edges = {e, g};
+        name.key = {2, e.mesh, e.u, e.v, g.mesh, g.u, g.v};
+        name.edges[name.edge_count++] = e;
+        name.edges[name.edge_count++] = g;
         break;
       }
     }
-    const auto [it, added] = ids_.emplace(key, int(points_.size()));
-    if (added) {
-      points_.push_back(point);
-      edges_.push_back(edges);
-      vertexOf_.push_back(vertex >= 0 ? std::pair<std::uint32_t, std::int64_t>{own.mesh, vertex}
-                                      : std::pair<std::uint32_t, std::int64_t>{0, -1});
-    }
-    return it->second;
+    // Open addressing (linear probing): one lookup per contact point, no
+    // allocation per point.
+    std::size_t slot = hash(name.key) & (slots_.size() - 1);
+    for (; slots_[slot] >= 0; slot = (slot + 1) & (slots_.size() - 1))
+      if (names_[slots_[slot]].key == name.key) return slots_[slot];
+    slots_[slot] = int(points_.size());
+    points_.push_back(point);
+    names_.push_back(name);
+    if (2 * points_.size() > slots_.size()) rehash();
+    return int(points_.size()) - 1;
   }
 
-  // Merges exactly coincident points; afterwards representative(id) names each.
+  // Merges exactly coincident points; afterwards representative(id) names
+  // each, and each representative lists its group (next_).
   void mergeCoincident() {
     std::vector<const ExactPoint*> all;
+    all.reserve(points_.size());
     for (const ExactPoint& p : points_) all.push_back(&p);
     representative_ = coincidentGroups(all);
+    next_.assign(points_.size(), -1);
     for (std::size_t i = 0; i < points_.size(); ++i) {
       const int r = representative_[i];
       if (r == int(i)) continue;
-      edges_[r].insert(edges_[r].end(), edges_[i].begin(), edges_[i].end());
+      next_[i] = next_[r];  // the group after r: the later points first
+      next_[r] = int(i);
     }
-    for (std::size_t i = 0; i < points_.size(); ++i)
-      if (vertexOf_[i].second >= 0)
-        inputVertex_[std::pair<std::uint32_t, int>(vertexOf_[i].first, representative_[i])] =
-            int(vertexOf_[i].second);
   }
 
   int representative(int id) const { return representative_[id]; }
   const ExactPoint& point(int id) const { return points_[id]; }
   std::size_t size() const { return points_.size(); }
-  // Input edges the point is known to lie on (from its names).
-  const std::vector<EdgeRef>& knownEdges(int id) const { return edges_[id]; }
-  // The input vertex of `mesh` at this point, or -1.
+  // Is the point (a representative) known to lie on input edge e (from the
+  // names of its group)?
+  bool knownOnEdge(int id, const EdgeRef& e) const {
+    for (int q = id; q >= 0; q = next_[q])
+      for (int k = 0; k < names_[q].edge_count; ++k)
+        if (names_[q].edges[k] == e) return true;
+    return false;
+  }
+  // The input vertex of `mesh` at this point (a representative), or -1;
+  // of two coincident ones (duplicates left unwelded), the later.
   int inputVertex(std::uint32_t mesh, int id) const {
-    const auto it = inputVertex_.find({mesh, id});
-    return it == inputVertex_.end() ? -1 : it->second;
+    for (int q = next_[id]; q >= 0; q = next_[q])
+      if (names_[q].vertex >= 0 && names_[q].vertex_mesh == mesh) return names_[q].vertex;
+    return names_[id].vertex >= 0 && names_[id].vertex_mesh == mesh ? names_[id].vertex : -1;
   }
 
  private:
   using Key = std::array<std::uint32_t, 7>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      std::size_t h = 0;
-      for (std::uint32_t x : k) h = h * 0x9E3779B97F4A7C15ull + x;
-      return h ^ (h >> 29);
-    }
+  struct Name {
+    Key key{};
+    std::array<EdgeRef, 2> edges{};  // input edges the point lies on
+    int edge_count = 0;
+    std::uint32_t vertex_mesh = 0;
+    int vertex = -1;  // the input vertex it is, or -1
   };
-  std::unordered_map<Key, int, KeyHash> ids_;
+  static std::size_t hash(const Key& k) {
+    std::size_t h = 0;
+    for (std::uint32_t x : k) h = h * 0x9E3779B97F4A7C15ull + x;
+    return h ^ (h >> 29);
+  }
+  void rehash() {
+    slots_.assign(2 * slots_.size(), -1);
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+      std::size_t slot = hash(names_[i].key) & (slots_.size() - 1);
+      while (slots_[slot] >= 0) slot = (slot + 1) & (slots_.size() - 1);
+      slots_[slot] = int(i);
+    }
+  }
+
   std::vector<ExactPoint> points_;
-  std::vector<std::vector<EdgeRef>> edges_;
-  std::vector<std::pair<std::uint32_t, std::int64_t>> vertexOf_;
+  std::vector<Name> names_;
+  std::vector<int> slots_;  // hash table: point index or -1
   std::vector<int> representative_;
-  std::map<std::pair<std::uint32_t, int>, int> inputVertex_;
+  std::vector<int> next_;  // the next point of the same group, or -1
 };
 
 // An output mesh as arrays, with the provenance of every element.
@@ -181,6 +228,33 @@ struct FaceWork {
   }
 };
 
+// The work of the faces that receive points, in the order they first do,
+// found by face index: a slot per face of the mesh, as a hash map's node
+// per face would cost more.
+class FaceWorkTable {
+ public:
+  using Entry = std::pair<std::uint32_t, FaceWork>;
+  explicit FaceWorkTable(std::size_t faces) : slot_(faces, -1) {}
+  FaceWork& operator[](std::uint32_t f) {  // added when missing
+    int& slot = slot_[f];
+    if (slot < 0) {
+      slot = int(entries_.size());
+      entries_.emplace_back(f, FaceWork{});
+    }
+    return entries_[slot].second;
+  }
+  const FaceWork& at(std::uint32_t f) const { return entries_[slot_[f]].second; }
+  std::size_t size() const { return entries_.size(); }
+  std::vector<Entry>::iterator begin() { return entries_.begin(); }
+  std::vector<Entry>::iterator end() { return entries_.end(); }
+  std::vector<Entry>::const_iterator begin() const { return entries_.begin(); }
+  std::vector<Entry>::const_iterator end() const { return entries_.end(); }
+
+ private:
+  std::vector<int> slot_;  // per face: its entry, or -1
+  std::vector<Entry> entries_;
+};
+
 class MeshSplitter {
  public:
   MeshSplitter(WeldedArrays&& input, std::uint32_t index)
@@ -188,7 +262,8 @@ class MeshSplitter {
         points_(std::move(input.mesh.points)),
         triangles_(std::move(input.mesh.triangles)),
         vertexOrigin_(std::move(input.vertex_origin)),
-        faceOrigin_(std::move(input.face_origin)) {}
+        faceOrigin_(std::move(input.face_origin)),
+        work_(triangles_.size()) {}
 
   const std::vector<Triangle>& triangles() const { return triangles_; }
 
@@ -197,15 +272,19 @@ class MeshSplitter {
   }
 
   // The contact of a pair (curve point ids), seen from this mesh's face f.
-  void addContact(std::uint32_t f, const std::vector<int>& contact) {
+  void addContact(std::uint32_t f, const int* contact, std::size_t n) {
     FaceWork& w = work_[f];
-    std::vector<int> ids;
-    for (int p : contact) ids.push_back(w.add(p));
-    if (ids.size() == 2 && ids[0] != ids[1]) w.segments.push_back({ids[0], ids[1]});
-    if (ids.size() > 2)
-      for (std::size_t i = 0; i < ids.size(); ++i)
-        if (ids[i] != ids[(i + 1) % ids.size()])
-          w.segments.push_back({ids[i], ids[(i + 1) % ids.size()]});
+    if (w.points.empty()) {  // room for a typical face's points without growing
+      w.points.reserve(4);
+      w.edges.reserve(4);
+      w.segments.reserve(4);
+    }
+    int ids[6];  // a contact has at most six points (two coplanar triangles' overlap)
+    for (std::size_t i = 0; i < n; ++i) ids[i] = w.add(contact[i]);
+    if (n == 2 && ids[0] != ids[1]) w.segments.push_back({ids[0], ids[1]});
+    if (n > 2)
+      for (std::size_t i = 0; i < n; ++i)
+        if (ids[i] != ids[(i + 1) % n]) w.segments.push_back({ids[i], ids[(i + 1) % n]});
   }
 
   // Points on an edge of a face also split that edge in the faces across it.
@@ -307,7 +386,8 @@ class MeshSplitter {
       origins[v] = {int(index_), vertexOrigin_[v], -1, Point3(0, 0, 0)};  // (vcg leaves {} unset)
     triangles.reserve(triangles_.size() + 8 * work_.size());
     birthFaces.reserve(triangles.capacity());
-    std::unordered_map<int, int> vertexOfPoint;              // curve point id -> output vertex
+    std::vector<int> vertexOfPoint(table.size(), -1);        // curve point id -> output vertex
+    std::vector<std::array<int, 2>> pointOfVertex;           // (output vertex, curve point id)
     std::map<RationalPoint, int, ExactLess> crossingPoints;  // made inside one face
     auto newVertex = [&](const ExactPoint& p, std::uint32_t f) {
       positions.push_back(p.approx());
@@ -332,7 +412,9 @@ class MeshSplitter {
         birthFaces[k] = {int(index_), faceOrigin_[f]};
         ++k;
       }
-    std::set<std::array<int, 2>> curveSet;
+    curves.clear();
+    std::array<Point3, 3> smallestFace;  // the new face with the smallest angle
+    double smallestSine = 2;             // its measure (smallestAngleMeasure)
     for (std::size_t i = 0; i < order_.size(); ++i) {
       const std::uint32_t f = order_[i];
       const Patch& patch = patches_[i];
@@ -347,14 +429,14 @@ class MeshSplitter {
         const int v = patch.vertex_of_input[3 + j];
         const int id = ids[j];
         if (global[v] < 0) {
-          const auto [it, added] = vertexOfPoint.emplace(id, -1);
-          if (added) {
+          int& vertex = vertexOfPoint[id];
+          if (vertex < 0) {
             const int input = table.inputVertex(index_, id);
-            it->second = input >= 0 ? input : newVertex(table.point(id), f);
+            vertex = input >= 0 ? input : newVertex(table.point(id), f);
           }
-          global[v] = it->second;
+          global[v] = vertex;
         }
-        pointOfVertex_[global[v]] = id;
+        pointOfVertex.push_back({global[v], id});
       }
       for (std::size_t v = 3; v < patch.vertices.size(); ++v) {
         if (global[v] >= 0) continue;
@@ -367,20 +449,24 @@ class MeshSplitter {
       for (std::size_t j = 3; j < patch.vertex_of_input.size(); ++j)
         contactVertices_.push_back(global[patch.vertex_of_input[j]]);
       for (const auto& t : patch.triangles) {
-        smallestAngle_ =
-            std::min(smallestAngle_, meshmend::smallestAngle(patch.vertices[t[0]].approx(),
-                                                             patch.vertices[t[1]].approx(),
-                                                             patch.vertices[t[2]].approx()));
+        const Point3 &a = patch.vertices[t[0]].approx(), &b = patch.vertices[t[1]].approx(),
+                     &c = patch.vertices[t[2]].approx();
+        const double sine = smallestAngleMeasure(a, b, c);
+        if (sine < smallestSine) smallestSine = sine, smallestFace = {a, b, c};
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
         birthFaces.push_back({int(index_), faceOrigin_[f]});
       }
-      for (const auto& e : patch.constrained_edges) {
-        std::array<int, 2> g{global[e[0]], global[e[1]]};
-        if (g[0] > g[1]) std::swap(g[0], g[1]);
-        curveSet.insert(g);
-      }
+      for (const auto& e : patch.constrained_edges)
+        curves.push_back(
+            {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
-    curves.assign(curveSet.begin(), curveSet.end());
+    std::sort(curves.begin(), curves.end());
+    curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
+    if (smallestSine < 2)  // one angle computed, not one per face
+      smallestAngle_ = meshmend::smallestAngle(smallestFace[0], smallestFace[1], smallestFace[2]);
+    // Later entries win, as each curve point is met again in every face it is in.
+    pointOfVertex_.assign(positions.size(), -1);
+    for (const auto& [vertex, id] : pointOfVertex) pointOfVertex_[vertex] = id;
     facesAdded += triangles.size() - triangles_.size();
   }
 
@@ -388,17 +474,15 @@ class MeshSplitter {
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
   const std::vector<int>& contactVertices() const { return contactVertices_; }
-  // Output vertices at curve points: the point's id.
-  const std::unordered_map<int, int>& pointOfVertex() const { return pointOfVertex_; }
+  // Per output vertex: the curve point id at it, or -1.
+  const std::vector<int>& pointOfVertex() const { return pointOfVertex_; }
   std::size_t degenerateKept() const { return degenerateKept_; }
   const std::vector<Point3>& points() const { return points_; }
 
  private:
   // Is curve point `id` on the input edge (a, b) of this mesh?
   bool onEdge(const CurvePoints& table, int id, int a, int b) const {
-    const EdgeRef e = edgeRef(index_, a, b);
-    for (const EdgeRef& known : table.knownEdges(id))
-      if (known == e) return true;
+    if (table.knownOnEdge(id, edgeRef(index_, a, b))) return true;
     const ExactPoint& p = table.point(id);
     if (p.isInputPoint() && (p.approx() == points_[a] || p.approx() == points_[b]))
       return false;  // a corner: not inside the edge
@@ -409,14 +493,14 @@ class MeshSplitter {
   std::vector<Point3> points_;
   std::vector<Triangle> triangles_;
   std::vector<int> vertexOrigin_, faceOrigin_;  // input index of each vertex and face
-  std::unordered_map<std::uint32_t, FaceWork> work_;
+  FaceWorkTable work_;
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
   std::size_t keptFaces_ = 0;
   double smallestAngle_ = M_PI;
   std::vector<int> contactVertices_;  // output vertices at contact points
-  std::unordered_map<int, int> pointOfVertex_;
+  std::vector<int> pointOfVertex_;
 };
 
 // Quality snapping (intersection paper §2.7). A curve point that lands very
@@ -1030,20 +1114,26 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     splitters.emplace_back(std::move(inputs[m]), std::uint32_t(m));
   std::vector<const std::vector<Triangle>*> triangles;
   for (const MeshSplitter& s : splitters) triangles.push_back(&s.triangles());
-  CurvePoints table;
-  std::vector<std::vector<int>> contactIds(found.pairs.size());
+  CurvePoints table(2 * found.pairs.size());
+  // Each pair's contact as curve point ids, all pairs in one array.
+  std::vector<int> contactIds;
+  std::vector<std::size_t> contactStart(found.pairs.size() + 1, 0);
+  contactIds.reserve(2 * found.pairs.size());
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
     const FaceRef faces[2] = {found.pairs[i].a, found.pairs[i].b};
     const TriangleContact& c = found.contacts[i];
+    if (c.points.size() > 6) throw std::logic_error("a contact of more than six points");
     for (std::size_t k = 0; k < c.points.size(); ++k)
-      contactIds[i].push_back(table.add(c.points[k], c.exact[k], faces, triangles));
+      contactIds.push_back(table.add(c.points[k], c.exact[k], faces, triangles));
+    contactStart[i + 1] = contactIds.size();
   }
   table.mergeCoincident();
+  for (int& id : contactIds) id = table.representative(id);
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
-    std::vector<int>& ids = contactIds[i];
-    for (int& id : ids) id = table.representative(id);
-    splitters[found.pairs[i].a.mesh].addContact(found.pairs[i].a.face, ids);
-    splitters[found.pairs[i].b.mesh].addContact(found.pairs[i].b.face, ids);
+    const int* ids = contactIds.data() + contactStart[i];
+    const std::size_t n = contactStart[i + 1] - contactStart[i];
+    splitters[found.pairs[i].a.mesh].addContact(found.pairs[i].a.face, ids, n);
+    splitters[found.pairs[i].b.mesh].addContact(found.pairs[i].b.face, ids, n);
   }
   reportProgress(options.progress, 55, "Re-triangulating crossed faces");
   std::vector<std::vector<ExactPoint>> exactNew(meshes.size());
@@ -1112,7 +1202,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     // those at one curve point by its id, the others (crossings of two
     // curves inside a face) by comparing exactly.
     std::vector<ExactPoint> curvePoints;  // one per curve point id used, then the others
-    std::unordered_map<int, int> curvePointOfId;
+    std::vector<int> curvePointOfId(table.size(), -1);
+    std::size_t crossings = 0;  // curve vertices not at a curve point (made inside one face)
     std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const OutputArrays& mesh = outputs[m];
@@ -1121,13 +1212,17 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       const auto& pointOfVertex = splitters[m].pointOfVertex();
       auto mark = [&](int v) {
         if (index[v] >= 0) return;
-        const auto known = pointOfVertex.find(v);
-        if (known != pointOfVertex.end()) {
-          const auto [it, added] = curvePointOfId.emplace(known->second, int(curvePoints.size()));
-          if (added) curvePoints.push_back(table.point(known->second));
-          index[v] = it->second;
+        const int id = pointOfVertex[v];
+        if (id >= 0) {
+          int& point = curvePointOfId[id];
+          if (point < 0) {
+            point = int(curvePoints.size());
+            curvePoints.push_back(table.point(id));
+          }
+          index[v] = point;
           return;
         }
+        ++crossings;
         index[v] = int(curvePoints.size());
         const std::size_t inputVertices = splitters[m].points().size();
         curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.positions[v])
@@ -1138,7 +1233,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     }
     std::vector<const ExactPoint*> curvePointers;
     for (const ExactPoint& p : curvePoints) curvePointers.push_back(&p);
-    const std::vector<int> weldedTo = coincidentGroups(curvePointers);
+    // Distinct curve points never coincide (the table merged those): only
+    // points made inside a face can coincide with another.
+    std::vector<int> weldedTo(curvePoints.size());
+    if (crossings > 0)
+      weldedTo = coincidentGroups(curvePointers);
+    else
+      std::iota(weldedTo.begin(), weldedTo.end(), 0);
     r.smallest_new_angle_deg_unsnapped = r.smallest_new_angle_deg;
     if (!mergedArrays) {
       // Only what the merged output would tell: its slivers (the new faces
@@ -1149,21 +1250,21 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         const OutputArrays& mesh = outputs[m];
         for (std::size_t f = splitters[m].keptFaces(); f < mesh.triangles.size(); ++f) {
           const Triangle& t = mesh.triangles[f];
-          slivers += meshmend::smallestAngle(mesh.positions[t[0]], mesh.positions[t[1]],
-                                             mesh.positions[t[2]]) < M_PI / 180;
+          slivers += isSliver(mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
         }
       }
       r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers;
-      std::set<std::array<int, 2>> curves;
+      std::vector<std::array<int, 2>> curves;
       for (std::size_t m = 0; m < meshes.size(); ++m)
         for (const auto& e : r.curve_edges[m]) {
-          std::array<int, 2> g{weldedTo[curveIndex[m][e[0]]], weldedTo[curveIndex[m][e[1]]]};
-          if (g[0] > g[1]) std::swap(g[0], g[1]);
-          curves.insert(g);
+          const int a = weldedTo[curveIndex[m][e[0]]], b = weldedTo[curveIndex[m][e[1]]];
+          curves.push_back({std::min(a, b), std::max(a, b)});
         }
+      std::sort(curves.begin(), curves.end());
+      curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
       finishSeparate();
       r.curve_edges_welded = curves.size();
-      countCurves(curvePoints.size(), {curves.begin(), curves.end()}, r.curve_loops, r.open_curves);
+      countCurves(curvePoints.size(), curves, r.curve_loops, r.open_curves);
       if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});
       reportProgress(options.progress, 100, "Done");
       r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -1218,8 +1319,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
         const Triangle& t = merged.triangles[f];
         n += r.merged_new_face[f] &&
-             meshmend::smallestAngle(merged.positions[t[0]], merged.positions[t[1]],
-                                     merged.positions[t[2]]) < M_PI / 180;
+             isSliver(merged.positions[t[0]], merged.positions[t[1]], merged.positions[t[2]]);
       }
       return n;
     };
