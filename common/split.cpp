@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -61,6 +62,29 @@ double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
 bool isSliver(const Point3& a, const Point3& b, const Point3& c) {
   static const double below = std::pow(std::sin(M_PI / 180), 2);
   return smallestAngleMeasure(a, b, c) < below;
+}
+
+// Is p certainly off the line through a and b, by its rounded value and
+// error bound? A component of (p - a) x (b - a) is then non-zero: its value
+// at the rounded point, less the rounding error of evaluating it and the
+// most p's error can change it. False when that does not settle it.
+bool visiblyOffLine(const ExactPoint& p, const Point3& a, const Point3& b) {
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon() / 2;
+  const Point3 &q = p.approx(), d = b - a, r = q - a;
+  const double e = p.error();
+  for (int k = 0; k < 3; ++k) {
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    const double left = r[u] * d[v], right = r[v] * d[u];
+    const double sum = std::fabs(left) + std::fabs(right);
+    if (!(sum > 1e-250) || !std::isfinite(sum)) continue;  // underflow or overflow: no bound
+    // Each difference and product rounds once, the subtraction once more
+    // (a relative 4 ε of the sum covers them); p's error moves the value by
+    // at most e (|d_u| + |d_v|), itself within a relative ε of its rounded form.
+    const double bound =
+        (4 * kEpsilon * sum + e * (std::fabs(d[u]) + std::fabs(d[v]))) * (1 + 8 * kEpsilon);
+    if (std::fabs(left - right) > bound) return true;
+  }
+  return false;
 }
 
 // An input edge: mesh and its two vertices, smaller first.
@@ -413,6 +437,8 @@ class MeshSplitter {
         ++k;
       }
     curves.clear();
+    std::vector<int> global;  // per patch vertex: its output vertex
+    exactNew.reserve(exactNew.size() + 2 * order_.size());
     std::array<Point3, 3> smallestFace;  // the new face with the smallest angle
     double smallestSine = 2;             // its measure (smallestAngleMeasure)
     for (std::size_t i = 0; i < order_.size(); ++i) {
@@ -423,7 +449,7 @@ class MeshSplitter {
         continue;
       }
       const std::vector<int>& ids = work_.at(f).points;
-      std::vector<int> global(patch.vertices.size(), -1);
+      global.assign(patch.vertices.size(), -1);
       for (int k = 0; k < 3; ++k) global[k] = triangles_[f][k];
       for (std::size_t j = 0; j < ids.size(); ++j) {
         const int v = patch.vertex_of_input[3 + j];
@@ -485,7 +511,8 @@ class MeshSplitter {
     if (table.knownOnEdge(id, edgeRef(index_, a, b))) return true;
     const ExactPoint& p = table.point(id);
     if (p.isInputPoint() && (p.approx() == points_[a] || p.approx() == points_[b]))
-      return false;  // a corner: not inside the edge
+      return false;                                               // a corner: not inside the edge
+    if (visiblyOffLine(p, points_[a], points_[b])) return false;  // most points, cheaply
     return onSegment(p, ExactPoint(points_[a]), ExactPoint(points_[b]));
   }
 
