@@ -1310,7 +1310,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       merged.face_origin.reserve(faces);
       r.merged_new_face.reserve(faces);
     }
-    std::set<std::array<int, 2>> curves;
+    std::vector<std::array<int, 2>>& curves = r.merged_curve_edges;  // sorted, each once
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const OutputArrays& mesh = outputs[m];
       std::vector<int>& global = r.merged_vertex.emplace_back(mesh.positions.size());
@@ -1334,12 +1334,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         merged.face_origin.push_back(mesh.face_origin[f]);
         r.merged_new_face.push_back(f >= splitters[m].keptFaces());
       }
-      for (const auto& e : r.curve_edges[m]) {
-        std::array<int, 2> g{global[e[0]], global[e[1]]};
-        if (g[0] > g[1]) std::swap(g[0], g[1]);
-        curves.insert(g);
-      }
+      for (const auto& e : r.curve_edges[m])
+        curves.push_back(
+            {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
+    std::sort(curves.begin(), curves.end());
+    curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
     // The quality of the new faces: their smallest angle, and the slivers.
     auto slivers = [&] {
       std::size_t n = 0;
@@ -1353,15 +1353,17 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers();
     if (options.snap_tolerance > 0 && r.faces_split > 0) {
       reportProgress(options.progress, 95, "Snapping curve points");
-      const std::size_t facesBefore = merged.triangles.size();  // edge snaps add faces
-      CurveSnapper snapper(merged, curves, r.merged_new_face, options.snap_tolerance);
+      const std::size_t facesBefore = merged.triangles.size();              // edge snaps add faces
+      std::set<std::array<int, 2>> curveSet(curves.begin(), curves.end());  // snapping edits it
+      CurveSnapper snapper(merged, curveSet, r.merged_new_face, options.snap_tolerance);
       r.vertices_snapped = snapper.snapVertices();
       r.edges_snapped = snapper.snapEdges();
       const std::vector<int> snappedTo = snapper.snappedTo();
       std::vector<int> index;
       snapper.compact(merged, index);
       if (options.separate_meshes) {
-        rebuildSeparate(merged, index, snappedTo, curves, outputs, r.merged_vertex, r.curve_edges);
+        rebuildSeparate(merged, index, snappedTo, curveSet, outputs, r.merged_vertex,
+                        r.curve_edges);
       } else {
         // No per-mesh outputs to rebuild: only where each input vertex went.
         for (std::vector<int>& global : r.merged_vertex)
@@ -1379,10 +1381,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         }
       r.smallest_new_angle_deg = smallest * 180 / M_PI;
       r.new_faces_below_1deg = slivers();
+      curves.assign(curveSet.begin(), curveSet.end());
     }
     if (options.merged_output) merged.toMesh(r.merged);
     finishSeparate();
-    r.merged_curve_edges.assign(curves.begin(), curves.end());
     if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});  // they go with `meshes`
     r.curve_edges_welded = curves.size();
     countCurves(positions.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
