@@ -1183,16 +1183,18 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // from them), so it needs them even when the merged mesh is not asked for.
   const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
-  // Without snapping, each input's output is final here: on a large input
-  // vcglib meshes are built on a second thread while the merged one is made
-  // (without it, while the last input's is built here).
+  // Without snapping, each input's output is final here: vcglib meshes are
+  // built on a second thread while the merged one is made (without it,
+  // while the curves are counted and the last input's is built here), once
+  // there are enough faces to pay for starting a thread (a few thousand
+  // faces take a few hundred microseconds; a thread start, tens).
   std::size_t outputFaces = 0;
   for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
   const std::size_t builtAside =
       mergedArrays ? meshes.size() : meshes.size() - 1;  // separate meshes the thread builds
   std::thread separateBuilder;
   std::exception_ptr separateError;
-  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 65536 &&
+  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096 &&
       builtAside > 0) {
     r.meshes.resize(meshes.size());
     try {
