@@ -5,7 +5,6 @@
 #include <cmath>
 #include <numeric>
 
-#include "common/box_tree.h"
 #include "common/interval.h"
 #include "common/predicates.h"
 
@@ -308,33 +307,51 @@ int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint
 }
 
 std::vector<int> coincidentGroups(const std::vector<const ExactPoint*>& points) {
-  std::vector<int> parent(points.size());
+  const std::size_t n = points.size();
+  std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
-  if (points.size() < 2) return parent;
-  std::vector<Box> boxes(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  if (n < 2) return parent;
+  // Each point's box of possible positions, and that box's extent along a
+  // direction across every coordinate plane (axis-aligned inputs put many
+  // points on one coordinate, hardly any on one plane across it): points
+  // that coincide have overlapping extents, so a sweep over the extents in
+  // order compares each point with the few whose extents overlap its own.
+  constexpr double kDirection[3] = {1.0, 0.6180339887498949, 0.3819660112501051};
+  std::vector<Point3> lo(n), hi(n);
+  std::vector<double> low(n), high(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const Point3& a = points[i]->approx();
     const double e = points[i]->error();
-    const Point3 lo(down(a[0] - e), down(a[1] - e), down(a[2] - e));
-    const Point3 hi(up(a[0] + e), up(a[1] + e), up(a[2] + e));
-    boxes[i] = boxOf(lo, hi, hi);
+    double l = 0, h = 0;
+    for (int k = 0; k < 3; ++k) {
+      lo[i][k] = down(a[k] - e);
+      hi[i][k] = up(a[k] + e);
+      l = down(l + down(kDirection[k] * lo[i][k]));  // all weights positive: low corner, low end
+      h = up(h + up(kDirection[k] * hi[i][k]));
+    }
+    low[i] = l;
+    high[i] = h;
   }
-  const BoxTree tree(boxes);
-  std::vector<std::vector<std::array<std::uint32_t, 2>>> candidates(workerCount());
-  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
-    candidates[worker].push_back({i, j});
-  });
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return low[a] < low[b]; });
   auto find = [&](int x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  for (const auto& list : candidates)  // sequential: exact values are computed on demand
-    for (const auto& [i, j] : list) {
-      const int ri = find(int(i)), rj = find(int(j));
+  for (std::size_t a = 0; a < n; ++a) {
+    const int i = order[a];
+    for (std::size_t b = a + 1; b < n && low[order[b]] <= high[i]; ++b) {
+      const int j = order[b];
+      bool overlap = true;
+      for (int k = 0; k < 3; ++k) overlap = overlap && lo[i][k] <= hi[j][k] && lo[j][k] <= hi[i][k];
+      if (!overlap) continue;
+      const int ri = find(i), rj = find(j);
       if (ri != rj && samePoint(*points[i], *points[j]))
         parent[std::max(ri, rj)] = std::min(ri, rj);
     }
-  for (std::size_t i = 0; i < points.size(); ++i) parent[i] = find(int(i));
+  }
+  for (std::size_t i = 0; i < n; ++i) parent[i] = find(int(i));
   return parent;
 }
 

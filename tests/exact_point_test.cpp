@@ -119,5 +119,41 @@ TEST(ExactPoint, CoincidentGroupsMergeExactlyEqualPointsOnly) {
   EXPECT_EQ(g, (std::vector<int>{0, 1, 2, 1, 1}));
 }
 
+TEST(ExactPoint, CoincidentGroupsMatchComparingEveryPair) {
+  // Points on a coarse grid (many share a coordinate, as on CAD inputs),
+  // each also constructed as where a segment crosses a plane through it, and
+  // points one ulp off: the groups are those of comparing every pair.
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> cell(0, 4);
+  std::vector<ExactPoint> points;
+  for (int i = 0; i < 400; ++i) {
+    const Point3 p(cell(rng), cell(rng) * 0.5, cell(rng) * 0.25);
+    switch (i % 3) {
+      case 0:
+        points.emplace_back(p);
+        break;
+      case 1:  // through p, crossing the plane z = p.z
+        points.push_back(ExactPoint::edgePlane(p - Point3(0.3, 0.1, 1), p + Point3(0.3, 0.1, 1),
+                                               Point3(0, 0, p[2]), Point3(1, 0, p[2]),
+                                               Point3(0, 1, p[2])));
+        break;
+      default:
+        points.emplace_back(Point3(p[0], std::nextafter(p[1], 9.0), p[2]));
+    }
+  }
+  std::vector<const ExactPoint*> pointers;
+  for (const ExactPoint& p : points) pointers.push_back(&p);
+  const std::vector<int> groups = coincidentGroups(pointers);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    int first = int(i);
+    for (std::size_t j = 0; j < i; ++j)
+      if (samePoint(points[i], points[j])) {
+        first = int(j);
+        break;
+      }
+    ASSERT_EQ(groups[i], first) << "point " << i;
+  }
+}
+
 }  // namespace
 }  // namespace meshmend
