@@ -1,6 +1,7 @@
 #include "common/split.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -496,6 +497,7 @@ class MeshSplitter {
     facesAdded += triangles.size() - triangles_.size();
   }
 
+  std::size_t facesWithPoints() const { return work_.size(); }
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
@@ -513,7 +515,9 @@ class MeshSplitter {
     if (p.isInputPoint() && (p.approx() == points_[a] || p.approx() == points_[b]))
       return false;                                               // a corner: not inside the edge
     if (visiblyOffLine(p, points_[a], points_[b])) return false;  // most points, cheaply
-    return onSegment(p, ExactPoint(points_[a]), ExactPoint(points_[b]));
+    // On a copy: the exact value is computed (and kept) per copy, and other
+    // meshes' threads read the table's points at the same time.
+    return onSegment(ExactPoint(p), ExactPoint(points_[a]), ExactPoint(points_[b]));
   }
 
   std::uint32_t index_;
@@ -1166,10 +1170,40 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   std::vector<std::vector<ExactPoint>> exactNew(meshes.size());
   std::vector<OutputArrays> outputs(meshes.size());
   r.curve_edges.resize(meshes.size());
+  // Each mesh's split reads only the finished curve point table (and copies
+  // the points it asks exact questions of), so meshes are split side by
+  // side: a second thread takes meshes from the same counter as this one.
+  std::atomic<std::size_t> nextMesh{0};
+  std::vector<std::size_t> facesAdded(meshes.size(), 0);
+  auto splitMeshes = [&] {
+    for (std::size_t m; (m = nextMesh++) < meshes.size();) {
+      splitters[m].shareEdgePoints(table);
+      splitters[m].retriangulateFaces(table);
+      splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
+    }
+  };
+  std::size_t facesWithPoints = 0, meshesWithPoints = 0;
+  for (const MeshSplitter& s : splitters) {
+    facesWithPoints += s.facesWithPoints();
+    meshesWithPoints += s.facesWithPoints() > 0;
+  }
+  if (meshesWithPoints > 1 && facesWithPoints >= 32) {  // worth a thread start
+    std::exception_ptr asideError;
+    TaskAlongside aside([&] {
+      try {
+        splitMeshes();
+      } catch (...) {
+        asideError = std::current_exception();
+      }
+    });
+    splitMeshes();
+    aside.wait();
+    if (asideError) std::rethrow_exception(asideError);
+  } else {
+    splitMeshes();
+  }
   for (std::size_t m = 0; m < meshes.size(); ++m) {
-    splitters[m].shareEdgePoints(table);
-    splitters[m].retriangulateFaces(table);
-    splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], r.faces_added);
+    r.faces_added += facesAdded[m];
     r.faces_split += splitters[m].facesSplit();
     r.degenerate_faces_kept += splitters[m].degenerateKept();
     r.new_vertices += exactNew[m].size();
