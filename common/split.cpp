@@ -236,10 +236,40 @@ struct OutputArrays {
 };
 
 // The curve points and segments one face receives (representative ids).
+// A list that keeps its first N elements in place and only a longer one on
+// the heap: a crossed face receives a few points and segments, and an
+// allocation for each would cost more than the rest of its bookkeeping.
+template <class T, std::size_t N>
+class SmallList {
+ public:
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  T* begin() { return size_ <= N ? local_.data() : heap_.data(); }
+  T* end() { return begin() + size_; }
+  const T* begin() const { return size_ <= N ? local_.data() : heap_.data(); }
+  const T* end() const { return begin() + size_; }
+  T& operator[](std::size_t i) { return begin()[i]; }
+  const T& operator[](std::size_t i) const { return begin()[i]; }
+  void push_back(const T& x) {
+    if (size_ < N) {
+      local_[size_++] = x;
+      return;
+    }
+    if (size_ == N) heap_.assign(local_.begin(), local_.end());
+    heap_.push_back(x);
+    ++size_;
+  }
+
+ private:
+  std::array<T, N> local_{};
+  std::vector<T> heap_;  // all elements once there are more than N
+  std::size_t size_ = 0;
+};
+
 struct FaceWork {
-  std::vector<int> points;
-  std::vector<std::uint8_t> edges;           // per point: the face's edges it lies inside (bits)
-  std::vector<std::array<int, 2>> segments;  // indices into points
+  SmallList<int, 6> points;
+  SmallList<std::uint8_t, 6> edges;           // per point: the face's edges it lies inside (bits)
+  SmallList<std::array<int, 2>, 6> segments;  // indices into points
 
   int add(int id, std::uint8_t onEdges = 0) {
     for (std::size_t i = 0; i < points.size(); ++i)
@@ -299,11 +329,6 @@ class MeshSplitter {
   // The contact of a pair (curve point ids), seen from this mesh's face f.
   void addContact(std::uint32_t f, const int* contact, std::size_t n) {
     FaceWork& w = work_[f];
-    if (w.points.empty()) {  // room for a typical face's points without growing
-      w.points.reserve(4);
-      w.edges.reserve(4);
-      w.segments.reserve(4);
-    }
     int ids[6];  // a contact has at most six points (two coplanar triangles' overlap)
     for (std::size_t i = 0; i < n; ++i) ids[i] = w.add(contact[i]);
     if (n == 2 && ids[0] != ids[1]) w.segments.push_back({ids[0], ids[1]});
@@ -386,7 +411,7 @@ class MeshSplitter {
             in.points.reserve(w.points.size());
             for (int id : w.points) in.points.push_back(table.point(id));
             in.segments.reserve(w.segments.size());
-            in.on_edges = w.edges;
+            in.on_edges.assign(w.edges.begin(), w.edges.end());
             for (const auto& s : w.segments) in.segments.push_back({3 + s[0], 3 + s[1]});
             patches_[i] = retriangulate(in);
           }
@@ -449,7 +474,7 @@ class MeshSplitter {
         ++degenerateKept_;
         continue;
       }
-      const std::vector<int>& ids = work_.at(f).points;
+      const SmallList<int, 6>& ids = work_.at(f).points;
       global.assign(patch.vertices.size(), -1);
       for (int k = 0; k < 3; ++k) global[k] = triangles_[f][k];
       for (std::size_t j = 0; j < ids.size(); ++j) {
