@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/predicates.h"
@@ -18,9 +16,26 @@ Edge key(int a, int b) {
   return a < b ? Edge{a, b} : Edge{b, a};
 }
 
+// One re-triangulation at a time; its storage is kept for the next patch
+// (retriangulate() holds one per thread), so that a patch in steady state
+// allocates only its output.
 class Retriangulator {
  public:
-  explicit Retriangulator(const PatchInput& in) {
+  Patch run(const PatchInput& in) {
+    reset(in);
+    return triangulate(in);
+  }
+
+ private:
+  void reset(const PatchInput& in) {
+    V_.clear();
+    edges_.clear();
+    lines_.clear();
+    T_.clear();
+    constrained_.clear();
+    lineEnds_.clear();
+    exactOrientations_.clear();
+    normalKnown_ = false;
     // Room for every vertex and triangle a few constraints make, without
     // moving the points (each copy of an ExactPoint is a reference count).
     const std::size_t vertices = 3 + in.points.size() + in.segments.size();
@@ -33,8 +48,9 @@ class Retriangulator {
     T_.push_back({0, 1, 2});
   }
 
-  Patch run(const PatchInput& in) {
+  Patch triangulate(const PatchInput& in) {
     Patch out;
+    out.vertex_of_input.reserve(3 + in.points.size());
     out.vertex_of_input = {0, 1, 2};
     if (!in.on_edges.empty() && in.on_edges.size() != in.points.size())
       throw InvalidInputError("retriangulate: on_edges must have one entry per point");
@@ -55,13 +71,14 @@ class Retriangulator {
       insertSegment(lineEnds_[s].first, lineEnds_[s].second, int(s));
     if (in.improve) improve();
     out.vertices = std::move(V_);
-    out.triangles = std::move(T_);
+    out.triangles = T_;
+    std::sort(constrained_.begin(), constrained_.end());
+    out.constrained_edges.reserve(constrained_.size());
     for (const auto& piece : constrained_)
-      out.constrained_edges.push_back({piece.first.first, piece.first.second});
+      out.constrained_edges.push_back({piece.edge.first, piece.edge.second});
     return out;
   }
 
- private:
   int add(const ExactPoint& p, std::uint8_t edges = 0) {
     V_.push_back(p);
     edges_.push_back(edges);
@@ -118,29 +135,33 @@ class Retriangulator {
     const std::uint64_t packed =
         (std::uint64_t(key[0]) << 42) | (std::uint64_t(key[1]) << 21) | std::uint64_t(key[2]);
     const bool packable = key[2] < (1 << 21);  // else not remembered
-    if (packable) {
-      const auto known = exactOrientations_.find(packed);
-      if (known != exactOrientations_.end()) return parity * known->second;
-    }
+    if (packable)
+      for (const auto& [triple, known] : exactOrientations_)
+        if (triple == packed) return parity * known;
     const int sign =
         sgn(orient2dValue(V_[key[0]].exact(), V_[key[1]].exact(), V_[key[2]].exact(), axis_));
-    if (packable) exactOrientations_.emplace(packed, sign);
+    if (packable) exactOrientations_.push_back({packed, sign});
     return parity * sign;
   }
 
   // Is p visibly off the triangle's plane (from the rounded values)?
-  bool visiblyOffPlane(const ExactPoint& p) const {
-    const Interval3 a = intervalOf(V_[0]), b = intervalOf(V_[1]), c = intervalOf(V_[2]);
-    const Interval3 d = intervalOf(p);
-    Interval e1[3], e2[3], e3[3];
-    for (int k = 0; k < 3; ++k) {
-      e1[k] = b[k] - a[k];
-      e2[k] = c[k] - a[k];
-      e3[k] = d[k] - a[k];
+  // The triangle's normal is enclosed once per patch.
+  bool visiblyOffPlane(const ExactPoint& p) {
+    const Interval3 a = intervalOf(V_[0]);
+    if (!normalKnown_) {
+      const Interval3 b = intervalOf(V_[1]), c = intervalOf(V_[2]);
+      Interval e1[3], e2[3];
+      for (int k = 0; k < 3; ++k) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+      }
+      normal_ = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                 e1[0] * e2[1] - e1[1] * e2[0]};
+      normalKnown_ = true;
     }
-    const Interval det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
-                         e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
-                         e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+    const Interval3 d = intervalOf(p);
+    const Interval det =
+        normal_[0] * (d[0] - a[0]) + normal_[1] * (d[1] - a[1]) + normal_[2] * (d[2] - a[2]);
     return det.positive() || det.negative();
   }
 
@@ -223,13 +244,24 @@ class Retriangulator {
       T_[t] = {x, q, c};
       T_.push_back({q, y, c});
     }
-    const auto piece = constrained_.find(key(a, b));
-    if (piece != constrained_.end()) {
-      const int support = piece->second;
-      constrained_.erase(piece);
-      constrained_.emplace(key(a, q), support);
-      constrained_.emplace(key(q, b), support);
+    const int piece = constrainedIndex(key(a, b));
+    if (piece >= 0) {
+      const int support = constrained_[piece].support;
+      constrained_[piece] = constrained_.back();
+      constrained_.pop_back();
+      constrain(key(a, q), support);
+      constrain(key(q, b), support);
     }
+  }
+
+  int constrainedIndex(const Edge& e) const {
+    for (std::size_t i = 0; i < constrained_.size(); ++i)
+      if (constrained_[i].edge == e) return int(i);
+    return -1;
+  }
+  // Marks e as a piece of input segment `support` (a piece known already keeps its first).
+  void constrain(const Edge& e, int support) {
+    if (constrainedIndex(e) < 0) constrained_.push_back({e, support});
   }
 
   // Is vertex v strictly inside segment (a, b)? (collinear checked by caller)
@@ -257,15 +289,22 @@ class Retriangulator {
       return;
     }
     if (triangleWith(a, b) >= 0 || triangleWith(b, a) >= 0) {
-      constrained_.emplace(key(a, b), support);
+      constrain(key(a, b), support);
       return;
     }
-    // The edges the segment crosses in both interiors.
+    // The edges the segment crosses in both interiors. Each vertex's side of
+    // a-b is asked once (no vertex is made until the crossings are known).
+    side_.assign(V_.size(), kUnknownSide);
+    auto sideOf = [&](int v) {
+      if (side_[v] == kUnknownSide) side_[v] = std::int8_t(orient(a, b, v));
+      return int(side_[v]);
+    };
     auto crosses = [&](int u, int w) {
-      return u != a && u != b && w != a && w != b && orient(a, b, u) * orient(a, b, w) < 0 &&
+      return u != a && u != b && w != a && w != b && sideOf(u) * sideOf(w) < 0 &&
              orient(u, w, a) * orient(u, w, b) < 0;
     };
-    std::vector<Edge> queue;  // first in, first out from `next`
+    std::vector<Edge>& queue = queue_;  // first in, first out from `next`
+    queue.clear();
     std::size_t next = 0;
     for (const auto& tri : T_)
       for (int i = 0; i < 3; ++i) {
@@ -273,15 +312,17 @@ class Retriangulator {
         if (u < w && crosses(u, w)) queue.push_back({u, w});
       }
     if (queue.empty()) throw InvalidInputError("retriangulate: a constraint leaves the triangle");
-    for (const Edge& e : queue) {
-      const auto other = constrained_.find(e);
-      if (other == constrained_.end()) continue;
+    for (std::size_t i = 0; i < queue.size(); ++i) {
+      const Edge e = queue[i];  // (the recursion below reuses the queue)
+      const int other = constrainedIndex(e);
+      if (other < 0) continue;
+      const int otherSupport = constrained_[other].support;
       // Two constraints cross: insert their crossing point, computed from
       // the end points of the two input segments they lie on, not from the
       // pieces, whose ends may be earlier crossings with far longer numbers
       // (the same point, at many times the cost where dozens of curves cross
       // in one face).
-      const Edge line = lineEnds_[support], across = lineEnds_[other->second];
+      const Edge line = lineEnds_[support], across = lineEnds_[otherSupport];
       const mpq_class oa = orientValue(across.first, across.second, line.first);
       const mpq_class ob = orientValue(across.first, across.second, line.second);
       const mpq_class t = oa / (oa - ob);
@@ -290,7 +331,7 @@ class Retriangulator {
       for (int k = 0; k < 3; ++k) x.x[k] = A.x[k] + t * (B.x[k] - A.x[k]);
       const int q = add(ExactPoint(x));
       lines_[q].add(support);
-      lines_[q].add(other->second);
+      lines_[q].add(otherSupport);
       splitEdge(e.first, e.second, q);
       insertSegment(a, q, support);
       insertSegment(q, b, support);
@@ -312,7 +353,7 @@ class Retriangulator {
     }
     if (triangleWith(a, b) < 0 && triangleWith(b, a) < 0)
       throw InvalidInputError("retriangulate: could not recover a constraint");
-    constrained_.emplace(key(a, b), support);
+    constrain(key(a, b), support);
   }
 
   // Flips edge (u, w) if the two triangles around it form a strictly convex
@@ -338,7 +379,16 @@ class Retriangulator {
   // A measure increasing with the smallest angle of triangle (a, b, c), from
   // the rounded positions: the squared sine of that angle, opposite the
   // shortest side (at most 60°, where the sine still grows with the angle).
+  // Computed from the smallest index on, so that every rotation of a
+  // triangle gets the same value (improve keeps one per triangle).
   double minAngle(int a, int b, int c) const {
+    if (b < a && b < c) {
+      std::swap(a, b);  // (b, a, c)
+      std::swap(b, c);  // (b, c, a)
+    } else if (c < a && c < b) {
+      std::swap(a, c);  // (c, b, a)
+      std::swap(b, c);  // (c, a, b)
+    }
     const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
     const double ab = (pb - pa).SquaredNorm(), bc = (pc - pb).SquaredNorm(),
                  ca = (pa - pc).SquaredNorm();
@@ -348,24 +398,107 @@ class Retriangulator {
     return others > 0 ? cross / others : 0;
   }
 
-  // Max-min angle flips on unconstrained interior edges. The validity of each
-  // flip is decided exactly; only the quality comparison is approximate.
+  // neighbour_[3 t + i]: the triangle across edge i of triangle t (from
+  // corner i to i + 1), or -1 on the border.
+  void findNeighbours() {
+    const int n = int(T_.size());
+    neighbour_.assign(3 * std::size_t(n), -1);
+    // The sides (as end corner and triangle) grouped by their first corner,
+    // so that the side back is found among the few that leave the other end.
+    firstSide_.assign(V_.size() + 1, 0);
+    for (const auto& tri : T_)
+      for (int v : tri) ++firstSide_[v + 1];
+    for (std::size_t v = 0; v < V_.size(); ++v) firstSide_[v + 1] += firstSide_[v];
+    sidesFrom_.resize(3 * std::size_t(n));
+    nextSide_.assign(firstSide_.begin(), firstSide_.end() - 1);
+    for (int t = 0; t < n; ++t)
+      for (int i = 0; i < 3; ++i) sidesFrom_[nextSide_[T_[t][i]]++] = {T_[t][(i + 1) % 3], t};
+    for (int t = 0; t < n; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const int u = T_[t][i], w = T_[t][(i + 1) % 3];
+        for (int k = firstSide_[w]; k < firstSide_[w + 1]; ++k)
+          if (sidesFrom_[k][0] == u) {
+            neighbour_[3 * t + i] = sidesFrom_[k][1];
+            break;
+          }
+      }
+  }
+
+  // The sides of t, and the sides across from them, are to be looked at again.
+  void unsettle(int t) {
+    for (int k = 0; k < 3; ++k) {
+      settled_[3 * t + k] = 0;
+      const int across = neighbour_[3 * t + k];
+      if (across < 0) continue;
+      for (int m = 0; m < 3; ++m)
+        if (neighbour_[3 * across + m] == t) settled_[3 * across + m] = 0;
+    }
+  }
+
+  // Max-min angle flips on unconstrained interior edges, in passes over the
+  // triangles' sides in order. The validity of each flip is decided
+  // exactly; only the quality comparison is approximate. An edge that keeps
+  // is settled until one of its two triangles changes: asking again would
+  // give the same answer.
   void improve() {
+    const int n = int(T_.size());
+    quality_.resize(n);
+    for (int t = 0; t < n; ++t) quality_[t] = minAngle(T_[t][0], T_[t][1], T_[t][2]);
+    findNeighbours();
+    settled_.assign(3 * std::size_t(n), 0);
     for (int pass = 0; pass < 50; ++pass) {
       bool changed = false;
-      for (std::size_t t = 0; t < T_.size(); ++t)
+      for (int t = 0; t < n; ++t)
         for (int i = 0; i < 3; ++i) {
+          if (settled_[3 * t + i]) continue;
           const int u = T_[t][i], w = T_[t][(i + 1) % 3];
-          if (constrained_.count(key(u, w))) continue;
-          const int other = triangleWith(w, u);
-          if (other < 0) continue;
-          const int p = opposite(int(t), u, w), q = opposite(other, w, u);
-          const double before = std::min(minAngle(u, w, p), minAngle(w, u, q));
-          const double after = std::min(minAngle(p, q, w), minAngle(q, p, u));
-          if (after > before * (1 + 1e-9) && flipIfConvex(u, w)) changed = true;
+          const int other = neighbour_[3 * t + i];
+          if (other < 0 || constrainedIndex(key(u, w)) >= 0) {
+            settled_[3 * t + i] = 1;
+            continue;
+          }
+          int j = 0;
+          while (T_[other][j] != w) ++j;
+          const int p = T_[t][(i + 2) % 3], q = T_[other][(j + 2) % 3];
+          // (u, w, p) and (w, u, q) are the triangles; the flip makes
+          // (p, q, w) and (q, p, u), if their quadrilateral is strictly convex.
+          const double before = std::min(quality_[t], quality_[other]);
+          const double first = minAngle(p, q, w), second = minAngle(q, p, u);
+          if (std::min(first, second) > before * (1 + 1e-9) && orient(p, q, w) > 0 &&
+              orient(q, p, u) > 0) {
+            flip(t, i, other, j);
+            quality_[t] = first;
+            quality_[other] = second;
+            changed = true;
+          } else {
+            settled_[3 * t + i] = settled_[3 * other + j] = 1;
+          }
         }
       if (!changed) return;
     }
+  }
+
+  // Flips the edge between side i of t1 and side j of t2 (see improve),
+  // keeping the neighbours.
+  void flip(int t1, int i, int t2, int j) {
+    const int u = T_[t1][i], w = T_[t1][(i + 1) % 3], p = T_[t1][(i + 2) % 3];
+    const int q = T_[t2][(j + 2) % 3];
+    const int wp = neighbour_[3 * t1 + (i + 1) % 3], pu = neighbour_[3 * t1 + (i + 2) % 3];
+    const int uq = neighbour_[3 * t2 + (j + 1) % 3], qw = neighbour_[3 * t2 + (j + 2) % 3];
+    T_[t1] = {p, q, w};
+    T_[t2] = {q, p, u};
+    const int n1[3] = {t2, qw, wp}, n2[3] = {t1, pu, uq};
+    for (int k = 0; k < 3; ++k) {
+      neighbour_[3 * t1 + k] = n1[k];
+      neighbour_[3 * t2 + k] = n2[k];
+    }
+    // p-u now borders t2, q-w t1.
+    for (int m = 0; pu >= 0 && m < 3; ++m)
+      if (neighbour_[3 * pu + m] == t1) neighbour_[3 * pu + m] = t2;
+    for (int m = 0; qw >= 0 && m < 3; ++m)
+      if (neighbour_[3 * qw + m] == t2) neighbour_[3 * qw + m] = t1;
+    unsettle(t1);
+    unsettle(t2);
   }
 
   std::vector<ExactPoint> V_;
@@ -373,7 +506,12 @@ class Retriangulator {
   std::vector<std::array<int, 3>> T_;
   // The constrained edges, each with the number of the input segment it is
   // a piece of.
-  std::map<Edge, int> constrained_;
+  struct Constrained {
+    Edge edge;
+    int support;
+    bool operator<(const Constrained& o) const { return edge < o.edge; }
+  };
+  std::vector<Constrained> constrained_;  // few: searched in order
   // The input segments' end points, and for each vertex the input segments
   // it lies on, exactly (end points, crossings, vertices found on a
   // segment): three points on one segment are collinear without asking the
@@ -395,15 +533,30 @@ class Retriangulator {
     }
   };
   std::vector<Edge> lineEnds_;
+  // Scratch of insertSegment: the crossed edges to flip, each vertex's side
+  // of the segment.
+  std::vector<Edge> queue_;
+  static constexpr std::int8_t kUnknownSide = 2;
+  std::vector<std::int8_t> side_;
+  // Scratch of improve: per triangle its quality and neighbours, per side
+  // whether it is settled, and the sides grouped by first corner.
+  std::vector<double> quality_;
+  std::vector<int> neighbour_, firstSide_, nextSide_;
+  std::vector<std::array<int, 2>> sidesFrom_;
+  std::vector<std::uint8_t> settled_;
   std::vector<Lines> lines_;
   int axis_ = 2, sign_ = 1;
-  mutable std::unordered_map<std::uint64_t, int> exactOrientations_;  // sorted triple -> sign
+  bool normalKnown_ = false;
+  Interval3 normal_;  // (corner 1 - corner 0) x (corner 2 - corner 0), enclosed
+  // Sorted triple -> sign; rare (only where the rounded values cannot tell).
+  mutable std::vector<std::pair<std::uint64_t, int>> exactOrientations_;
 };
 
 }  // namespace
 
 Patch retriangulate(const PatchInput& input) {
-  return Retriangulator(input).run(input);
+  thread_local Retriangulator workspace;
+  return workspace.run(input);
 }
 
 }  // namespace meshmend
