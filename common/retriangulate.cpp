@@ -45,6 +45,8 @@ class Retriangulator {
     T_.reserve(2 * vertices);
     for (int i = 0; i < 3; ++i) add(in.corners[i], std::uint8_t((1 << i) | (1 << ((i + 2) % 3))));
     chooseProjection();
+    kept_[0] = (axis_ + 1) % 3;
+    kept_[1] = (axis_ + 2) % 3;
     T_.push_back({0, 1, 2});
   }
 
@@ -118,8 +120,36 @@ class Retriangulator {
   int orient(int a, int b, int c) const {
     if (edges_[a] & edges_[b] & edges_[c]) return 0;           // on one edge of the input triangle
     if (lines_[a].sharedWith(lines_[b], lines_[c])) return 0;  // on one input segment
-    const int sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
+    int sign = certifiedOrient(a, b, c);
+    if (sign == kUndecided) sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
     return sign_ * (sign != kUndecided ? sign : exactOrient(a, b, c));
+  }
+
+  // The sign of the projected orientation of (a, b, c) where the rounded
+  // positions certify it, else kUndecided: a bound on the error by forward
+  // analysis, a few operations where the interval filter
+  // (orient2dDroppingFiltered) takes many. With u = 2^-53 and m the largest
+  // rounded difference, each difference is within e = (the three points'
+  // errors) + u m of the exact one, so the products' difference is within
+  // 4 m e + 2 e^2, and rounding the determinant adds at most
+  // 2u (|l| + |r|) (1 + u). The bound is computed with twice that last term
+  // and widened by (1 + 2^-40) for its own rounding, plus 2^-1000 for
+  // underflow; large or non-finite values are left to the interval filter.
+  int certifiedOrient(int a, int b, int c) const {
+    const int x = kept_[0], y = kept_[1];
+    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
+    const double x1 = pb[x] - pa[x], y1 = pb[y] - pa[y], x2 = pc[x] - pa[x], y2 = pc[y] - pa[y];
+    const double m =
+        std::max(std::max(std::fabs(x1), std::fabs(y1)), std::max(std::fabs(x2), std::fabs(y2)));
+    if (!(m < 1e100)) return kUndecided;
+    const double l = x1 * y2, r = y1 * x2, d = l - r;
+    const double e = V_[a].error() + V_[b].error() + V_[c].error() + 0x1p-53 * m;
+    const double bound =
+        (4 * m * e + 2 * e * e + 0x1p-51 * (std::fabs(l) + std::fabs(r))) * (1 + 0x1p-40) +
+        0x1p-1000;
+    if (d > bound) return 1;
+    if (-d > bound) return -1;
+    return kUndecided;
   }
 
   // The exact orientation of three vertices the rounded values leave open
@@ -144,25 +174,33 @@ class Retriangulator {
     return parity * sign;
   }
 
-  // Is p visibly off the triangle's plane (from the rounded values)?
-  // The triangle's normal is enclosed once per patch.
+  // Is p visibly off the triangle's plane (from the rounded values)? The
+  // triple product det[b - a, c - a, p - a] of the rounded differences
+  // against a bound on its error: with m the largest difference and e the
+  // points' errors plus u m (u = 2^-53) the largest error of one, each of
+  // its six terms is within (m + e)^3 - m^3 = e (3 m^2 + 3 m e + e^2) of
+  // the exact one, and evaluating it rounds by less than 2^-45 m^3. The
+  // bound is widened by (1 + 2^-40) for its own rounding, plus 2^-1000 for
+  // underflow; large or non-finite values are not checked.
   bool visiblyOffPlane(const ExactPoint& p) {
-    const Interval3 a = intervalOf(V_[0]);
+    const Point3& a = V_[0].approx();
     if (!normalKnown_) {
-      const Interval3 b = intervalOf(V_[1]), c = intervalOf(V_[2]);
-      Interval e1[3], e2[3];
-      for (int k = 0; k < 3; ++k) {
-        e1[k] = b[k] - a[k];
-        e2[k] = c[k] - a[k];
-      }
-      normal_ = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                 e1[0] * e2[1] - e1[1] * e2[0]};
+      const Point3 e1 = V_[1].approx() - a, e2 = V_[2].approx() - a;
+      normal_ = e1 ^ e2;
+      cornerDifference_ = std::max(largest(e1), largest(e2));
       normalKnown_ = true;
     }
-    const Interval3 d = intervalOf(p);
-    const Interval det =
-        normal_[0] * (d[0] - a[0]) + normal_[1] * (d[1] - a[1]) + normal_[2] * (d[2] - a[2]);
-    return det.positive() || det.negative();
+    const Point3 e3 = p.approx() - a;
+    const double m = std::max(cornerDifference_, largest(e3));
+    if (!(m < 1e90)) return false;
+    const double e =
+        V_[0].error() + std::max({V_[1].error(), V_[2].error(), p.error()}) + 0x1p-53 * m;
+    const double bound =
+        (6 * e * (3 * m * m + 3 * m * e + e * e) + 0x1p-45 * m * m * m) * (1 + 0x1p-40) + 0x1p-1000;
+    return std::fabs(normal_ * e3) > bound;
+  }
+  static double largest(const Point3& d) {
+    return std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
   }
 
   // Index of the triangle holding directed edge a->b, or -1.
@@ -254,18 +292,36 @@ class Retriangulator {
     }
   }
 
+  // Is v beyond a and b in some coordinate by more than the points' errors
+  // and the rounding of this test (the bounding box of the rounded values,
+  // widened), so that between() need not compare exactly?
+  bool clearlyOutside(int a, int b, int v) const {
+    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pv = V_[v].approx();
+    const double errors = V_[a].error() + V_[b].error() + V_[v].error();
+    for (int k = 0; k < 3; ++k) {
+      const double lo = std::min(pa[k], pb[k]), hi = std::max(pa[k], pb[k]);
+      const double slack =
+          (errors + 0x1p-50 * (std::fabs(lo) + std::fabs(hi) + std::fabs(pv[k]))) * (1 + 0x1p-40) +
+          0x1p-1000;
+      if (pv[k] + slack < lo || pv[k] - slack > hi) return true;
+    }
+    return false;
+  }
+
   int constrainedIndex(const Edge& e) const {
     for (std::size_t i = 0; i < constrained_.size(); ++i)
       if (constrained_[i].edge == e) return int(i);
     return -1;
   }
-  // Marks e as a piece of input segment `support` (a piece known already keeps its first).
+  // Marks e as a piece of input segment `support` (a piece known already keeps
+  // its first).
   void constrain(const Edge& e, int support) {
     if (constrainedIndex(e) < 0) constrained_.push_back({e, support});
   }
 
   // Is vertex v strictly inside segment (a, b)? (collinear checked by caller)
   bool between(int a, int b, int v) const {
+    if (clearlyOutside(a, b, v)) return false;
     for (int k = 0; k < 3; ++k)
       if (compareCoordinate(V_[v], V_[a], k) * compareCoordinate(V_[b], V_[v], k) < 0) return false;
     return !samePoint(V_[a], V_[v]) && !samePoint(V_[b], V_[v]);
@@ -393,7 +449,8 @@ class Retriangulator {
     const double ab = (pb - pa).SquaredNorm(), bc = (pc - pb).SquaredNorm(),
                  ca = (pa - pc).SquaredNorm();
     const double cross = ((pb - pa) ^ (pc - pa)).SquaredNorm();  // 4 × area²
-    // sin² at the apex opposite the shortest side = 4 area² / (product of the two others).
+    // sin² at the apex opposite the shortest side = 4 area² / (product of the
+    // two others).
     const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
     return others > 0 ? cross / others : 0;
   }
@@ -519,7 +576,8 @@ class Retriangulator {
   // orientation is the slow path, and points on one curve ask it often).
   struct Lines {
     std::array<int, 4> id;
-    int n = 0;  // a vertex on more segments keeps the first four: the rest are computed
+    int n = 0;  // a vertex on more segments keeps the first four: the rest are
+                // computed
     void add(int line) {
       if (n < 4 && !has(line)) id[n++] = line;
     }
@@ -546,8 +604,10 @@ class Retriangulator {
   std::vector<std::uint8_t> settled_;
   std::vector<Lines> lines_;
   int axis_ = 2, sign_ = 1;
+  std::array<int, 2> kept_{0, 1};  // the coordinates the projection keeps
   bool normalKnown_ = false;
-  Interval3 normal_;  // (corner 1 - corner 0) x (corner 2 - corner 0), enclosed
+  Point3 normal_;                // (corner 1 - corner 0) x (corner 2 - corner 0), rounded
+  double cornerDifference_ = 0;  // the largest coordinate of those differences
   // Sorted triple -> sign; rare (only where the rounded values cannot tell).
   mutable std::vector<std::pair<std::uint64_t, int>> exactOrientations_;
 };
