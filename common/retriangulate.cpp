@@ -460,22 +460,22 @@ class Retriangulator {
   void findNeighbours() {
     const int n = int(T_.size());
     neighbour_.assign(3 * std::size_t(n), -1);
-    // The sides (as end corner and triangle) grouped by their first corner,
-    // so that the side back is found among the few that leave the other end.
-    firstSide_.assign(V_.size() + 1, 0);
-    for (const auto& tri : T_)
-      for (int v : tri) ++firstSide_[v + 1];
-    for (std::size_t v = 0; v < V_.size(); ++v) firstSide_[v + 1] += firstSide_[v];
-    sidesFrom_.resize(3 * std::size_t(n));
-    nextSide_.assign(firstSide_.begin(), firstSide_.end() - 1);
-    for (int t = 0; t < n; ++t)
-      for (int i = 0; i < 3; ++i) sidesFrom_[nextSide_[T_[t][i]]++] = {T_[t][(i + 1) % 3], t};
+    // The sides listed by their first corner (a linked list per corner), so
+    // that the side back is found among the few that leave the other end.
+    firstSide_.assign(V_.size(), -1);
+    sides_.resize(3 * std::size_t(n));
     for (int t = 0; t < n; ++t)
       for (int i = 0; i < 3; ++i) {
-        const int u = T_[t][i], w = T_[t][(i + 1) % 3];
-        for (int k = firstSide_[w]; k < firstSide_[w + 1]; ++k)
-          if (sidesFrom_[k][0] == u) {
-            neighbour_[3 * t + i] = sidesFrom_[k][1];
+        int& first = firstSide_[T_[t][i]];
+        sides_[3 * t + i] = {first, T_[t][(i + 1) % 3], t};
+        first = 3 * t + i;
+      }
+    for (int t = 0; t < n; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const int u = T_[t][i];
+        for (int s = firstSide_[T_[t][(i + 1) % 3]]; s >= 0; s = sides_[s].next)
+          if (sides_[s].end == u) {
+            neighbour_[3 * t + i] = sides_[s].triangle;
             break;
           }
       }
@@ -519,10 +519,12 @@ class Retriangulator {
           const int p = T_[t][(i + 2) % 3], q = T_[other][(j + 2) % 3];
           // (u, w, p) and (w, u, q) are the triangles; the flip makes
           // (p, q, w) and (q, p, u), if their quadrilateral is strictly convex.
-          const double before = std::min(quality_[t], quality_[other]);
-          const double first = minAngle(p, q, w), second = minAngle(q, p, u);
-          if (std::min(first, second) > before * (1 + 1e-9) && orient(p, q, w) > 0 &&
-              orient(q, p, u) > 0) {
+          // Better when both new triangles are (the second is not needed
+          // when the first is not).
+          const double needed = std::min(quality_[t], quality_[other]) * (1 + 1e-9);
+          const double first = minAngle(p, q, w);
+          const double second = first > needed ? minAngle(q, p, u) : 0;
+          if (second > needed && orient(p, q, w) > 0 && orient(q, p, u) > 0) {
             flip(t, i, other, j);
             quality_[t] = first;
             quality_[other] = second;
@@ -597,10 +599,14 @@ class Retriangulator {
   static constexpr std::int8_t kUnknownSide = 2;
   std::vector<std::int8_t> side_;
   // Scratch of improve: per triangle its quality and neighbours, per side
-  // whether it is settled, and the sides grouped by first corner.
+  // whether it is settled, and the sides listed by first corner.
   std::vector<double> quality_;
-  std::vector<int> neighbour_, firstSide_, nextSide_;
-  std::vector<std::array<int, 2>> sidesFrom_;
+  std::vector<int> neighbour_, firstSide_;
+  struct Side {
+    int next;  // the next side from the same corner, or -1
+    int end, triangle;
+  };
+  std::vector<Side> sides_;
   std::vector<std::uint8_t> settled_;
   std::vector<Lines> lines_;
   int axis_ = 2, sign_ = 1;
