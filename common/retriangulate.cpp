@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/predicates.h"
@@ -18,9 +16,26 @@ Edge key(int a, int b) {
   return a < b ? Edge{a, b} : Edge{b, a};
 }
 
+// One re-triangulation at a time; its storage is kept for the next patch
+// (retriangulate() holds one per thread), so that a patch in steady state
+// allocates only its output.
 class Retriangulator {
  public:
-  explicit Retriangulator(const PatchInput& in) {
+  Patch run(const PatchInput& in) {
+    reset(in);
+    return triangulate(in);
+  }
+
+ private:
+  void reset(const PatchInput& in) {
+    V_.clear();
+    edges_.clear();
+    lines_.clear();
+    T_.clear();
+    constrained_.clear();
+    lineEnds_.clear();
+    exactOrientations_.clear();
+    normalKnown_ = false;
     // Room for every vertex and triangle a few constraints make, without
     // moving the points (each copy of an ExactPoint is a reference count).
     const std::size_t vertices = 3 + in.points.size() + in.segments.size();
@@ -30,11 +45,14 @@ class Retriangulator {
     T_.reserve(2 * vertices);
     for (int i = 0; i < 3; ++i) add(in.corners[i], std::uint8_t((1 << i) | (1 << ((i + 2) % 3))));
     chooseProjection();
+    kept_[0] = (axis_ + 1) % 3;
+    kept_[1] = (axis_ + 2) % 3;
     T_.push_back({0, 1, 2});
   }
 
-  Patch run(const PatchInput& in) {
+  Patch triangulate(const PatchInput& in) {
     Patch out;
+    out.vertex_of_input.reserve(3 + in.points.size());
     out.vertex_of_input = {0, 1, 2};
     if (!in.on_edges.empty() && in.on_edges.size() != in.points.size())
       throw InvalidInputError("retriangulate: on_edges must have one entry per point");
@@ -55,13 +73,14 @@ class Retriangulator {
       insertSegment(lineEnds_[s].first, lineEnds_[s].second, int(s));
     if (in.improve) improve();
     out.vertices = std::move(V_);
-    out.triangles = std::move(T_);
+    out.triangles = T_;
+    std::sort(constrained_.begin(), constrained_.end());
+    out.constrained_edges.reserve(constrained_.size());
     for (const auto& piece : constrained_)
-      out.constrained_edges.push_back({piece.first.first, piece.first.second});
+      out.constrained_edges.push_back({piece.edge.first, piece.edge.second});
     return out;
   }
 
- private:
   int add(const ExactPoint& p, std::uint8_t edges = 0) {
     V_.push_back(p);
     edges_.push_back(edges);
@@ -101,8 +120,36 @@ class Retriangulator {
   int orient(int a, int b, int c) const {
     if (edges_[a] & edges_[b] & edges_[c]) return 0;           // on one edge of the input triangle
     if (lines_[a].sharedWith(lines_[b], lines_[c])) return 0;  // on one input segment
-    const int sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
+    int sign = certifiedOrient(a, b, c);
+    if (sign == kUndecided) sign = orient2dDroppingFiltered(V_[a], V_[b], V_[c], axis_);
     return sign_ * (sign != kUndecided ? sign : exactOrient(a, b, c));
+  }
+
+  // The sign of the projected orientation of (a, b, c) where the rounded
+  // positions certify it, else kUndecided: a bound on the error by forward
+  // analysis, a few operations where the interval filter
+  // (orient2dDroppingFiltered) takes many. With u = 2^-53 and m the largest
+  // rounded difference, each difference is within e = (the three points'
+  // errors) + u m of the exact one, so the products' difference is within
+  // 4 m e + 2 e^2, and rounding the determinant adds at most
+  // 2u (|l| + |r|) (1 + u). The bound is computed with twice that last term
+  // and widened by (1 + 2^-40) for its own rounding, plus 2^-1000 for
+  // underflow; large or non-finite values are left to the interval filter.
+  int certifiedOrient(int a, int b, int c) const {
+    const int x = kept_[0], y = kept_[1];
+    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
+    const double x1 = pb[x] - pa[x], y1 = pb[y] - pa[y], x2 = pc[x] - pa[x], y2 = pc[y] - pa[y];
+    const double m =
+        std::max(std::max(std::fabs(x1), std::fabs(y1)), std::max(std::fabs(x2), std::fabs(y2)));
+    if (!(m < 1e100)) return kUndecided;
+    const double l = x1 * y2, r = y1 * x2, d = l - r;
+    const double e = V_[a].error() + V_[b].error() + V_[c].error() + 0x1p-53 * m;
+    const double bound =
+        (4 * m * e + 2 * e * e + 0x1p-51 * (std::fabs(l) + std::fabs(r))) * (1 + 0x1p-40) +
+        0x1p-1000;
+    if (d > bound) return 1;
+    if (-d > bound) return -1;
+    return kUndecided;
   }
 
   // The exact orientation of three vertices the rounded values leave open
@@ -118,30 +165,42 @@ class Retriangulator {
     const std::uint64_t packed =
         (std::uint64_t(key[0]) << 42) | (std::uint64_t(key[1]) << 21) | std::uint64_t(key[2]);
     const bool packable = key[2] < (1 << 21);  // else not remembered
-    if (packable) {
-      const auto known = exactOrientations_.find(packed);
-      if (known != exactOrientations_.end()) return parity * known->second;
-    }
+    if (packable)
+      for (const auto& [triple, known] : exactOrientations_)
+        if (triple == packed) return parity * known;
     const int sign =
         sgn(orient2dValue(V_[key[0]].exact(), V_[key[1]].exact(), V_[key[2]].exact(), axis_));
-    if (packable) exactOrientations_.emplace(packed, sign);
+    if (packable) exactOrientations_.push_back({packed, sign});
     return parity * sign;
   }
 
-  // Is p visibly off the triangle's plane (from the rounded values)?
-  bool visiblyOffPlane(const ExactPoint& p) const {
-    const Interval3 a = intervalOf(V_[0]), b = intervalOf(V_[1]), c = intervalOf(V_[2]);
-    const Interval3 d = intervalOf(p);
-    Interval e1[3], e2[3], e3[3];
-    for (int k = 0; k < 3; ++k) {
-      e1[k] = b[k] - a[k];
-      e2[k] = c[k] - a[k];
-      e3[k] = d[k] - a[k];
+  // Is p visibly off the triangle's plane (from the rounded values)? The
+  // triple product det[b - a, c - a, p - a] of the rounded differences
+  // against a bound on its error: with m the largest difference and e the
+  // points' errors plus u m (u = 2^-53) the largest error of one, each of
+  // its six terms is within (m + e)^3 - m^3 = e (3 m^2 + 3 m e + e^2) of
+  // the exact one, and evaluating it rounds by less than 2^-45 m^3. The
+  // bound is widened by (1 + 2^-40) for its own rounding, plus 2^-1000 for
+  // underflow; large or non-finite values are not checked.
+  bool visiblyOffPlane(const ExactPoint& p) {
+    const Point3& a = V_[0].approx();
+    if (!normalKnown_) {
+      const Point3 e1 = V_[1].approx() - a, e2 = V_[2].approx() - a;
+      normal_ = e1 ^ e2;
+      cornerDifference_ = std::max(largest(e1), largest(e2));
+      normalKnown_ = true;
     }
-    const Interval det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
-                         e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
-                         e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
-    return det.positive() || det.negative();
+    const Point3 e3 = p.approx() - a;
+    const double m = std::max(cornerDifference_, largest(e3));
+    if (!(m < 1e90)) return false;
+    const double e =
+        V_[0].error() + std::max({V_[1].error(), V_[2].error(), p.error()}) + 0x1p-53 * m;
+    const double bound =
+        (6 * e * (3 * m * m + 3 * m * e + e * e) + 0x1p-45 * m * m * m) * (1 + 0x1p-40) + 0x1p-1000;
+    return std::fabs(normal_ * e3) > bound;
+  }
+  static double largest(const Point3& d) {
+    return std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
   }
 
   // Index of the triangle holding directed edge a->b, or -1.
@@ -223,17 +282,46 @@ class Retriangulator {
       T_[t] = {x, q, c};
       T_.push_back({q, y, c});
     }
-    const auto piece = constrained_.find(key(a, b));
-    if (piece != constrained_.end()) {
-      const int support = piece->second;
-      constrained_.erase(piece);
-      constrained_.emplace(key(a, q), support);
-      constrained_.emplace(key(q, b), support);
+    const int piece = constrainedIndex(key(a, b));
+    if (piece >= 0) {
+      const int support = constrained_[piece].support;
+      constrained_[piece] = constrained_.back();
+      constrained_.pop_back();
+      constrain(key(a, q), support);
+      constrain(key(q, b), support);
     }
+  }
+
+  // Is v beyond a and b in some coordinate by more than the points' errors
+  // and the rounding of this test (the bounding box of the rounded values,
+  // widened), so that between() need not compare exactly?
+  bool clearlyOutside(int a, int b, int v) const {
+    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pv = V_[v].approx();
+    const double errors = V_[a].error() + V_[b].error() + V_[v].error();
+    for (int k = 0; k < 3; ++k) {
+      const double lo = std::min(pa[k], pb[k]), hi = std::max(pa[k], pb[k]);
+      const double slack =
+          (errors + 0x1p-50 * (std::fabs(lo) + std::fabs(hi) + std::fabs(pv[k]))) * (1 + 0x1p-40) +
+          0x1p-1000;
+      if (pv[k] + slack < lo || pv[k] - slack > hi) return true;
+    }
+    return false;
+  }
+
+  int constrainedIndex(const Edge& e) const {
+    for (std::size_t i = 0; i < constrained_.size(); ++i)
+      if (constrained_[i].edge == e) return int(i);
+    return -1;
+  }
+  // Marks e as a piece of input segment `support` (a piece known already keeps
+  // its first).
+  void constrain(const Edge& e, int support) {
+    if (constrainedIndex(e) < 0) constrained_.push_back({e, support});
   }
 
   // Is vertex v strictly inside segment (a, b)? (collinear checked by caller)
   bool between(int a, int b, int v) const {
+    if (clearlyOutside(a, b, v)) return false;
     for (int k = 0; k < 3; ++k)
       if (compareCoordinate(V_[v], V_[a], k) * compareCoordinate(V_[b], V_[v], k) < 0) return false;
     return !samePoint(V_[a], V_[v]) && !samePoint(V_[b], V_[v]);
@@ -257,15 +345,22 @@ class Retriangulator {
       return;
     }
     if (triangleWith(a, b) >= 0 || triangleWith(b, a) >= 0) {
-      constrained_.emplace(key(a, b), support);
+      constrain(key(a, b), support);
       return;
     }
-    // The edges the segment crosses in both interiors.
+    // The edges the segment crosses in both interiors. Each vertex's side of
+    // a-b is asked once (no vertex is made until the crossings are known).
+    side_.assign(V_.size(), kUnknownSide);
+    auto sideOf = [&](int v) {
+      if (side_[v] == kUnknownSide) side_[v] = std::int8_t(orient(a, b, v));
+      return int(side_[v]);
+    };
     auto crosses = [&](int u, int w) {
-      return u != a && u != b && w != a && w != b && orient(a, b, u) * orient(a, b, w) < 0 &&
+      return u != a && u != b && w != a && w != b && sideOf(u) * sideOf(w) < 0 &&
              orient(u, w, a) * orient(u, w, b) < 0;
     };
-    std::vector<Edge> queue;  // first in, first out from `next`
+    std::vector<Edge>& queue = queue_;  // first in, first out from `next`
+    queue.clear();
     std::size_t next = 0;
     for (const auto& tri : T_)
       for (int i = 0; i < 3; ++i) {
@@ -273,15 +368,17 @@ class Retriangulator {
         if (u < w && crosses(u, w)) queue.push_back({u, w});
       }
     if (queue.empty()) throw InvalidInputError("retriangulate: a constraint leaves the triangle");
-    for (const Edge& e : queue) {
-      const auto other = constrained_.find(e);
-      if (other == constrained_.end()) continue;
+    for (std::size_t i = 0; i < queue.size(); ++i) {
+      const Edge e = queue[i];  // (the recursion below reuses the queue)
+      const int other = constrainedIndex(e);
+      if (other < 0) continue;
+      const int otherSupport = constrained_[other].support;
       // Two constraints cross: insert their crossing point, computed from
       // the end points of the two input segments they lie on, not from the
       // pieces, whose ends may be earlier crossings with far longer numbers
       // (the same point, at many times the cost where dozens of curves cross
       // in one face).
-      const Edge line = lineEnds_[support], across = lineEnds_[other->second];
+      const Edge line = lineEnds_[support], across = lineEnds_[otherSupport];
       const mpq_class oa = orientValue(across.first, across.second, line.first);
       const mpq_class ob = orientValue(across.first, across.second, line.second);
       const mpq_class t = oa / (oa - ob);
@@ -290,7 +387,7 @@ class Retriangulator {
       for (int k = 0; k < 3; ++k) x.x[k] = A.x[k] + t * (B.x[k] - A.x[k]);
       const int q = add(ExactPoint(x));
       lines_[q].add(support);
-      lines_[q].add(other->second);
+      lines_[q].add(otherSupport);
       splitEdge(e.first, e.second, q);
       insertSegment(a, q, support);
       insertSegment(q, b, support);
@@ -312,7 +409,7 @@ class Retriangulator {
     }
     if (triangleWith(a, b) < 0 && triangleWith(b, a) < 0)
       throw InvalidInputError("retriangulate: could not recover a constraint");
-    constrained_.emplace(key(a, b), support);
+    constrain(key(a, b), support);
   }
 
   // Flips edge (u, w) if the two triangles around it form a strictly convex
@@ -338,34 +435,129 @@ class Retriangulator {
   // A measure increasing with the smallest angle of triangle (a, b, c), from
   // the rounded positions: the squared sine of that angle, opposite the
   // shortest side (at most 60°, where the sine still grows with the angle).
+  // Computed from the smallest index on, so that every rotation of a
+  // triangle gets the same value (improve keeps one per triangle).
   double minAngle(int a, int b, int c) const {
+    if (b < a && b < c) {
+      std::swap(a, b);  // (b, a, c)
+      std::swap(b, c);  // (b, c, a)
+    } else if (c < a && c < b) {
+      std::swap(a, c);  // (c, b, a)
+      std::swap(b, c);  // (c, a, b)
+    }
     const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
     const double ab = (pb - pa).SquaredNorm(), bc = (pc - pb).SquaredNorm(),
                  ca = (pa - pc).SquaredNorm();
     const double cross = ((pb - pa) ^ (pc - pa)).SquaredNorm();  // 4 × area²
-    // sin² at the apex opposite the shortest side = 4 area² / (product of the two others).
+    // sin² at the apex opposite the shortest side = 4 area² / (product of the
+    // two others).
     const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
     return others > 0 ? cross / others : 0;
   }
 
-  // Max-min angle flips on unconstrained interior edges. The validity of each
-  // flip is decided exactly; only the quality comparison is approximate.
+  // neighbour_[3 t + i]: the triangle across edge i of triangle t (from
+  // corner i to i + 1), or -1 on the border.
+  void findNeighbours() {
+    const int n = int(T_.size());
+    neighbour_.assign(3 * std::size_t(n), -1);
+    // The sides listed by their first corner (a linked list per corner), so
+    // that the side back is found among the few that leave the other end.
+    firstSide_.assign(V_.size(), -1);
+    sides_.resize(3 * std::size_t(n));
+    for (int t = 0; t < n; ++t)
+      for (int i = 0; i < 3; ++i) {
+        int& first = firstSide_[T_[t][i]];
+        sides_[3 * t + i] = {first, T_[t][(i + 1) % 3], t};
+        first = 3 * t + i;
+      }
+    for (int t = 0; t < n; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const int u = T_[t][i];
+        for (int s = firstSide_[T_[t][(i + 1) % 3]]; s >= 0; s = sides_[s].next)
+          if (sides_[s].end == u) {
+            neighbour_[3 * t + i] = sides_[s].triangle;
+            break;
+          }
+      }
+  }
+
+  // The sides of t, and the sides across from them, are to be looked at again.
+  void unsettle(int t) {
+    for (int k = 0; k < 3; ++k) {
+      settled_[3 * t + k] = 0;
+      const int across = neighbour_[3 * t + k];
+      if (across < 0) continue;
+      for (int m = 0; m < 3; ++m)
+        if (neighbour_[3 * across + m] == t) settled_[3 * across + m] = 0;
+    }
+  }
+
+  // Max-min angle flips on unconstrained interior edges, in passes over the
+  // triangles' sides in order. The validity of each flip is decided
+  // exactly; only the quality comparison is approximate. An edge that keeps
+  // is settled until one of its two triangles changes: asking again would
+  // give the same answer.
   void improve() {
+    const int n = int(T_.size());
+    quality_.resize(n);
+    for (int t = 0; t < n; ++t) quality_[t] = minAngle(T_[t][0], T_[t][1], T_[t][2]);
+    findNeighbours();
+    settled_.assign(3 * std::size_t(n), 0);
     for (int pass = 0; pass < 50; ++pass) {
       bool changed = false;
-      for (std::size_t t = 0; t < T_.size(); ++t)
+      for (int t = 0; t < n; ++t)
         for (int i = 0; i < 3; ++i) {
+          if (settled_[3 * t + i]) continue;
           const int u = T_[t][i], w = T_[t][(i + 1) % 3];
-          if (constrained_.count(key(u, w))) continue;
-          const int other = triangleWith(w, u);
-          if (other < 0) continue;
-          const int p = opposite(int(t), u, w), q = opposite(other, w, u);
-          const double before = std::min(minAngle(u, w, p), minAngle(w, u, q));
-          const double after = std::min(minAngle(p, q, w), minAngle(q, p, u));
-          if (after > before * (1 + 1e-9) && flipIfConvex(u, w)) changed = true;
+          const int other = neighbour_[3 * t + i];
+          if (other < 0 || constrainedIndex(key(u, w)) >= 0) {
+            settled_[3 * t + i] = 1;
+            continue;
+          }
+          int j = 0;
+          while (T_[other][j] != w) ++j;
+          const int p = T_[t][(i + 2) % 3], q = T_[other][(j + 2) % 3];
+          // (u, w, p) and (w, u, q) are the triangles; the flip makes
+          // (p, q, w) and (q, p, u), if their quadrilateral is strictly convex.
+          // Better when both new triangles are (the second is not needed
+          // when the first is not).
+          const double needed = std::min(quality_[t], quality_[other]) * (1 + 1e-9);
+          const double first = minAngle(p, q, w);
+          const double second = first > needed ? minAngle(q, p, u) : 0;
+          if (second > needed && orient(p, q, w) > 0 && orient(q, p, u) > 0) {
+            flip(t, i, other, j);
+            quality_[t] = first;
+            quality_[other] = second;
+            changed = true;
+          } else {
+            settled_[3 * t + i] = settled_[3 * other + j] = 1;
+          }
         }
       if (!changed) return;
     }
+  }
+
+  // Flips the edge between side i of t1 and side j of t2 (see improve),
+  // keeping the neighbours.
+  void flip(int t1, int i, int t2, int j) {
+    const int u = T_[t1][i], w = T_[t1][(i + 1) % 3], p = T_[t1][(i + 2) % 3];
+    const int q = T_[t2][(j + 2) % 3];
+    const int wp = neighbour_[3 * t1 + (i + 1) % 3], pu = neighbour_[3 * t1 + (i + 2) % 3];
+    const int uq = neighbour_[3 * t2 + (j + 1) % 3], qw = neighbour_[3 * t2 + (j + 2) % 3];
+    T_[t1] = {p, q, w};
+    T_[t2] = {q, p, u};
+    const int n1[3] = {t2, qw, wp}, n2[3] = {t1, pu, uq};
+    for (int k = 0; k < 3; ++k) {
+      neighbour_[3 * t1 + k] = n1[k];
+      neighbour_[3 * t2 + k] = n2[k];
+    }
+    // p-u now borders t2, q-w t1.
+    for (int m = 0; pu >= 0 && m < 3; ++m)
+      if (neighbour_[3 * pu + m] == t1) neighbour_[3 * pu + m] = t2;
+    for (int m = 0; qw >= 0 && m < 3; ++m)
+      if (neighbour_[3 * qw + m] == t2) neighbour_[3 * qw + m] = t1;
+    unsettle(t1);
+    unsettle(t2);
   }
 
   std::vector<ExactPoint> V_;
@@ -373,7 +565,12 @@ class Retriangulator {
   std::vector<std::array<int, 3>> T_;
   // The constrained edges, each with the number of the input segment it is
   // a piece of.
-  std::map<Edge, int> constrained_;
+  struct Constrained {
+    Edge edge;
+    int support;
+    bool operator<(const Constrained& o) const { return edge < o.edge; }
+  };
+  std::vector<Constrained> constrained_;  // few: searched in order
   // The input segments' end points, and for each vertex the input segments
   // it lies on, exactly (end points, crossings, vertices found on a
   // segment): three points on one segment are collinear without asking the
@@ -381,7 +578,8 @@ class Retriangulator {
   // orientation is the slow path, and points on one curve ask it often).
   struct Lines {
     std::array<int, 4> id;
-    int n = 0;  // a vertex on more segments keeps the first four: the rest are computed
+    int n = 0;  // a vertex on more segments keeps the first four: the rest are
+                // computed
     void add(int line) {
       if (n < 4 && !has(line)) id[n++] = line;
     }
@@ -395,15 +593,36 @@ class Retriangulator {
     }
   };
   std::vector<Edge> lineEnds_;
+  // Scratch of insertSegment: the crossed edges to flip, each vertex's side
+  // of the segment.
+  std::vector<Edge> queue_;
+  static constexpr std::int8_t kUnknownSide = 2;
+  std::vector<std::int8_t> side_;
+  // Scratch of improve: per triangle its quality and neighbours, per side
+  // whether it is settled, and the sides listed by first corner.
+  std::vector<double> quality_;
+  std::vector<int> neighbour_, firstSide_;
+  struct Side {
+    int next;  // the next side from the same corner, or -1
+    int end, triangle;
+  };
+  std::vector<Side> sides_;
+  std::vector<std::uint8_t> settled_;
   std::vector<Lines> lines_;
   int axis_ = 2, sign_ = 1;
-  mutable std::unordered_map<std::uint64_t, int> exactOrientations_;  // sorted triple -> sign
+  std::array<int, 2> kept_{0, 1};  // the coordinates the projection keeps
+  bool normalKnown_ = false;
+  Point3 normal_;                // (corner 1 - corner 0) x (corner 2 - corner 0), rounded
+  double cornerDifference_ = 0;  // the largest coordinate of those differences
+  // Sorted triple -> sign; rare (only where the rounded values cannot tell).
+  mutable std::vector<std::pair<std::uint64_t, int>> exactOrientations_;
 };
 
 }  // namespace
 
 Patch retriangulate(const PatchInput& input) {
-  return Retriangulator(input).run(input);
+  thread_local Retriangulator workspace;
+  return workspace.run(input);
 }
 
 }  // namespace meshmend

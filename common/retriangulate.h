@@ -37,7 +37,9 @@ struct Patch {
 };
 
 // Throws InvalidInputError when the triangle is degenerate, a point is not
-// on it, or a segment index is out of range.
+// on it, or a segment index is out of range. Safe to call from several
+// threads at once: each thread keeps its own working storage between calls,
+// so that a patch in steady state allocates only the returned Patch.
 Patch retriangulate(const PatchInput& input);
 
 }  // namespace meshmend

@@ -401,17 +401,17 @@ class MeshSplitter {
     parallelChunks(
         order_.size(),
         [&](std::size_t begin, std::size_t end, unsigned) {
+          PatchInput in;  // one for the chunk: its storage serves every face
           for (std::size_t i = begin; i < end; ++i) {
             const std::uint32_t f = order_[i];
             const FaceWork& w = work_.at(f);
             const TrianglePoints t = at(f);
             if (collinear(t[0], t[1], t[2])) continue;  // degenerate: kept as it is (empty patch)
-            PatchInput in;
             for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(t[k]);
-            in.points.reserve(w.points.size());
+            in.points.clear();
             for (int id : w.points) in.points.push_back(table.point(id));
-            in.segments.reserve(w.segments.size());
             in.on_edges.assign(w.edges.begin(), w.edges.end());
+            in.segments.clear();
             for (const auto& s : w.segments) in.segments.push_back({3 + s[0], 3 + s[1]});
             patches_[i] = retriangulate(in);
           }
