@@ -374,10 +374,25 @@ class MeshSplitter {
     std::vector<Shared> shared;
     for (auto& [f, w] : work_) {
       const Triangle& t = triangles_[f];
-      for (std::size_t p = 0; p < w.points.size(); ++p)
+      int proper = -1;  // is the face a proper triangle (not collinear)? asked once, if needed
+      auto isProper = [&] {
+        if (proper < 0) proper = !collinear(at(f)[0], at(f)[1], at(f)[2]);
+        return proper == 1;
+      };
+      for (std::size_t p = 0; p < w.points.size(); ++p) {
+        // A point known to lie inside one edge of a proper triangle lies on
+        // no other (two edges share only a corner): the other tests are spared.
+        std::uint8_t edges = 0;
+        for (int i = 0; i < 3; ++i)
+          if (table.knownOnEdge(w.points[p], edgeRef(index_, t[i], t[(i + 1) % 3])))
+            edges |= std::uint8_t(1 << i);
+        if (edges == 0 || !isProper())
+          for (int i = 0; i < 3; ++i)
+            if (!(edges & (1 << i)) && onEdge(table, w.points[p], t[i], t[(i + 1) % 3]))
+              edges |= std::uint8_t(1 << i);
         for (int i = 0; i < 3; ++i) {
+          if (!(edges & (1 << i))) continue;
           const int a = t[i], b = t[(i + 1) % 3];
-          if (!onEdge(table, w.points[p], a, b)) continue;
           w.edges[p] |= std::uint8_t(1 << i);
           for (std::uint32_t k = offsets[row[a]]; k < offsets[row[a] + 1]; ++k) {
             const std::uint32_t g = faces[k];
@@ -388,6 +403,7 @@ class MeshSplitter {
                 shared.push_back({g, w.points[p], std::uint8_t(1 << j)});
           }
         }
+      }
     }
     for (const Shared& x : shared) work_[x.face].add(x.id, x.edges);
   }
@@ -533,9 +549,9 @@ class MeshSplitter {
   const std::vector<Point3>& points() const { return points_; }
 
  private:
-  // Is curve point `id` on the input edge (a, b) of this mesh?
+  // Is curve point `id` inside the input edge (a, b) of this mesh? (Its
+  // name, which may say so, is asked by the caller.)
   bool onEdge(const CurvePoints& table, int id, int a, int b) const {
-    if (table.knownOnEdge(id, edgeRef(index_, a, b))) return true;
     const ExactPoint& p = table.point(id);
     if (p.isInputPoint() && (p.approx() == points_[a] || p.approx() == points_[b]))
       return false;                                               // a corner: not inside the edge
