@@ -270,6 +270,7 @@ struct FaceWork {
   SmallList<int, 6> points;
   SmallList<std::uint8_t, 6> edges;           // per point: the face's edges it lies inside (bits)
   SmallList<std::array<int, 2>, 6> segments;  // indices into points
+  std::int8_t proper = -1;  // is the face a proper triangle (not collinear)? -1: not asked yet
 
   int add(int id, std::uint8_t onEdges = 0) {
     for (std::size_t i = 0; i < points.size(); ++i)
@@ -374,10 +375,9 @@ class MeshSplitter {
     std::vector<Shared> shared;
     for (auto& [f, w] : work_) {
       const Triangle& t = triangles_[f];
-      int proper = -1;  // is the face a proper triangle (not collinear)? asked once, if needed
-      auto isProper = [&] {
-        if (proper < 0) proper = !collinear(at(f)[0], at(f)[1], at(f)[2]);
-        return proper == 1;
+      auto isProper = [&, &w = w] {  // asked once, if needed
+        if (w.proper < 0) w.proper = !collinear(at(f)[0], at(f)[1], at(f)[2]);
+        return w.proper == 1;
       };
       for (std::size_t p = 0; p < w.points.size(); ++p) {
         // A point known to lie inside one edge of a proper triangle lies on
@@ -408,8 +408,8 @@ class MeshSplitter {
     for (const Shared& x : shared) work_[x.face].add(x.id, x.edges);
   }
 
-  // Re-triangulates every face that received points, in parallel.
-  void retriangulateFaces(const CurvePoints& table) {
+  // Re-triangulates every face that received points (in parallel if asked).
+  void retriangulateFaces(const CurvePoints& table, bool parallel) {
     order_.clear();
     for (const auto& [f, w] : work_) order_.push_back(f);
     std::sort(order_.begin(), order_.end());
@@ -422,7 +422,8 @@ class MeshSplitter {
             const std::uint32_t f = order_[i];
             const FaceWork& w = work_.at(f);
             const TrianglePoints t = at(f);
-            if (collinear(t[0], t[1], t[2])) continue;  // degenerate: kept as it is (empty patch)
+            if (w.proper == 0 || (w.proper < 0 && collinear(t[0], t[1], t[2])))
+              continue;  // degenerate: kept as it is (empty patch)
             for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(t[k]);
             in.points.clear();
             for (int id : w.points) in.points.push_back(table.point(id));
@@ -432,7 +433,7 @@ class MeshSplitter {
             patches_[i] = retriangulate(in);
           }
         },
-        16);
+        parallel ? 16 : order_.size() + 1);
   }
 
   // Builds the output mesh and its curve edges; `exactNew` receives the
@@ -1212,23 +1213,30 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   std::vector<OutputArrays> outputs(meshes.size());
   r.curve_edges.resize(meshes.size());
   // Each mesh's split reads only the finished curve point table (and copies
-  // the points it asks exact questions of), so meshes are split side by
-  // side: a second thread takes meshes from the same counter as this one.
+  // the points it asks exact questions of), so meshes can be split side by
+  // side: a second thread takes meshes from the same counter as this one,
+  // and each mesh's faces are re-triangulated on its thread alone (both
+  // cores are busy already). Only when the work is shared fairly evenly (as
+  // between two meshes that cross, where every curve segment goes into
+  // both) and there is enough of it to pay for a thread start (a few dozen
+  // faces); otherwise one mesh after the other, each on every core.
   std::atomic<std::size_t> nextMesh{0};
   std::vector<std::size_t> facesAdded(meshes.size(), 0);
+  bool sideBySide = false;
   auto splitMeshes = [&] {
     for (std::size_t m; (m = nextMesh++) < meshes.size();) {
       splitters[m].shareEdgePoints(table);
-      splitters[m].retriangulateFaces(table);
+      splitters[m].retriangulateFaces(table, !sideBySide);
       splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
     }
   };
-  std::size_t facesWithPoints = 0, meshesWithPoints = 0;
+  std::size_t facesWithPoints = 0, mostFacesWithPoints = 0;
   for (const MeshSplitter& s : splitters) {
     facesWithPoints += s.facesWithPoints();
-    meshesWithPoints += s.facesWithPoints() > 0;
+    mostFacesWithPoints = std::max(mostFacesWithPoints, s.facesWithPoints());
   }
-  if (meshesWithPoints > 1 && facesWithPoints >= 32) {  // worth a thread start
+  if (facesWithPoints >= 32 && 3 * mostFacesWithPoints <= 2 * facesWithPoints) {
+    sideBySide = true;
     std::exception_ptr asideError;
     TaskAlongside aside([&] {
       try {
