@@ -620,7 +620,64 @@ class Retriangulator {
 
 }  // namespace
 
+namespace {
+
+// A measure that grows with the smallest angle of triangle (a, b, c), as
+// Retriangulator::minAngle's: the squared sine of the angle opposite the
+// shortest side.
+double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
+  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
+  const double cross = ((b - a) ^ (c - a)).SquaredNorm();
+  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
+  return others > 0 ? cross / others : 0;
+}
+
+// The edge whose inside a point is known to lie in (a single bit), or -1.
+int onlyEdge(std::uint8_t bits) {
+  return bits == 1 ? 0 : bits == 2 ? 1 : bits == 4 ? 2 : -1;
+}
+
+// The most common patch where two surfaces cross: one segment between
+// points known to lie inside two different edges. It cuts a corner off the
+// triangle, and the rest is a convex quadrilateral (its corners are on the
+// triangle's border, none at the corner cut off) with two ways to split it;
+// the one with the larger smallest angle is what the max-min angle flips
+// reach. Every triangle is proper: no three of these points are collinear.
+// False (and `out` untouched) when the input is not of that shape.
+bool cutCorner(const PatchInput& in, Patch& out) {
+  if (!in.improve || in.points.size() != 2 || in.on_edges.size() != 2 || in.segments.size() != 1)
+    return false;
+  const std::array<int, 2> s = in.segments[0];
+  if (!((s[0] == 3 && s[1] == 4) || (s[0] == 4 && s[1] == 3))) return false;
+  const int e0 = onlyEdge(in.on_edges[0]), e1 = onlyEdge(in.on_edges[1]);
+  if (e0 < 0 || e1 < 0 || e0 == e1) return false;
+  // Around the border, in the triangle's orientation: corner a, p (inside
+  // edge k, from a to c), corner c, q (inside edge k + 1), corner b.
+  const int k = (e0 + 1) % 3 == e1 ? e0 : e1;
+  const int p = k == e0 ? 3 : 4, q = 7 - p;
+  const int a = k, c = (k + 1) % 3, b = (k + 2) % 3;
+  out.vertices = {in.corners[0], in.corners[1], in.corners[2], in.points[0], in.points[1]};
+  out.vertex_of_input = {0, 1, 2, 3, 4};
+  auto measure = [&](int x, int y, int z) {
+    return smallestAngleMeasure(out.vertices[x].approx(), out.vertices[y].approx(),
+                                out.vertices[z].approx());
+  };
+  const double throughB = std::min(measure(a, p, b), measure(p, q, b));  // diagonal p-b
+  const double throughA = std::min(measure(a, p, q), measure(a, q, b));  // diagonal a-q
+  out.triangles = {{p, c, q}};
+  if (throughB >= throughA)
+    out.triangles.insert(out.triangles.end(), {{a, p, b}, {p, q, b}});
+  else
+    out.triangles.insert(out.triangles.end(), {{a, p, q}, {a, q, b}});
+  out.constrained_edges = {{3, 4}};
+  return true;
+}
+
+}  // namespace
+
 Patch retriangulate(const PatchInput& input) {
+  Patch patch;
+  if (cutCorner(input, patch)) return patch;
   thread_local Retriangulator workspace;
   return workspace.run(input);
 }

@@ -1,7 +1,9 @@
 #include "common/retriangulate.h"
 
+#include <algorithm>
 #include <map>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -209,6 +211,54 @@ TEST(Retriangulate, RandomConstraintsAlwaysGiveValidTilings) {
       }
       EXPECT_TRUE(seen.count(b)) << "trial " << trial;
     }
+  }
+}
+
+// The triangles of a patch as a set, each rotated to start at its smallest vertex.
+std::set<std::array<int, 3>> triangleSet(const Patch& p) {
+  std::set<std::array<int, 3>> set;
+  for (std::array<int, 3> t : p.triangles) {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    set.insert(t);
+  }
+  return set;
+}
+
+TEST(Retriangulate, SegmentAcrossACornerGivesWhatTheFlipsGive) {
+  // One segment between points known to lie inside two edges (the common
+  // patch where surfaces cross, which has a shortcut): the same triangles as
+  // when the points arrive without saying which edges they are on (the
+  // general insertion, constraint recovery and max-min angle flips), for
+  // every pair of edges, both segment directions and points near corners.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> numerator(1, 99);
+  for (int trial = 0; trial < 600; ++trial) {
+    const int k = trial % 3, direction = (trial / 3) % 2;
+    const mpq_class s(numerator(rng), 100), t(numerator(rng), 100);
+    // Inside edge k (corner k to k + 1) and inside edge k + 1.
+    auto onEdge = [&](int edge, const mpq_class& f) {
+      RationalPoint x;
+      const RationalPoint &a = kTri[edge], &b = kTri[(edge + 1) % 3];
+      for (int c = 0; c < 3; ++c) x.x[c] = a.x[c] + f * (b.x[c] - a.x[c]);
+      return x;
+    };
+    std::vector<RationalPoint> points{onEdge(k, s), onEdge((k + 1) % 3, t)};
+    std::vector<std::uint8_t> edges{std::uint8_t(1 << k), std::uint8_t(1 << (k + 1) % 3)};
+    if (trial % 4 == 0) {  // the points listed the other way round
+      std::swap(points[0], points[1]);
+      std::swap(edges[0], edges[1]);
+    }
+    PatchInput unknown =
+        input(points, {direction ? std::array<int, 2>{3, 4} : std::array<int, 2>{4, 3}});
+    PatchInput known = unknown;
+    known.on_edges = edges;
+    const Patch fast = retriangulate(known), general = retriangulate(unknown);
+    ASSERT_EQ(fast.triangles.size(), 3u);
+    expectValidTiling(fast);
+    EXPECT_EQ(triangleSet(fast), triangleSet(general)) << "trial " << trial;
+    ASSERT_EQ(fast.constrained_edges.size(), 1u);
+    EXPECT_EQ(fast.constrained_edges[0], (std::array<int, 2>{3, 4}));
+    EXPECT_EQ(fast.vertex_of_input, general.vertex_of_input);
   }
 }
 
