@@ -85,27 +85,24 @@ struct Candidates {
 Candidates facesTouching(const Soup& s, const Box& other) {
   // A face whose corners all lie beyond the float next to a side of `other`
   // has its box (rounded outward, never past that float) beyond the side:
-  // turned away in double, its box is never made. The rest are decided on
-  // their boxes, as the search sees them.
+  // turned away in double, by one bit per corner and side, its box is never
+  // made. The rest are decided on their boxes, as the search sees them.
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k) {
     lo[k] = std::nextafter(other.lo[k], -INFINITY);
     hi[k] = std::nextafter(other.hi[k], INFINITY);
   }
+  std::vector<std::uint8_t> beyond(s.points.size());
+  for (std::size_t v = 0; v < s.points.size(); ++v) {
+    const Point3& p = s.points[v];
+    beyond[v] = std::uint8_t((p[0] < lo[0]) | (p[0] > hi[0]) << 1 | (p[1] < lo[1]) << 2 |
+                             (p[1] > hi[1]) << 3 | (p[2] < lo[2]) << 4 | (p[2] > hi[2]) << 5);
+  }
   Candidates c;
   for (std::size_t f = 0; f < s.triangles.size(); ++f) {
-    if (s.degenerate[f]) continue;
-    const Point3 &p = s.corner(std::uint32_t(f), 0), &q = s.corner(std::uint32_t(f), 1),
-                 &r = s.corner(std::uint32_t(f), 2);
-    Point3 mn, mx;
-    bool beyond = false;
-    for (int k = 0; k < 3 && !beyond; ++k) {
-      mn[k] = std::min({p[k], q[k], r[k]});
-      mx[k] = std::max({p[k], q[k], r[k]});
-      beyond = mn[k] > hi[k] || mx[k] < lo[k];
-    }
-    if (beyond) continue;
-    const Box box = boxOf(mn, mx, mx);
+    const Triangle& t = s.triangles[f];
+    if ((beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) || s.degenerate[f]) continue;
+    const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
     if (!overlap(box, other)) continue;
     c.faces.push_back(std::uint32_t(f));
     c.boxes.push_back(box);
