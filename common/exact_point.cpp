@@ -12,18 +12,6 @@ namespace meshmend {
 
 namespace {
 
-// det[s-r, t-r, p-r]
-Interval orient3dInterval(const Point3& r, const Point3& s, const Point3& t, const Point3& p) {
-  Interval b[3], c[3], d[3];
-  for (int k = 0; k < 3; ++k) {
-    b[k] = Interval(s[k]) - r[k];
-    c[k] = Interval(t[k]) - r[k];
-    d[k] = Interval(p[k]) - r[k];
-  }
-  return b[0] * (c[1] * d[2] - c[2] * d[1]) - b[1] * (c[0] * d[2] - c[2] * d[0]) +
-         b[2] * (c[0] * d[1] - c[1] * d[0]);
-}
-
 Interval orient2dInterval(const Point3& a, const Point3& b, const Point3& c, int axis) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   return (Interval(b[u]) - a[u]) * (Interval(c[v]) - a[v]) -
@@ -49,6 +37,28 @@ void enclose(const Interval3& x, Point3& approx, double& error) {
 }
 
 }  // namespace
+
+PlaneInterval::PlaneInterval(const Point3& r, const Point3& s, const Point3& t) : r_(r) {
+  for (int k = 0; k < 3; ++k) {
+    b_[k] = Interval(s[k]) - r[k];
+    c_[k] = Interval(t[k]) - r[k];
+  }
+}
+
+Interval PlaneInterval::operator()(const Point3& p) const {
+  const Interval *b = b_, *c = c_;
+  Interval d[3];
+  for (int k = 0; k < 3; ++k) d[k] = Interval(p[k]) - r_[k];
+  return b[0] * (c[1] * d[2] - c[2] * d[1]) - b[1] * (c[0] * d[2] - c[2] * d[0]) +
+         b[2] * (c[0] * d[1] - c[1] * d[0]);
+}
+
+Interval3 PlaneInterval::normal() const {
+  Interval3 n;
+  for (int k = 0; k < 3; ++k)
+    n[k] = b_[(k + 1) % 3] * c_[(k + 2) % 3] - b_[(k + 2) % 3] * c_[(k + 1) % 3];
+  return n;
+}
 
 RationalPoint rationalOf(const Point3& p) {
   return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
@@ -118,10 +128,15 @@ Interval3 onSegmentAt(const Point3& p, const Point3& q, const Interval& lambda) 
 
 ExactPoint ExactPoint::edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
                                  const Point3& t) {
+  const PlaneInterval plane(r, s, t);
+  return edgePlane(p, q, r, s, t, plane(p), plane(q));
+}
+
+ExactPoint ExactPoint::edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                                 const Point3& t, const Interval& sp, const Interval& sq) {
   ExactPoint e;
   e.kind_ = Kind::kEdgePlane;
   e.definition_ = {p, q, r, s, t};
-  const Interval sp = orient3dInterval(r, s, t, p), sq = orient3dInterval(r, s, t, q);
   e.approximate(onSegmentAt(p, q, sp / (sp - sq)));
   return e;
 }

@@ -24,6 +24,22 @@ struct RationalPoint {
   std::array<mpq_class, 3> x;
 };
 
+// det[s-r, t-r, p-r] in interval arithmetic for one plane (r, s, t) and many
+// points p: the plane's edge vectors are computed once. Every construction
+// on the plane evaluates it through this class, so a caller that shares one
+// gets values identical to edgePlane's own.
+class PlaneInterval {
+ public:
+  PlaneInterval(const Point3& r, const Point3& s, const Point3& t);
+  Interval operator()(const Point3& p) const;
+  // (s-r) x (t-r)
+  Interval3 normal() const;
+
+ private:
+  Point3 r_;
+  Interval b_[3], c_[3];  // s-r, t-r
+};
+
 class ExactPoint {
  public:
   ExactPoint() = default;
@@ -34,6 +50,10 @@ class ExactPoint {
   // strictly on opposite sides of that plane.
   static ExactPoint edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
                               const Point3& t);
+  // The same given sp, sq = PlaneInterval(r, s, t) of p and q (a caller
+  // building several points on one plane evaluates each corner once).
+  static ExactPoint edgePlane(const Point3& p, const Point3& q, const Point3& r, const Point3& s,
+                              const Point3& t, const Interval& sp, const Interval& sq);
   // Coplanar: where segment pq crosses the line through r and s, in the
   // projection that drops `axis`; p and q strictly on opposite sides of it.
   static ExactPoint edgeLine(const Point3& p, const Point3& q, const Point3& r, const Point3& s,

@@ -26,13 +26,29 @@ double msSince(Clock::time_point t) {
 struct Soup {
   const std::vector<Point3>& points;
   const std::vector<Triangle>& triangles;
-  std::vector<Box> boxes;
   std::vector<char> degenerate;
-  std::vector<PlaneSide> planes;  // per face: exact side of points against its plane
+  Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
+  // Only for the search within the mesh (`withTree`): every face's box and
+  // its exact plane sides.
+  std::vector<Box> boxes;
+  std::vector<PlaneSide> planes;
 
-  // `withPlanes`: also prepare the exact plane sides of every face (needed
-  // for faces that are tested against many others).
-  Soup(const MeshArrays& mesh, bool withPlanes) : points(mesh.points), triangles(mesh.triangles) {
+  Soup(const MeshArrays& mesh, bool withTree) : points(mesh.points), triangles(mesh.triangles) {
+    Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
+    for (const Point3& p : points)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], p[k]);
+        hi[k] = std::max(hi[k], p[k]);
+      }
+    if (!points.empty()) bounds = boxOf(lo, hi, hi);
+    degenerate.resize(triangles.size());
+    if (!withTree) {
+      for (std::size_t f = 0; f < triangles.size(); ++f) {
+        const Triangle& t = triangles[f];
+        degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
+      }
+      return;
+    }
     // Each point rounded to float once (about six faces share it), then
     // each face's box from its corners'.
     std::vector<Box> pointBoxes(points.size());
@@ -40,15 +56,14 @@ struct Soup {
       for (std::size_t v = begin; v < end; ++v) pointBoxes[v] = boxOf(points[v]);
     });
     boxes.resize(triangles.size());
-    degenerate.resize(triangles.size());
-    if (withPlanes) planes.resize(triangles.size());
+    planes.resize(triangles.size());
     parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
         const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
         boxes[f] = hull(pointBoxes[t[0]], pointBoxes[t[1]], pointBoxes[t[2]]);
         degenerate[f] = collinear(a, b, c);
-        if (withPlanes) planes[f] = PlaneSide(a, b, c);
+        planes[f] = PlaneSide(a, b, c);
       }
     });
   }
@@ -58,6 +73,42 @@ struct Soup {
     return {points[t[0]], points[t[1]], points[t[2]]};
   }
 };
+
+// The faces of a mesh that may meet another mesh: not degenerate, their box
+// overlapping the other's bounds. Only these enter the search between the
+// two; on small pairs that meet along a curve they are a small part of each.
+struct Candidates {
+  std::vector<std::uint32_t> faces;
+  std::vector<Box> boxes;  // parallel to faces
+};
+
+Candidates facesTouching(const Soup& s, const Box& other) {
+  // A face whose corners all lie beyond the float next to a side of `other`
+  // has its box (rounded outward, never past that float) beyond the side:
+  // turned away in double, by one bit per corner and side, its box is never
+  // made. The rest are decided on their boxes, as the search sees them.
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::nextafter(other.lo[k], -INFINITY);
+    hi[k] = std::nextafter(other.hi[k], INFINITY);
+  }
+  std::vector<std::uint8_t> beyond(s.points.size());
+  for (std::size_t v = 0; v < s.points.size(); ++v) {
+    const Point3& p = s.points[v];
+    beyond[v] = std::uint8_t((p[0] < lo[0]) | (p[0] > hi[0]) << 1 | (p[1] < lo[1]) << 2 |
+                             (p[1] > hi[1]) << 3 | (p[2] < lo[2]) << 4 | (p[2] > hi[2]) << 5);
+  }
+  Candidates c;
+  for (std::size_t f = 0; f < s.triangles.size(); ++f) {
+    const Triangle& t = s.triangles[f];
+    if ((beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) || s.degenerate[f]) continue;
+    const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
+    if (!overlap(box, other)) continue;
+    c.faces.push_back(std::uint32_t(f));
+    c.boxes.push_back(box);
+  }
+  return c;
+}
 
 // Are all three corners of face g of `gs` strictly on one side of the plane
 // of face f of `fs`?
@@ -133,30 +184,34 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
         throw InvalidInputError("mesh " + std::to_string(m) + " has a non-finite coordinate");
   }
   reportProgress(options.progress, 0, "Preparing boxes");
-  // A mesh needs a tree (and exact plane sides) for its self-intersections,
-  // or when it is the smaller of a pair: the larger one's faces query it.
-  std::vector<bool> needsTree(n, options.self);
-  if (options.cross)
-    for (std::size_t m = 0; m < n; ++m)
-      for (std::size_t k = m + 1; k < n; ++k)
-        needsTree[meshes[m]->triangles.size() > meshes[k]->triangles.size() ? k : m] = true;
+  // Each mesh gets a tree (and every face's box and plane) only for its
+  // self-intersections; the search between meshes builds its own over the
+  // faces near the other mesh.
   std::vector<Soup> soups;
   soups.reserve(n);
-  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m], needsTree[m]);
+  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m], options.self);
+  // A pair found between meshes keeps the plane sides its test computed:
+  // the contact classification needs the same ones.
+  struct Found {
+    IntersectingPair pair;
+    std::int8_t side[2][3];  // as PlaneSides, for (pair.a, pair.b)
+    bool sidesKnown;
+  };
   // Per-worker results, each on its own cache line (no false sharing).
   struct alignas(64) WorkerFindings {
-    std::vector<IntersectingPair> pairs;
+    std::vector<Found> pairs;
     std::size_t candidates = 0;
   };
   std::vector<WorkerFindings> found(workerCount());
 
   const auto buildStart = Clock::now();
   std::vector<BoxTree> trees;
-  trees.reserve(n);
-  for (std::size_t m = 0; m < n; ++m)
-    trees.emplace_back(
-        needsTree[m] ? soups[m].boxes : std::vector<Box>(),
-        options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
+  if (options.self) {
+    trees.reserve(n);
+    for (std::size_t m = 0; m < n; ++m)
+      trees.emplace_back(soups[m].boxes, options.layout == 1 ? BoxTree::Layout::kMorton
+                                                             : BoxTree::Layout::kMedianSplit);
+  }
   r.build_ms = msSince(buildStart);
 
   const auto searchStart = Clock::now();
@@ -168,38 +223,69 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
         if (s.degenerate[f] || s.degenerate[g]) return;
         ++found[worker].candidates;
         if (selfIntersect(s, f, g))
-          found[worker].pairs.push_back({{std::uint32_t(m), f}, {std::uint32_t(m), g}});
+          found[worker].pairs.push_back(
+              {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
       });
     }
   if (options.cross)
     for (std::size_t m = 0; m < n; ++m)
       for (std::size_t k = m + 1; k < n; ++k) {
         reportProgress(options.progress, 50, "Intersections between meshes");
-        // Query the faces of the larger mesh against the tree of the smaller.
-        const bool swap = meshes[m]->triangles.size() > meshes[k]->triangles.size();
-        const std::size_t small = swap ? k : m, large = swap ? m : k;
+        if (!overlap(soups[m].bounds, soups[k].bounds)) continue;
+        Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
+                              facesTouching(soups[k], soups[m].bounds)};
+        // A tree over the smaller set of candidates, queried by the other's.
+        const bool swap = near[0].faces.size() > near[1].faces.size();
+        const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];
+        const std::uint32_t small = std::uint32_t(swap ? k : m),
+                            large = std::uint32_t(swap ? m : k);
+        if (sc.faces.empty()) continue;
         const Soup &s = soups[small], &l = soups[large];
-        const Box& smallBounds = trees[small].bounds();
-        // Most faces of a large mesh lie inside the smaller one's bounds but
+        const auto treeStart = Clock::now();
+        // Many faces of a large mesh lie inside the smaller one's bounds but
         // far from its faces: a coarse grid of those turns them away before
         // a tree descent (for a small mesh, its set-up would cost more).
         std::unique_ptr<BoxGrid> nearSmall;
-        if (l.triangles.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(s.boxes);
+        if (lc.faces.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(sc.boxes);
+        const BoxTree tree(sc.boxes, options.layout == 1 ? BoxTree::Layout::kMorton
+                                                         : BoxTree::Layout::kMedianSplit);
+        std::vector<PlaneSide> planes(sc.faces.size());
+        for (std::size_t i = 0; i < sc.faces.size(); ++i) {
+          const TrianglePoints t = s.at(sc.faces[i]);
+          planes[i] = PlaneSide(t[0], t[1], t[2]);
+        }
+        r.build_ms += msSince(treeStart);
         parallelChunks(
-            l.triangles.size(),
+            lc.faces.size(),
             [&](std::size_t begin, std::size_t end, unsigned worker) {
-              for (std::size_t g = begin; g < end; ++g) {
-                if (l.degenerate[g] || !overlap(l.boxes[g], smallBounds)) continue;
-                if (nearSmall && !nearSmall->touches(l.boxes[g])) continue;
-                const TrianglePoints tg = l.at(std::uint32_t(g));
-                trees[small].query(l.boxes[g], worker, [&](std::uint32_t f, unsigned w) {
-                  if (s.degenerate[f]) return;
+              for (std::size_t i = begin; i < end; ++i) {
+                if (nearSmall && !nearSmall->touches(lc.boxes[i])) continue;
+                const std::uint32_t g = lc.faces[i];
+                const TrianglePoints tg = l.at(g);
+                PlaneSide planeOfG;  // made when a face first reaches g's plane
+                bool planeOfGMade = false;
+                tree.query(lc.boxes[i], worker, [&](std::uint32_t j, unsigned w) {
                   ++found[w].candidates;
-                  if (strictlyBeside(s, f, l, std::uint32_t(g)) || !trianglesIntersect(s.at(f), tg))
+                  // side[0]: f's corners against g's plane; side[1]: g's against f's.
+                  PlaneSides side;
+                  for (int c = 0; c < 3; ++c) side[1][c] = planes[j](tg[c]);
+                  if (side[1][0] != 0 && side[1][1] == side[1][0] && side[1][2] == side[1][0])
                     return;
-                  FaceRef a{std::uint32_t(small), f}, b{std::uint32_t(large), std::uint32_t(g)};
-                  if (b < a) std::swap(a, b);
-                  found[w].pairs.push_back({a, b});
+                  if (!planeOfGMade) {
+                    planeOfG = PlaneSide(tg[0], tg[1], tg[2]);
+                    planeOfGMade = true;
+                  }
+                  const std::uint32_t f = sc.faces[j];
+                  const TrianglePoints tf = s.at(f);
+                  for (int c = 0; c < 3; ++c) side[0][c] = planeOfG(tf[c]);
+                  if (!trianglesIntersect(tf, tg, side)) return;
+                  Found x{{{small, f}, {large, g}}, {}, true};
+                  const bool flip = x.pair.b < x.pair.a;
+                  if (flip) std::swap(x.pair.a, x.pair.b);
+                  for (int t = 0; t < 2; ++t)
+                    for (int c = 0; c < 3; ++c)
+                      x.side[t][c] = std::int8_t(side[flip ? 1 - t : t][c]);
+                  found[w].pairs.push_back(x);
                 });
               }
             },
@@ -207,14 +293,16 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
       }
   r.search_ms = msSince(searchStart);
 
+  std::vector<Found> all;
   for (std::size_t w = 0; w < found.size(); ++w) {
-    r.pairs.insert(r.pairs.end(), found[w].pairs.begin(), found[w].pairs.end());
+    all.insert(all.end(), found[w].pairs.begin(), found[w].pairs.end());
     r.candidate_pairs += found[w].candidates;
   }
-  std::sort(r.pairs.begin(), r.pairs.end(),
-            [](const IntersectingPair& x, const IntersectingPair& y) {
-              return x.a < y.a || (x.a == y.a && x.b < y.b);
-            });
+  std::sort(all.begin(), all.end(), [](const Found& x, const Found& y) {
+    return x.pair.a < y.pair.a || (x.pair.a == y.pair.a && x.pair.b < y.pair.b);
+  });
+  r.pairs.reserve(all.size());
+  for (const Found& x : all) r.pairs.push_back(x.pair);
 
   r.self_pairs.assign(n, 0);
   r.self_faces.assign(n, 0);
@@ -250,17 +338,27 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
 
   if (options.contacts) {
     reportProgress(options.progress, 80, "Intersection segments");
-    r.contacts.resize(r.pairs.size());
+    r.contacts.resize(all.size());
+    // A pair takes some ten thousand instructions: a second thread pays for
+    // its start only from a few hundred pairs on.
     parallelChunks(
-        r.pairs.size(),
+        all.size(),
         [&](std::size_t begin, std::size_t end, unsigned) {
           for (std::size_t i = begin; i < end; ++i) {
-            const IntersectingPair& p = r.pairs[i];
-            r.contacts[i] =
-                classifyContact(soups[p.a.mesh].at(p.a.face), soups[p.b.mesh].at(p.b.face));
+            const Found& x = all[i];
+            const TrianglePoints a = soups[x.pair.a.mesh].at(x.pair.a.face);
+            const TrianglePoints b = soups[x.pair.b.mesh].at(x.pair.b.face);
+            if (!x.sidesKnown) {
+              r.contacts[i] = classifyContact(a, b);
+              continue;
+            }
+            PlaneSides side;
+            for (int t = 0; t < 2; ++t)
+              for (int c = 0; c < 3; ++c) side[t][c] = x.side[t][c];
+            r.contacts[i] = classifyContact(a, b, side);
           }
         },
-        64);
+        256);
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);

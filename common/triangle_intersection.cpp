@@ -79,11 +79,16 @@ bool segmentIntersectsTriangle(const Point3& p, const Point3& q, const TriangleP
 }
 
 bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b) {
-  int sb[3], sa[3];
-  for (int j = 0; j < 3; ++j) sb[j] = orient3d(a[0], a[1], a[2], b[j]);
-  if (strictlyOneSide(sb)) return false;
-  for (int i = 0; i < 3; ++i) sa[i] = orient3d(b[0], b[1], b[2], a[i]);
-  if (strictlyOneSide(sa)) return false;
+  PlaneSides side;
+  for (int j = 0; j < 3; ++j) side[1][j] = orient3d(a[0], a[1], a[2], b[j]);
+  if (strictlyOneSide(side[1])) return false;
+  for (int i = 0; i < 3; ++i) side[0][i] = orient3d(b[0], b[1], b[2], a[i]);
+  return trianglesIntersect(a, b, side);
+}
+
+bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b, const PlaneSides& side) {
+  const int *sa = side[0], *sb = side[1];
+  if (strictlyOneSide(sb) || strictlyOneSide(sa)) return false;
   if (sa[0] == 0 && sa[1] == 0 && sa[2] == 0)
     return trianglesIntersect2(a, b, projectionAxis(a[0], a[1], a[2]));
   // Not coplanar: an end point of the common segment lies on an edge of one
@@ -187,17 +192,10 @@ ExactPoint exactPointOf(const ContactPoint& c, const TrianglePoints& a, const Tr
 bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const int side[2][3],
                       TriangleContact& contact) {
   const TrianglePoints* T[2] = {&a, &b};
-  Interval3 n[2];
-  for (int t = 0; t < 2; ++t) {
-    const TrianglePoints& p = *T[t];
-    Interval e1[3], e2[3];
-    for (int k = 0; k < 3; ++k) {
-      e1[k] = Interval(p[1][k]) - p[0][k];
-      e2[k] = Interval(p[2][k]) - p[0][k];
-    }
-    for (int k = 0; k < 3; ++k)
-      n[t][k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
-  }
+  // Each triangle's plane serves twice: its normal gives the line's
+  // direction, and the other's edges cross it (each corner evaluated once).
+  const PlaneInterval plane[2] = {PlaneInterval(a[0], a[1], a[2]), PlaneInterval(b[0], b[1], b[2])};
+  const Interval3 n[2] = {plane[0].normal(), plane[1].normal()};
   Interval3 d;  // direction of the common line
   for (int k = 0; k < 3; ++k)
     d[k] = n[0][(k + 1) % 3] * n[1][(k + 2) % 3] - n[0][(k + 2) % 3] * n[1][(k + 1) % 3];
@@ -208,7 +206,14 @@ bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const in
   };
   Candidate part[2][2];
   int count[2] = {0, 0}, zeros[2] = {0, 0};
-  for (int t = 0; t < 2; ++t)
+  for (int t = 0; t < 2; ++t) {
+    const TrianglePoints &own = *T[t], &other = *T[1 - t];
+    Interval cornerSide[3];
+    bool evaluated[3] = {false, false, false};
+    auto sideOf = [&](int i) -> const Interval& {
+      if (!evaluated[i]) cornerSide[i] = plane[1 - t](own[i]), evaluated[i] = true;
+      return cornerSide[i];
+    };
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3;
       const int si = side[t][i], sj = side[t][j];
@@ -220,13 +225,16 @@ bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const in
       if (si == 0) {
         c.tag.kind = ContactPoint::Kind::kVertex;
         ++zeros[t];
+        c.point = ExactPoint(own[i]);
       } else {
         c.tag.kind = ContactPoint::Kind::kEdgeFace;
+        c.point = ExactPoint::edgePlane(own[i], own[j], other[0], other[1], other[2], sideOf(i),
+                                        sideOf(j));
       }
-      c.point = exactPointOf(c.tag, a, b);
       const Interval3 x = intervalOf(c.point);
       c.key = d[0] * x[0] + d[1] * x[1] + d[2] * x[2];
     }
+  }
   const Candidate *lo[2], *hi[2];
   for (int t = 0; t < 2; ++t) {
     if (count[t] != 2) return false;  // touching at a corner: exactly
@@ -259,6 +267,8 @@ bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const in
   if (!(start->key.hi < end->key.lo)) return false;
   contact.kind =
       (zeros[0] == 2 || zeros[1] == 2) ? ContactKind::kTouchAlongEdge : ContactKind::kCrossing;
+  contact.points.reserve(2);  // one allocation each, not a growth step per point
+  contact.exact.reserve(2);
   for (const Candidate* c : {start, end}) {
     ContactPoint p = c->tag;
     p.position = c->point.approx();
@@ -544,11 +554,16 @@ class Classifier {
 }  // namespace
 
 TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b) {
-  int side[2][3];  // corner i of triangle t against the other triangle's plane
+  PlaneSides side;
   for (int i = 0; i < 3; ++i) {
     side[0][i] = orient3d(b[0], b[1], b[2], a[i]);
     side[1][i] = orient3d(a[0], a[1], a[2], b[i]);
   }
+  return classifyContact(a, b, side);
+}
+
+TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b,
+                                const PlaneSides& side) {
   if (strictlyOneSide(side[0]) || strictlyOneSide(side[1])) return {};
   const bool coplanar = side[0][0] == 0 && side[0][1] == 0 && side[0][2] == 0;
   TriangleContact contact;

@@ -24,6 +24,14 @@ bool segmentIntersectsTriangle(const Point3& p, const Point3& q, const TriangleP
 // Exact: do the two closed, non-degenerate triangles share at least one point?
 bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b);
 
+// The exact sides of each triangle's corners against the other's plane:
+// side[0][i] = orient3d(b[0], b[1], b[2], a[i]), side[1][j] = orient3d(a[0],
+// a[1], a[2], b[j]). A caller that has them (a candidate search) passes them
+// on, so that neither test below evaluates them again.
+using PlaneSides = int[2][3];
+// trianglesIntersect given the sides.
+bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b, const PlaneSides& side);
+
 // The rule of CGAL::Polygon_mesh_processing::self_intersections for two
 // faces of one mesh that share `shared` vertices (by index): 0 -> any
 // contact; 1 -> the edge opposite the shared vertex in one triangle meets the
@@ -84,5 +92,8 @@ struct TriangleContact {
 // are classified from rounded values with error bounds; touching and
 // coplanar ones fall back to rational arithmetic.
 TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b);
+// The same given the sides.
+TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b,
+                                const PlaneSides& side);
 
 }  // namespace meshmend

@@ -136,6 +136,62 @@ TEST(Intersections, ContactsAreClassified) {
   for (int d : degree) EXPECT_EQ(d % 2, 0);
 }
 
+// Between two meshes, against every pair of faces: the pairs, their
+// contacts, and the candidates (the pairs of non-degenerate faces whose
+// boxes overlap, each tested once), also where only the boxes' rounding to
+// float makes faces of the two meshes candidates.
+void expectCrossMatchesBruteForce(const Mesh& a, const Mesh& b, std::size_t& pairs) {
+  FindIntersectionsOptions o;
+  o.self = false;
+  o.contacts = true;
+  const FindIntersectionsResult r = findIntersections({&a, &b}, o);
+  const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);
+  const std::vector<Triangle> ta = trianglesOf(a), tb = trianglesOf(b);
+  std::size_t candidates = 0, k = 0;
+  for (std::size_t f = 0; f < ta.size(); ++f)
+    for (std::size_t g = 0; g < tb.size(); ++g) {
+      const TrianglePoints x{pa[ta[f][0]], pa[ta[f][1]], pa[ta[f][2]]},
+          y{pb[tb[g][0]], pb[tb[g][1]], pb[tb[g][2]]};
+      if (collinear(x[0], x[1], x[2]) || collinear(y[0], y[1], y[2])) continue;
+      candidates += overlap(boxOf(x[0], x[1], x[2]), boxOf(y[0], y[1], y[2]));
+      if (!trianglesIntersect(x, y)) continue;
+      ASSERT_LT(k, r.pairs.size());
+      EXPECT_EQ(r.pairs[k].a, (FaceRef{0, std::uint32_t(f)}));
+      EXPECT_EQ(r.pairs[k].b, (FaceRef{1, std::uint32_t(g)}));
+      const TriangleContact c = classifyContact(x, y);
+      EXPECT_EQ(r.contacts[k].kind, c.kind);
+      ASSERT_EQ(r.contacts[k].points.size(), c.points.size());
+      for (std::size_t i = 0; i < c.points.size(); ++i)
+        EXPECT_EQ(r.contacts[k].points[i].position, c.points[i].position);
+      ++k;
+    }
+  EXPECT_EQ(r.pairs.size(), k);
+  EXPECT_EQ(r.candidate_pairs, candidates);
+  pairs = k;
+}
+
+TEST(Intersections, BetweenMeshesMatchesBruteForceAtTheEdgeOfTheirBounds) {
+  const Mesh a = box();
+  std::size_t pairs = 0;
+  // Touching along the plane x = 1: coplanar faces and faces meeting it in an edge.
+  expectCrossMatchesBruteForce(a, moved(box(), {1, 0.25, 0.5}), pairs);
+  EXPECT_GT(pairs, 0u);
+  // Apart by one double step, or by less than a float step: no contact, but
+  // the float boxes of the faces near x = 1 still overlap.
+  for (const double gap : {std::nextafter(1.0, 2.0) - 1, 1e-9}) {
+    const Mesh b = moved(box(), {1 + gap, 0.25, 0.5});
+    expectCrossMatchesBruteForce(a, b, pairs);
+    EXPECT_EQ(pairs, 0u);
+    EXPECT_GT(findIntersections({&a, &b}).candidate_pairs, 0u);
+  }
+  // Crossing spheres of different resolutions, each mesh passed first.
+  const Mesh s = uvSphere(12, 18), t = uvSphere(7, 9, 0.6, {0.9, 0.1, 0.05});
+  expectCrossMatchesBruteForce(s, t, pairs);
+  EXPECT_GT(pairs, 0u);
+  expectCrossMatchesBruteForce(t, s, pairs);
+  EXPECT_GT(pairs, 0u);
+}
+
 TEST(Intersections, BadInput) {
   const Mesh empty;
   EXPECT_THROW(findIntersections({&empty}), InvalidInputError);
