@@ -255,6 +255,8 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
           planes[i] = PlaneSide(t[0], t[1], t[2]);
         }
         r.build_ms += msSince(treeStart);
+        // A query face costs about a microsecond (a descent and its
+        // candidates' tests): a second thread from a few hundred each.
         parallelChunks(
             lc.faces.size(),
             [&](std::size_t begin, std::size_t end, unsigned worker) {
@@ -289,7 +291,7 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
                 });
               }
             },
-            1024);
+            256);
       }
   r.search_ms = msSince(searchStart);
 
@@ -339,8 +341,9 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   if (options.contacts) {
     reportProgress(options.progress, 80, "Intersection segments");
     r.contacts.resize(all.size());
-    // A pair takes some ten thousand instructions: a second thread pays for
-    // its start only from a few hundred pairs on.
+    // A pair takes some ten thousand instructions (a few microseconds): a
+    // second thread, which takes tens of microseconds to start, pays for
+    // itself from a few dozen pairs each on.
     parallelChunks(
         all.size(),
         [&](std::size_t begin, std::size_t end, unsigned) {
@@ -358,7 +361,7 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
             r.contacts[i] = classifyContact(a, b, side);
           }
         },
-        256);
+        48);
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);
