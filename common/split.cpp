@@ -1220,14 +1220,17 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // between two meshes that cross, where every curve segment goes into
   // both) and there is enough of it to pay for a thread start (a few dozen
   // faces); otherwise one mesh after the other, each on every core.
+  // Without snapping, which rebuilds them, each mesh's output is final once
+  // built, and side by side its thread makes its vcglib mesh too.
   std::atomic<std::size_t> nextMesh{0};
   std::vector<std::size_t> facesAdded(meshes.size(), 0);
-  bool sideBySide = false;
+  bool sideBySide = false, separateBuilt = false;
   auto splitMeshes = [&] {
     for (std::size_t m; (m = nextMesh++) < meshes.size();) {
       splitters[m].shareEdgePoints(table);
       splitters[m].retriangulateFaces(table, !sideBySide);
       splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
+      if (separateBuilt) outputs[m].toMesh(r.meshes[m]);
     }
   };
   std::size_t facesWithPoints = 0, mostFacesWithPoints = 0;
@@ -1237,6 +1240,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
   if (facesWithPoints >= 32 && 3 * mostFacesWithPoints <= 2 * facesWithPoints) {
     sideBySide = true;
+    separateBuilt = options.separate_meshes && options.snap_tolerance <= 0;
+    if (separateBuilt) r.meshes.resize(meshes.size());
     std::exception_ptr asideError;
     TaskAlongside aside([&] {
       try {
@@ -1266,11 +1271,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // from them), so it needs them even when the merged mesh is not asked for.
   const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
-  // Without snapping, each input's output is final here: vcglib meshes are
-  // built on a second thread while the merged one is made (without it,
-  // while the curves are counted and the last input's is built here), once
-  // there are enough faces to pay for starting a thread (a few thousand
-  // faces take a few hundred microseconds; a thread start, tens).
+  // Without snapping, each input's output is final here: unless built
+  // already, vcglib meshes are built on a second thread while the merged
+  // one is made (without it, while the curves are counted and the last
+  // input's is built here), once there are enough faces to pay for starting
+  // a thread (a few thousand faces take a few hundred microseconds; a thread
+  // start, tens).
   std::size_t outputFaces = 0;
   for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
   const std::size_t builtAside =
@@ -1278,7 +1284,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   std::thread separateBuilder;
   std::exception_ptr separateError;
   if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096 &&
-      builtAside > 0) {
+      builtAside > 0 && !separateBuilt) {
     r.meshes.resize(meshes.size());
     try {
       separateBuilder = std::thread([&] {
@@ -1304,7 +1310,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       separateBuilder.join();
       if (separateError) std::rethrow_exception(separateError);
       for (std::size_t m = builtAside; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
-    } else if (options.separate_meshes) {
+    } else if (options.separate_meshes && !separateBuilt) {
       r.meshes.resize(meshes.size());
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
