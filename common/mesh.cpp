@@ -42,6 +42,14 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
   return std::atan2((u ^ v).Norm(), u * v);
 }
 
+double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
+  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
+  const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
+  // sin² at the apex opposite the shortest side = 4 area² / (product of the two others).
+  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
+  return others > 0 ? cross / others : 0;
+}
+
 bool isFinite(const Point3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }

@@ -132,6 +132,11 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh);
 // opposite the shortest side (one atan2 instead of three).
 double smallestAngle(const Point3& a, const Point3& b, const Point3& c);
 
+// A measure that grows with the smallest angle of triangle (a, b, c), cheaper
+// than the angle: the squared sine of the angle opposite the shortest side
+// (at most 60°, where the sine still grows), 0 when degenerate.
+double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c);
+
 bool isFinite(const Point3& p);
 
 // `p` as MeshLab stores it: each coordinate rounded to float.

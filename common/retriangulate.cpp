@@ -432,9 +432,7 @@ class Retriangulator {
     return -1;
   }
 
-  // A measure increasing with the smallest angle of triangle (a, b, c), from
-  // the rounded positions: the squared sine of that angle, opposite the
-  // shortest side (at most 60°, where the sine still grows with the angle).
+  // smallestAngleMeasure of triangle (a, b, c), from the rounded positions.
   // Computed from the smallest index on, so that every rotation of a
   // triangle gets the same value (improve keeps one per triangle).
   double minAngle(int a, int b, int c) const {
@@ -445,14 +443,7 @@ class Retriangulator {
       std::swap(a, c);  // (c, b, a)
       std::swap(b, c);  // (c, a, b)
     }
-    const Point3 &pa = V_[a].approx(), &pb = V_[b].approx(), &pc = V_[c].approx();
-    const double ab = (pb - pa).SquaredNorm(), bc = (pc - pb).SquaredNorm(),
-                 ca = (pa - pc).SquaredNorm();
-    const double cross = ((pb - pa) ^ (pc - pa)).SquaredNorm();  // 4 × area²
-    // sin² at the apex opposite the shortest side = 4 area² / (product of the
-    // two others).
-    const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
-    return others > 0 ? cross / others : 0;
+    return smallestAngleMeasure(V_[a].approx(), V_[b].approx(), V_[c].approx());
   }
 
   // neighbour_[3 t + i]: the triangle across edge i of triangle t (from
@@ -621,16 +612,6 @@ class Retriangulator {
 }  // namespace
 
 namespace {
-
-// A measure that grows with the smallest angle of triangle (a, b, c), as
-// Retriangulator::minAngle's: the squared sine of the angle opposite the
-// shortest side.
-double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
-  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
-  const double cross = ((b - a) ^ (c - a)).SquaredNorm();
-  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
-  return others > 0 ? cross / others : 0;
-}
 
 // The edge whose inside a point is known to lie in (a single bit), or -1.
 int onlyEdge(std::uint8_t bits) {

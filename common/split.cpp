@@ -49,16 +49,6 @@ Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Poin
   return {wa, wb, 1 - wa - wb};
 }
 
-// A measure that grows with the smallest angle of triangle (a, b, c): the
-// squared sine of the angle opposite the shortest side (at most 60°, where
-// the sine still grows), 0 when degenerate. Cheaper than the angle.
-double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
-  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
-  const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
-  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
-  return others > 0 ? cross / others : 0;
-}
-
 // Has the triangle an angle under 1°?
 bool isSliver(const Point3& a, const Point3& b, const Point3& c) {
   static const double below = std::pow(std::sin(M_PI / 180), 2);
