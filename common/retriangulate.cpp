@@ -619,12 +619,14 @@ int onlyEdge(std::uint8_t bits) {
 }
 
 // The most common patch where two surfaces cross: one segment between
-// points known to lie inside two different edges. It cuts a corner off the
+// points known to lie inside two different edges of a proper triangle (the
+// bits of on_edges are trusted, as everywhere). It cuts a corner off the
 // triangle, and the rest is a convex quadrilateral (its corners are on the
-// triangle's border, none at the corner cut off) with two ways to split it;
-// the one with the larger smallest angle is what the max-min angle flips
-// reach. Every triangle is proper: no three of these points are collinear.
-// False (and `out` untouched) when the input is not of that shape.
+// triangle's border, none at the corner cut off) with two ways to split it:
+// the one the general path's insertions and max-min angle flips end with,
+// so the triangles are the same. Every triangle is proper: no three of
+// these points are collinear. False (and `out` untouched) when the input is
+// not of that shape.
 bool cutCorner(const PatchInput& in, Patch& out) {
   if (!in.improve || in.points.size() != 2 || in.on_edges.size() != 2 || in.segments.size() != 1)
     return false;
@@ -632,6 +634,11 @@ bool cutCorner(const PatchInput& in, Patch& out) {
   if (!((s[0] == 3 && s[1] == 4) || (s[0] == 4 && s[1] == 3))) return false;
   const int e0 = onlyEdge(in.on_edges[0]), e1 = onlyEdge(in.on_edges[1]);
   if (e0 < 0 || e1 < 0 || e0 == e1) return false;
+  // A degenerate triangle is the general path's to refuse.
+  for (const ExactPoint& corner : in.corners)
+    if (!corner.isInputPoint()) return false;
+  if (collinear(in.corners[0].approx(), in.corners[1].approx(), in.corners[2].approx()))
+    return false;
   // Around the border, in the triangle's orientation: corner a, p (inside
   // edge k, from a to c), corner c, q (inside edge k + 1), corner b.
   const int k = (e0 + 1) % 3 == e1 ? e0 : e1;
@@ -639,14 +646,22 @@ bool cutCorner(const PatchInput& in, Patch& out) {
   const int a = k, c = (k + 1) % 3, b = (k + 2) % 3;
   out.vertices = {in.corners[0], in.corners[1], in.corners[2], in.points[0], in.points[1]};
   out.vertex_of_input = {0, 1, 2, 3, 4};
+  // The diagonal the general path ends with: inserting the points in their
+  // order makes p-b when p comes first (a-q otherwise), and a flip needs a
+  // gain of more than 1e-9 in the measure taken from the smallest index on.
   auto measure = [&](int x, int y, int z) {
+    if (y < x && y < z)
+      std::swap(x, y), std::swap(y, z);
+    else if (z < x && z < y)
+      std::swap(x, z), std::swap(y, z);
     return smallestAngleMeasure(out.vertices[x].approx(), out.vertices[y].approx(),
                                 out.vertices[z].approx());
   };
   const double throughB = std::min(measure(a, p, b), measure(p, q, b));  // diagonal p-b
   const double throughA = std::min(measure(a, p, q), measure(a, q, b));  // diagonal a-q
+  const bool viaB = p == 3 ? !(throughA > throughB * (1 + 1e-9)) : throughB > throughA * (1 + 1e-9);
   out.triangles = {{p, c, q}};
-  if (throughB >= throughA)
+  if (viaB)
     out.triangles.insert(out.triangles.end(), {{a, p, b}, {p, q, b}});
   else
     out.triangles.insert(out.triangles.end(), {{a, p, q}, {a, q, b}});

@@ -260,6 +260,43 @@ TEST(Retriangulate, SegmentAcrossACornerGivesWhatTheFlipsGive) {
     EXPECT_EQ(fast.constrained_edges[0], (std::array<int, 2>{3, 4}));
     EXPECT_EQ(fast.vertex_of_input, general.vertex_of_input);
   }
+  // Exact ties between the two diagonals (a right isosceles triangle, points
+  // at eighths of its legs), points listed both ways: still the same.
+  const std::array<Point3, 3> right{Point3(0, 0, 0), Point3(3, 0, 0), Point3(0, 3, 0)};
+  for (int k = 0; k < 3; ++k)
+    for (int i = 1; i < 8; ++i)
+      for (int j = 1; j < 8; ++j)
+        for (int order = 0; order < 2; ++order) {
+          auto at = [&](int edge, double f) {
+            return right[edge] + (right[(edge + 1) % 3] - right[edge]) * f;
+          };
+          PatchInput unknown;
+          for (int c = 0; c < 3; ++c) unknown.corners[c] = ExactPoint(right[c]);
+          unknown.points = {ExactPoint(at(k, i / 8.0)), ExactPoint(at((k + 1) % 3, j / 8.0))};
+          std::vector<std::uint8_t> edges{std::uint8_t(1 << k), std::uint8_t(1 << (k + 1) % 3)};
+          if (order) {
+            std::swap(unknown.points[0], unknown.points[1]);
+            std::swap(edges[0], edges[1]);
+          }
+          unknown.segments = {{3, 4}};
+          PatchInput known = unknown;
+          known.on_edges = edges;
+          const Patch fast = retriangulate(known), general = retriangulate(unknown);
+          EXPECT_EQ(triangleSet(fast), triangleSet(general))
+              << "edge " << k << " at " << i << "/8 and " << j << "/8, order " << order;
+        }
+}
+
+TEST(Retriangulate, SegmentAcrossADegenerateTriangleIsRefused) {
+  // The shortcut leaves a triangle with collinear corners to the general
+  // path, which refuses it.
+  PatchInput in;
+  in.corners = {ExactPoint(Point3(0, 0, 0)), ExactPoint(Point3(2, 0, 0)),
+                ExactPoint(Point3(4, 0, 0))};
+  in.points = {ExactPoint(Point3(1, 0, 0)), ExactPoint(Point3(3, 0, 0))};
+  in.on_edges = {1, 2};
+  in.segments = {{3, 4}};
+  EXPECT_THROW(retriangulate(in), InvalidInputError);
 }
 
 }  // namespace
