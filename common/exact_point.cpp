@@ -337,6 +337,13 @@ std::vector<int> coincidentGroups(const std::vector<const ExactPoint*>& points) 
   for (std::size_t i = 0; i < n; ++i) {
     const Point3& a = points[i]->approx();
     const double e = points[i]->error();
+    if (!isFinite(a) || !std::isfinite(e)) {  // no bound: compared with every point
+      lo[i] = Point3(-INFINITY, -INFINITY, -INFINITY);
+      hi[i] = Point3(INFINITY, INFINITY, INFINITY);
+      low[i] = -INFINITY;
+      high[i] = INFINITY;
+      continue;
+    }
     double l = 0, h = 0;
     for (int k = 0; k < 3; ++k) {
       lo[i][k] = down(a[k] - e);

@@ -569,8 +569,8 @@ class Retriangulator {
   // orientation is the slow path, and points on one curve ask it often).
   struct Lines {
     std::array<int, 4> id;
-    int n = 0;  // a vertex on more segments keeps the first four: the rest are
-                // computed
+    // A vertex on more segments keeps the first four: the rest are computed.
+    int n = 0;
     void add(int line) {
       if (n < 4 && !has(line)) id[n++] = line;
     }

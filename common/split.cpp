@@ -225,7 +225,6 @@ struct OutputArrays {
   }
 };
 
-// The curve points and segments one face receives (representative ids).
 // A list that keeps its first N elements in place and only a longer one on
 // the heap: a crossed face receives a few points and segments, and an
 // allocation for each would cost more than the rest of its bookkeeping.
@@ -256,6 +255,7 @@ class SmallList {
   std::size_t size_ = 0;
 };
 
+// The curve points and segments one face receives (representative ids).
 struct FaceWork {
   SmallList<int, 6> points;
   SmallList<std::uint8_t, 6> edges;           // per point: the face's edges it lies inside (bits)
@@ -1209,7 +1209,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // cores are busy already). Only when the work is shared fairly evenly (as
   // between two meshes that cross, where every curve segment goes into
   // both) and there is enough of it to pay for a thread start (a few dozen
-  // faces); otherwise one mesh after the other, each on every core.
+  // faces); otherwise one mesh after the other, each on every core. With
+  // more than two cores, each mesh still re-triangulates on several.
   // Without snapping, which rebuilds them, each mesh's output is final once
   // built, and side by side its thread makes its vcglib mesh too.
   std::atomic<std::size_t> nextMesh{0};
@@ -1218,7 +1219,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   auto splitMeshes = [&] {
     for (std::size_t m; (m = nextMesh++) < meshes.size();) {
       splitters[m].shareEdgePoints(table);
-      splitters[m].retriangulateFaces(table, !sideBySide);
+      splitters[m].retriangulateFaces(table, !sideBySide || workerCount() > 2);
       splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
       if (separateBuilt) outputs[m].toMesh(r.meshes[m]);
     }
@@ -1238,9 +1239,15 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         splitMeshes();
       } catch (...) {
         asideError = std::current_exception();
+        nextMesh = meshes.size();  // the other thread takes no more
       }
     });
-    splitMeshes();
+    try {
+      splitMeshes();
+    } catch (...) {
+      nextMesh = meshes.size();
+      throw;
+    }
     aside.wait();
     if (asideError) std::rethrow_exception(asideError);
   } else {
@@ -1311,7 +1318,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     // curves inside a face) by comparing exactly.
     std::vector<ExactPoint> curvePoints;  // one per curve point id used, then the others
     std::vector<int> curvePointOfId(table.size(), -1);
-    std::size_t crossings = 0;  // curve vertices not at a curve point (made inside one face)
+    std::size_t notAtCurvePoints = 0;  // curve vertices without an id: crossings made in a face
     std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const OutputArrays& mesh = outputs[m];
@@ -1330,7 +1337,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
           index[v] = point;
           return;
         }
-        ++crossings;
+        ++notAtCurvePoints;
         index[v] = int(curvePoints.size());
         const std::size_t inputVertices = splitters[m].points().size();
         curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.positions[v])
@@ -1344,7 +1351,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     // Distinct curve points never coincide (the table merged those): only
     // points made inside a face can coincide with another.
     std::vector<int> weldedTo(curvePoints.size());
-    if (crossings > 0)
+    if (notAtCurvePoints > 0)
       weldedTo = coincidentGroups(curvePointers);
     else
       std::iota(weldedTo.begin(), weldedTo.end(), 0);
