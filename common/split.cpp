@@ -530,6 +530,12 @@ class MeshSplitter {
   }
 
   std::size_t facesWithPoints() const { return work_.size(); }
+  // The re-triangulation's work, roughly: the points and segments received.
+  std::size_t pointsAndSegments() const {
+    std::size_t n = 0;
+    for (const auto& [f, w] : work_) n += w.points.size() + w.segments.size();
+    return n;
+  }
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
@@ -1206,9 +1212,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // the points it asks exact questions of), so meshes can be split side by
   // side: a second thread takes meshes from the same counter as this one,
   // and each mesh's faces are re-triangulated on its thread alone (both
-  // cores are busy already). Only when the work is shared fairly evenly (as
-  // between two meshes that cross, where every curve segment goes into
-  // both) and there is enough of it to pay for a thread start (a few dozen
+  // cores are busy already). Only when the work (points and segments
+  // received, not faces: a coarse mesh's faces receive many each) is shared
+  // fairly evenly (as between two meshes that cross, where every curve
+  // segment goes into both) and there is enough of it to pay for a thread start (a few dozen
   // faces); otherwise one mesh after the other, each on every core. With
   // more than two cores, each mesh still re-triangulates on several.
   // Without snapping, which rebuilds them, each mesh's output is final once
@@ -1224,12 +1231,13 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       if (separateBuilt) outputs[m].toMesh(r.meshes[m]);
     }
   };
-  std::size_t facesWithPoints = 0, mostFacesWithPoints = 0;
+  std::size_t facesWithPoints = 0, work = 0, mostWork = 0;
   for (const MeshSplitter& s : splitters) {
     facesWithPoints += s.facesWithPoints();
-    mostFacesWithPoints = std::max(mostFacesWithPoints, s.facesWithPoints());
+    work += s.pointsAndSegments();
+    mostWork = std::max(mostWork, s.pointsAndSegments());
   }
-  if (facesWithPoints >= 32 && 3 * mostFacesWithPoints <= 2 * facesWithPoints) {
+  if (facesWithPoints >= 32 && 3 * mostWork <= 2 * work) {
     sideBySide = true;
     separateBuilt = options.separate_meshes && options.snap_tolerance <= 0;
     if (separateBuilt) r.meshes.resize(meshes.size());
