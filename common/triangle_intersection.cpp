@@ -70,6 +70,70 @@ bool strictlyOneSide(const int s[3]) {
   return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0);
 }
 
+// Two triangles a, b whose corners all lie strictly off the other's plane,
+// neither all on one side (the common case where surfaces cross). Each meets
+// the other's plane in a segment whose ends lie on the two edges at its
+// corner alone on its side, and the order of the four ends along the
+// planes' common line, direction d = n_a x n_b (n = (t1-t0) x (t2-t0)), is a
+// sign of input points, so no point needs constructing to decide it:
+//  - a's ends X1, X2 on the edges from its lone corner p to a[ia+1], a[ia+2]:
+//    X2 - X1 has the sign of -side(p) along d;
+//  - b's ends Y1, Y2 (lone corner u): Y2 - Y1 has the sign of side(u);
+//  - X on the edge from p to x, Y on the edge from u to y: Y - X has the
+//    sign of orient3d(p, x, u, y) side(p) side(u).
+// (With X = p + s(x - p), Y = u + t(y - u), s, t in (0, 1), Y - X = τd:
+// orient3d(p, x, u, y) = det[x-p, Y-p, y-u] = (τ/s) det[X-p, d, y-u]
+// = (τ/s) (n_a·(y-u)) (n_b·(X-p)), as n_a·(X-p) = 0 (Binet-Cauchy); the two
+// dot products have the signs -side(u) and -side(p). The first two follow
+// from (X1-p) x (X2-p) = s1 s2 n_a and its twin for b in the same way.)
+class CrossingOrder {
+ public:
+  struct End {
+    std::uint8_t triangle, edge;  // the end lies on edge `edge` of triangle `triangle`
+    const Point3 *from, *to;      // that edge from the lone corner to its other corner
+  };
+
+  // side as PlaneSides, all six non-zero, neither triangle strictly on one side.
+  CrossingOrder(const TrianglePoints& a, const TrianglePoints& b, const PlaneSides& side) {
+    const TrianglePoints* T[2] = {&a, &b};
+    for (int t = 0; t < 2; ++t) {
+      const int* s = side[t];
+      const int lone = s[0] == s[1] ? 2 : s[0] == s[2] ? 1 : 0;
+      sign_[t] = s[lone];
+      const TrianglePoints& own = *T[t];
+      const End first{std::uint8_t(t), std::uint8_t(lone), &own[lone], &own[(lone + 1) % 3]};
+      const End second{std::uint8_t(t), std::uint8_t((lone + 2) % 3), &own[lone],
+                       &own[(lone + 2) % 3]};
+      // second - first along d: -side(p) for a, side(u) for b.
+      const bool secondFirst = t == 0 ? sign_[0] > 0 : sign_[1] < 0;
+      lo_[t] = secondFirst ? second : first;
+      hi_[t] = secondFirst ? first : second;
+    }
+  }
+
+  const End& lo(int t) const { return lo_[t]; }
+  const End& hi(int t) const { return hi_[t]; }
+
+  // Sign of y - x along d, for ends of different triangles.
+  int compare(const End& x, const End& y) const {
+    const End &ea = x.triangle == 0 ? x : y, &eb = x.triangle == 0 ? y : x;
+    const int s = orient3d(*ea.from, *ea.to, *eb.from, *eb.to) * sign_[0] * sign_[1];
+    return x.triangle == 0 ? s : -s;
+  }
+
+  // Do the closed segments overlap?
+  bool overlap() const { return compare(lo_[0], hi_[1]) >= 0 && compare(lo_[1], hi_[0]) >= 0; }
+
+ private:
+  int sign_[2];  // side of each triangle's lone corner
+  End lo_[2], hi_[2];
+};
+
+bool allOffPlane(const PlaneSides& side) {
+  return side[0][0] != 0 && side[0][1] != 0 && side[0][2] != 0 && side[1][0] != 0 &&
+         side[1][1] != 0 && side[1][2] != 0;
+}
+
 }  // namespace
 
 bool segmentIntersectsTriangle(const Point3& p, const Point3& q, const TrianglePoints& t) {
@@ -91,6 +155,7 @@ bool trianglesIntersect(const TrianglePoints& a, const TrianglePoints& b, const 
   if (strictlyOneSide(sb) || strictlyOneSide(sa)) return false;
   if (sa[0] == 0 && sa[1] == 0 && sa[2] == 0)
     return trianglesIntersect2(a, b, projectionAxis(a[0], a[1], a[2]));
+  if (allOffPlane(side)) return CrossingOrder(a, b, side).overlap();
   // Not coplanar: an end point of the common segment lies on an edge of one
   // triangle inside the other.
   for (int i = 0; i < 3; ++i) {
@@ -274,6 +339,44 @@ bool classifyCrossing(const TrianglePoints& a, const TrianglePoints& b, const in
     p.position = c->point.approx();
     contact.points.push_back(p);
     contact.exact.push_back(c->point);
+  }
+  return true;
+}
+
+// Crossing triangles with every corner strictly off the other's plane:
+// the contact from the order of the segments' ends (CrossingOrder), only its
+// two end points constructed. The same contact as classifyCrossing's where
+// that decides; false when two ends coincide (edges of a and b meet on the
+// line: a touching configuration for the exact classification).
+bool classifyByOrder(const TrianglePoints& a, const TrianglePoints& b, const PlaneSides& side,
+                     TriangleContact& contact) {
+  const CrossingOrder order(a, b, side);
+  using End = CrossingOrder::End;
+  const int starts = order.compare(order.lo(0), order.lo(1));
+  const int ends = order.compare(order.hi(0), order.hi(1));
+  if (starts == 0 || ends == 0) return false;
+  const End& start = starts > 0 ? order.lo(1) : order.lo(0);  // the later start
+  const End& end = ends < 0 ? order.hi(1) : order.hi(0);      // the earlier end
+  contact = {};
+  if (start.triangle != end.triangle) {  // else one segment lies inside the other
+    const int length = order.compare(start, end);
+    if (length == 0) return false;
+    if (length < 0) return true;  // the segments do not overlap
+  }
+  contact.kind = ContactKind::kCrossing;
+  contact.points.reserve(2);
+  contact.exact.reserve(2);
+  const TrianglePoints* T[2] = {&a, &b};
+  for (const End* e : {&start, &end}) {
+    const TrianglePoints &own = *T[e->triangle], &other = *T[1 - e->triangle];
+    contact.exact.push_back(
+        ExactPoint::edgePlane(own[e->edge], own[(e->edge + 1) % 3], other[0], other[1], other[2]));
+    ContactPoint p;
+    p.kind = ContactPoint::Kind::kEdgeFace;
+    p.triangle = e->triangle;
+    p.index = e->edge;
+    p.position = contact.exact.back().approx();
+    contact.points.push_back(p);
   }
   return true;
 }
@@ -567,6 +670,7 @@ TriangleContact classifyContact(const TrianglePoints& a, const TrianglePoints& b
   if (strictlyOneSide(side[0]) || strictlyOneSide(side[1])) return {};
   const bool coplanar = side[0][0] == 0 && side[0][1] == 0 && side[0][2] == 0;
   TriangleContact contact;
+  if (!coplanar && allOffPlane(side) && classifyByOrder(a, b, side, contact)) return contact;
   if (!coplanar && classifyCrossing(a, b, side, contact)) return contact;
   return Classifier(a, b).run();
 }

@@ -177,6 +177,9 @@ class Generator {
           double v = grid_(rng_);
           if (mode == 1 && ulp_(rng_) == 0) v = std::nextafter(v, 10.0);
           if (mode == 2) v *= double(FLT_MAX) / 8;
+          if (mode == 3)  // every coordinate a few ulps off the grid: strict signs, near ties
+            for (int n = ulp_(rng_) - 1; n != 0; n += n > 0 ? -1 : 1)
+              v = std::nextafter(v, n > 0 ? 10.0 : -10.0);
           p[k] = v;
         }
       }
@@ -249,6 +252,46 @@ TEST(TriangleIntersection, ContactPointsAgreeWithCgalExactIntersection) {
     ++compared;
   }
   EXPECT_GT(compared, 1000);
+}
+
+// Triangles with every corner a few ulps off the other's plane, their
+// segments' ends nearly coinciding along the common line: the search's test
+// and the classification decide from orientations of input points
+// (CrossingOrder), and agree with CGAL's exact kernel.
+TEST(TriangleIntersection, NearTiesOffThePlanesAgreeWithCgal) {
+  Generator gen(99);
+  int offPlane = 0, crossing = 0;
+  for (int i = 0; i < 8000; ++i) {
+    const TrianglePoints a = gen.next(3), b = gen.next(3);
+    bool off = true;
+    for (int k = 0; k < 3; ++k)
+      off &= orient3d(a[0], a[1], a[2], b[k]) != 0 && orient3d(b[0], b[1], b[2], a[k]) != 0;
+    if (!off) continue;
+    ++offPlane;
+    const bool meet = CGAL::do_intersect(cgal<Epick>(a), cgal<Epick>(b));
+    ASSERT_EQ(trianglesIntersect(a, b), meet);
+    const TriangleContact c = classifyContact(a, b);
+    const auto result = CGAL::intersection(cgal<Epeck>(a), cgal<Epeck>(b));
+    ASSERT_EQ(c.kind == ContactKind::kNone, !result);
+    if (!result) continue;
+    std::vector<Epeck::Point_3> expected;
+    if (const auto* p = boost::get<Epeck::Point_3>(&*result)) expected = {*p};
+    if (const auto* seg = boost::get<Epeck::Segment_3>(&*result))
+      expected = {seg->source(), seg->target()};
+    ASSERT_EQ(c.points.size(), expected.size()) << toString(c.kind);
+    for (const Epeck::Point_3& e : expected) {
+      bool found = false;
+      for (const ExactPoint& p : c.exact) {
+        const RationalPoint& x = p.exact();
+        found |= x.x[0] == CGAL::exact(e.x()) && x.x[1] == CGAL::exact(e.y()) &&
+                 x.x[2] == CGAL::exact(e.z());
+      }
+      EXPECT_TRUE(found) << toString(c.kind);
+    }
+    crossing += c.kind == ContactKind::kCrossing;
+  }
+  EXPECT_GT(offPlane, 6000);
+  EXPECT_GT(crossing, 1500);
 }
 
 // Every contact point lies exactly on both triangles' planes, and its
