@@ -122,10 +122,13 @@ std::vector<EdgeUse> edgeUses(const std::vector<Triangle>& triangles) {
 WeldedArrays weldCoincident(const MeshArrays& in) {
   const std::vector<Point3>& points = in.points;
   // Each vertex goes to the first vertex with its exact coordinates, found
-  // in an open-addressing table keyed by the coordinates' bits.
+  // in an open-addressing table keyed by the coordinates' bits. An entry
+  // keeps the upper half of its hash beside the vertex index, so that a
+  // probe reads a point (anywhere in memory) only when the hashes agree.
   std::size_t capacity = 16;
   while (capacity < 2 * points.size()) capacity *= 2;
-  std::vector<int> table(capacity, -1);
+  constexpr std::uint64_t kEmpty = ~std::uint64_t(0), kIndex = 0xFFFFFFFFu;
+  std::vector<std::uint64_t> table(capacity, kEmpty);  // (hash & ~kIndex) | vertex
   auto hash = [](const Point3& p) {
     std::uint64_t h = 0;
     for (int k = 0; k < 3; ++k) {
@@ -140,17 +143,26 @@ WeldedArrays weldCoincident(const MeshArrays& in) {
   std::vector<int> target(points.size());
   WeldedArrays w;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    std::size_t slot = hash(points[i]) & (capacity - 1);
-    while (table[slot] >= 0 && !(points[table[slot]] == points[i]))
-      slot = (slot + 1) & (capacity - 1);
-    if (table[slot] < 0) {
-      table[slot] = int(i);
-      target[i] = int(i);
-    } else {
-      target[i] = table[slot];
-      ++w.vertices_merged;
+    const std::uint64_t h = hash(points[i]), tag = h & ~kIndex;
+    for (std::size_t slot = h & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {
+      const std::uint64_t entry = table[slot];
+      if (entry == kEmpty) {
+        table[slot] = tag | i;
+        target[i] = int(i);
+        break;
+      }
+      const std::size_t j = entry & kIndex;
+      if ((entry & ~kIndex) == tag && points[j] == points[i]) {
+        target[i] = int(j);
+        ++w.vertices_merged;
+        break;
+      }
     }
   }
+  w.mesh.points.reserve(points.size() - w.vertices_merged);
+  w.vertex_origin.reserve(points.size() - w.vertices_merged);
+  w.mesh.triangles.reserve(in.triangles.size());
+  w.face_origin.reserve(in.triangles.size());
   // Keep every vertex that is not a merged duplicate; renumber.
   std::vector<int> index(points.size(), -1);
   for (std::size_t v = 0; v < points.size(); ++v)

@@ -1078,29 +1078,33 @@ void rebuildSeparate(const OutputArrays& merged, const std::vector<int>& index,
 // order): the same surface twice, which would intersect itself everywhere.
 std::size_t removeDuplicateFaces(WeldedArrays& in) {
   const std::vector<Triangle>& triangles = in.mesh.triangles;
-  auto sorted = [&](std::size_t f) {
+  auto sorted = [&](std::uint32_t f) {
     Triangle t = triangles[f];
     std::sort(t.begin(), t.end());
     return t;
   };
-  // Open-addressing table of the first face with each vertex set.
-  std::size_t capacity = 16;
-  while (capacity < 2 * triangles.size()) capacity *= 2;
-  std::vector<int> table(capacity, -1);
-  std::vector<char> drop(triangles.size(), 0);
-  for (std::size_t f = 0; f < triangles.size(); ++f) {
-    const Triangle key = sorted(f);
-    std::uint64_t h = 0;
-    for (int v : key)
-      h = (h ^ std::uint64_t(std::uint32_t(v))) * 0x9E3779B97F4A7C15ull, h ^= h >> 29;
-    std::size_t slot = h & (capacity - 1);
-    while (table[slot] >= 0 && sorted(std::size_t(table[slot])) != key)
-      slot = (slot + 1) & (capacity - 1);
-    if (table[slot] < 0)
-      table[slot] = int(f);
-    else
-      drop[f] = 1;
+  // Faces with the same vertices share their smallest: the faces are listed
+  // by it (counting, in face order), and each is compared with the earlier
+  // faces kept in its list, a few at most. (A table keyed by the vertex set
+  // cost four times as much on a large mesh: every probe read another face
+  // from anywhere in memory.)
+  auto smallest = [&](const Triangle& t) { return std::size_t(std::min({t[0], t[1], t[2]})); };
+  std::vector<std::uint32_t> first(in.mesh.points.size() + 1, 0);
+  for (const Triangle& t : triangles) ++first[smallest(t) + 1];
+  for (std::size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
+  std::vector<std::uint32_t> byCorner(triangles.size());
+  {
+    std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+      byCorner[next[smallest(triangles[f])]++] = std::uint32_t(f);
   }
+  std::vector<char> drop(triangles.size(), 0);
+  for (std::size_t v = 0; v + 1 < first.size(); ++v)
+    for (std::uint32_t i = first[v] + 1; i < first[v + 1]; ++i) {
+      const Triangle key = sorted(byCorner[i]);
+      for (std::uint32_t j = first[v]; j < i && !drop[byCorner[i]]; ++j)
+        if (!drop[byCorner[j]] && sorted(byCorner[j]) == key) drop[byCorner[i]] = 1;
+    }
   std::size_t kept = 0;
   for (std::size_t f = 0; f < drop.size(); ++f)
     if (!drop[f]) {

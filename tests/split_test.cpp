@@ -272,6 +272,24 @@ TEST(Split, DuplicateFacesAreRemovedFirst) {
     EXPECT_EQ(birth[f].face, 0);  // the first of the two stays, and its pieces say so
 }
 
+TEST(Split, DuplicateFacesAreFoundAmongFacesSharingTheirSmallestCorner) {
+  // A fan around vertex 0 with the first face three times and the second
+  // twice, in other orders and orientations; a far plate to split against.
+  const Mesh fan = makeMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {-1, 1, 0}},
+                            {{0, 1, 2}, {0, 2, 3}, {2, 1, 0}, {0, 3, 4}, {3, 0, 2}, {1, 0, 2}});
+  const Mesh plate = makeMesh({{5, 5, 5}, {6, 5, 5}, {5, 6, 5}}, {{0, 1, 2}});
+  SplitOptions o;
+  o.remove_duplicate_faces = true;
+  SplitResult r = splitAlongIntersections({&fan, &plate}, o);
+  EXPECT_EQ(r.duplicate_faces_removed, 3u);
+  ASSERT_EQ(r.meshes[0].face.size(), 3u);
+  FaceOriginHandle birth = faceOrigins(r.meshes[0]);
+  std::vector<int> kept;
+  for (std::size_t f = 0; f < 3; ++f) kept.push_back(birth[f].face);
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(kept, (std::vector<int>{0, 1, 3}));  // the first of each group
+}
+
 TEST(Split, NoIntersectionLeavesTheMeshes) {
   const Mesh a = box(), b = moved(box(), {5, 0, 0});
   const SplitResult r = splitAlongIntersections({&a, &b});
