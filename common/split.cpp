@@ -1595,8 +1595,24 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   };
 
   std::size_t remaining = 0;
-  for (int pass = 0; pass <= passes; ++pass) {
-    const std::vector<std::array<std::uint32_t, 2>> crossing = intersectingOf(P, T, pairs);
+  std::vector<std::array<std::uint32_t, 2>> crossing = intersectingOf(P, T, pairs);
+  std::vector<char> moved(P.size(), 0);  // re-rounded in the last pass
+  for (int pass = 0;; ++pass) {
+    if (pass > 0) {
+      // Only pairs with a face at a vertex that moved can have changed: the
+      // others keep what the last check found.
+      auto touches = [&](std::uint32_t f) {
+        return moved[T[f][0]] | moved[T[f][1]] | moved[T[f][2]];
+      };
+      std::vector<std::array<std::uint32_t, 2>> recheck, still;
+      for (const auto& p : pairs)
+        if (touches(p[0]) || touches(p[1])) recheck.push_back(p);
+      for (const auto& p : crossing)
+        if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
+      crossing = intersectingOf(P, T, recheck);
+      crossing.insert(crossing.end(), still.begin(), still.end());
+      std::fill(moved.begin(), moved.end(), 0);
+    }
     remaining = crossing.size();
     if (remaining == 0 || pass == passes) break;
     std::set<int> candidates;
@@ -1605,8 +1621,8 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
         for (int v : T[f])
           if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
     for (int v : candidates) {
-      const Point3 e = exact[v];
-      Point3 best = P[v];
+      const Point3 e = exact[v], start = P[v];
+      Point3 best = start;
       std::size_t bestCount = localCrossings(v);
       for (int choice = 0; choice < 8 && bestCount > 0; ++choice) {
         P[v] =
@@ -1615,6 +1631,7 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
         const std::size_t n = localCrossings(v);
         if (n < bestCount) best = P[v], bestCount = n;
       }
+      moved[v] = best != start;
       P[v] = best;
     }
   }
