@@ -116,8 +116,19 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
     : boxes_(std::move(boxes)), order_(boxes_.size()) {
   std::iota(order_.begin(), order_.end(), 0u);
   if (boxes_.empty()) return;
-  if (layout == Layout::kMorton) sortByMorton();
-  buildParallel(layout == Layout::kMedianSplit);
+  if (layout == Layout::kMorton) {
+    sortByMorton();
+    buildParallel(false);
+    return;
+  }
+  centres_.resize(boxes_.size());
+  for (std::size_t i = 0; i < boxes_.size(); ++i) {
+    const Box& b = boxes_[i];
+    centres_[i] = {{b.lo[0] + b.hi[0], b.lo[1] + b.hi[1], b.lo[2] + b.hi[2]}, std::uint32_t(i)};
+  }
+  buildParallel(true);
+  for (std::size_t i = 0; i < centres_.size(); ++i) order_[i] = centres_[i].index;
+  centres_ = {};
 }
 
 // Builds the two halves of the root in parallel (for large inputs), then joins
@@ -151,9 +162,8 @@ void BoxTree::buildParallel(bool splitByMedian) {
     for (int k = 1; k < 3; ++k)
       if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
     std::nth_element(
-        order_.begin(), order_.begin() + mid, order_.end(), [&](std::uint32_t x, std::uint32_t y) {
-          return boxes_[x].lo[axis] + boxes_[x].hi[axis] < boxes_[y].lo[axis] + boxes_[y].hi[axis];
-        });
+        centres_.begin(), centres_.begin() + mid, centres_.end(),
+        [axis](const Centre& x, const Centre& y) { return x.sum[axis] < y.sum[axis]; });
   }
   std::vector<Node> left, right;
   TaskAlongside worker([&] { one(0, mid, left); });
@@ -250,38 +260,33 @@ void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<N
 void BoxTree::build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) {
   const std::uint32_t self = std::uint32_t(out.size());
   out.push_back({});
-  Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
-  Box centers = box;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const Box& b = boxes_[order_[i]];
-    grow(box, b);
+  if (end - begin <= kLeafSize) {
+    Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+    for (std::uint32_t i = begin; i < end; ++i) grow(box, boxes_[centres_[i].index]);
+    out[self] = {box, begin, (end - begin) | kLeaf};
+    return;
+  }
+  Box centers{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  for (std::uint32_t i = begin; i < end; ++i)
     for (int k = 0; k < 3; ++k) {
-      const float c = 0.5f * (b.lo[k] + b.hi[k]);
+      const float c = 0.5f * centres_[i].sum[k];
       centers.lo[k] = std::min(centers.lo[k], c);
       centers.hi[k] = std::max(centers.hi[k], c);
     }
-  }
-  out[self].box = box;
-  if (end - begin <= kLeafSize) {
-    out[self].a = begin;
-    out[self].b = (end - begin) | kLeaf;
-    return;
-  }
   int axis = 0;
   for (int k = 1; k < 3; ++k)
     if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
   const std::uint32_t mid = begin + (end - begin) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                   [&](std::uint32_t x, std::uint32_t y) {
-                     return boxes_[x].lo[axis] + boxes_[x].hi[axis] <
-                            boxes_[y].lo[axis] + boxes_[y].hi[axis];
-                   });
+  std::nth_element(centres_.begin() + begin, centres_.begin() + mid, centres_.begin() + end,
+                   [axis](const Centre& x, const Centre& y) { return x.sum[axis] < y.sum[axis]; });
   const std::uint32_t left = std::uint32_t(out.size());
   build(begin, mid, out);
   const std::uint32_t right = std::uint32_t(out.size());
   build(mid, end, out);
-  out[self].a = left;
-  out[self].b = right;
+  // A node's box is its children's together (the same as over its boxes).
+  Box box = out[left].box;
+  grow(box, out[right].box);
+  out[self] = {box, left, right};
 }
 
 void BoxTree::tasks(std::uint32_t n, int depth,

@@ -123,6 +123,15 @@ class BoxTree {
 
   std::vector<Box> boxes_;
   std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
+  // While a median-split hierarchy is built: per primitive in the current
+  // order, lo + hi of its box on each axis and its index. Selecting medians
+  // on these, next to each other in memory, does the same as on order_ with
+  // the boxes looked up, at a fraction of the cost on a large mesh.
+  struct Centre {
+    float sum[3];
+    std::uint32_t index;
+  };
+  std::vector<Centre> centres_;
   std::vector<Node> nodes_;
   Box empty_{{1, 1, 1}, {0, 0, 0}};
 };
