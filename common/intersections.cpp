@@ -29,9 +29,9 @@ struct Soup {
   std::vector<char> degenerate;
   Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
   // Only for the search within the mesh (`withTree`): every face's box and
-  // its exact plane sides.
+  // the filter of its exact plane sides (side()).
   std::vector<Box> boxes;
-  std::vector<PlaneSide> planes;
+  std::vector<PlaneFilter> planes;
 
   Soup(const MeshArrays& mesh, bool withTree) : points(mesh.points), triangles(mesh.triangles) {
     Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
@@ -63,11 +63,16 @@ struct Soup {
         const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
         boxes[f] = hull(pointBoxes[t[0]], pointBoxes[t[1]], pointBoxes[t[2]]);
         degenerate[f] = collinear(a, b, c);
-        planes[f] = PlaneSide(a, b, c);
+        planes[f] = PlaneFilter(a, b, c);
       }
     });
   }
   const Point3& corner(std::uint32_t f, int i) const { return points[triangles[f][i]]; }
+  // orient3d of face f's corners and p.
+  int side(std::uint32_t f, const Point3& p) const {
+    const Triangle& t = triangles[f];
+    return planes[f].side(points[t[0]], points[t[1]], points[t[2]], p);
+  }
   TrianglePoints at(std::uint32_t f) const {
     const Triangle& t = triangles[f];
     return {points[t[0]], points[t[1]], points[t[2]]};
@@ -113,15 +118,15 @@ Candidates facesTouching(const Soup& s, const Box& other) {
 // Are all three corners of face g of `gs` strictly on one side of the plane
 // of face f of `fs`?
 bool strictlyBeside(const Soup& fs, std::uint32_t f, const Soup& gs, std::uint32_t g) {
-  const int s0 = fs.planes[f](gs.corner(g, 0));
+  const int s0 = fs.side(f, gs.corner(g, 0));
   if (s0 == 0) return false;
-  return fs.planes[f](gs.corner(g, 1)) == s0 && fs.planes[f](gs.corner(g, 2)) == s0;
+  return fs.side(f, gs.corner(g, 1)) == s0 && fs.side(f, gs.corner(g, 2)) == s0;
 }
 
 // Exact: can the segment from corner i to corner j of face g meet face f?
 // False when both ends lie strictly on one side of f's plane.
 bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
-  return s.planes[f](s.corner(g, i)) * s.planes[f](s.corner(g, j)) <= 0;
+  return s.side(f, s.corner(g, i)) * s.side(f, s.corner(g, j)) <= 0;
 }
 
 // The self-intersection rule for two faces of one mesh. Cheap exact plane
@@ -141,7 +146,7 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
         return false;
       break;
     case 2:  // folded faces are coplanar: the other's apex must lie in the plane
-      if (s.planes[f](s.corner(g, c.ib)) != 0) return false;
+      if (s.side(f, s.corner(g, c.ib)) != 0) return false;
       break;
     default:
       return true;

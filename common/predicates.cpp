@@ -84,7 +84,7 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
   return exact::orient3d(a, b, c, d);
 }
 
-PlaneSide::PlaneSide(const Point3& a, const Point3& b, const Point3& c) : a_(a), b_(b), c_(c) {
+PlaneFilter::PlaneFilter(const Point3& a, const Point3& b, const Point3& c) {
   const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
   const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
   n_[0] = by * cz - bz * cy;
@@ -95,8 +95,8 @@ PlaneSide::PlaneSide(const Point3& a, const Point3& b, const Point3& c) : a_(a),
   nAbs_[2] = std::fabs(bx * cy) + std::fabs(by * cx);
 }
 
-int PlaneSide::operator()(const Point3& p) const {
-  const double dx = p[0] - a_[0], dy = p[1] - a_[1], dz = p[2] - a_[2];
+int PlaneFilter::side(const Point3& a, const Point3& b, const Point3& c, const Point3& p) const {
+  const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
   const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
   const double permanent =
       std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
@@ -105,7 +105,7 @@ int PlaneSide::operator()(const Point3& p) const {
     if (det > bound) return 1;
     if (-det > bound) return -1;
   }
-  return orient3d(a_, b_, c_, p);
+  return orient3d(a, b, c, p);
 }
 
 int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {

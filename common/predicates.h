@@ -40,16 +40,31 @@ inline int orient2dDropping(const Point3& a, const Point3& b, const Point3& c, i
 // triangle's edge cross products are computed once. It evaluates the same
 // determinant with the same error bound (expanded along p's row), so its
 // sign is exact: the filter falls back to orient3d when it cannot decide.
+// PlaneFilter keeps only those products, for a caller that has the corners
+// at hand (a mesh's faces: a third of the memory); PlaneSide keeps the
+// corners too.
+class PlaneFilter {
+ public:
+  PlaneFilter() = default;
+  PlaneFilter(const Point3& a, const Point3& b, const Point3& c);
+  // orient3d(a, b, c, p) for the corners this filter was made from.
+  int side(const Point3& a, const Point3& b, const Point3& c, const Point3& p) const;
+
+ private:
+  double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded
+  double nAbs_[3] = {0, 0, 0};  // the matching sums of absolute products
+};
+
 class PlaneSide {
  public:
   PlaneSide() = default;
-  PlaneSide(const Point3& a, const Point3& b, const Point3& c);
-  int operator()(const Point3& p) const;
+  PlaneSide(const Point3& a, const Point3& b, const Point3& c)
+      : a_(a), b_(b), c_(c), filter_(a, b, c) {}
+  int operator()(const Point3& p) const { return filter_.side(a_, b_, c_, p); }
 
  private:
   Point3 a_, b_, c_;
-  double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded
-  double nAbs_[3] = {0, 0, 0};  // the matching sums of absolute products
+  PlaneFilter filter_;
 };
 
 namespace exact {
