@@ -240,7 +240,29 @@ def uv_sphere(path, centre, radius, rings, segments):
     return write_off(path, *uv_sphere_arrays(centre, radius, rings, segments))
 
 
-def split(repeat):
+def split_rounds(command, rounds):
+    """Runs a bench_split command `rounds` times, ours and the peers one
+    after the other in each round, and keeps per method the median of the
+    rounds' medians: a burst of load on this shared machine then spoils one
+    round, not the comparison."""
+    runs = [json.loads(subprocess.run(command, capture_output=True, text=True,
+                                      check=True).stdout)["methods"] for _ in range(rounds)]
+    methods = {}
+    for name in [m["method"] for m in runs[0]]:
+        entries = [m for run in runs for m in run if m["method"] == name]
+        ok = [m for m in entries if m.get("ok")]
+        if len(ok) < len(entries):
+            methods[name] = next(m for m in entries if not m.get("ok"))
+            continue
+        merged = dict(ok[0])
+        merged["median_ms"] = statistics.median(m["median_ms"] for m in ok)
+        merged["round_medians_ms"] = [m["median_ms"] for m in ok]
+        merged["peak_rss_mb"] = max(m.get("peak_rss_mb", 0) for m in ok)
+        methods[name] = merged
+    return methods
+
+
+def split(repeat, rounds=3):
     import tempfile
     tmp = tempfile.mkdtemp(prefix="meshmend-bench-")
     small = uv_sphere(Path(tmp) / "sphere_70k.off", (0, 0, 0), 1.0, 141, 250)
@@ -252,8 +274,10 @@ def split(repeat):
             ("generated spheres, 70k + 870k faces", small, large, []),
             ("bunny + dragon (sample configuration)", DATA / "stanford/bun_zipper.ply",
              data_file("stanford/dragon_vrip.ply", tmp), ["--sample", "--autorefine", "--limit", "300"])]
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; medians of {repeat} runs in one "
-           "`bench_split` run per pair (`benchmarks/run.py split`), each method in a child process. "
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; per method the median of "
+           f"{rounds} rounds, each the median of {repeat} runs in one `bench_split` run per pair "
+           "(`benchmarks/run.py split`; in each round ours and the peers run one after the other, "
+           "each method in a child process). "
            "Ours: `splitAlongIntersections` with `merged_output` off (the curves inserted into both "
            "meshes, the two refined meshes built: the job `PMP::corefine` does), and in the next "
            "column the default (the welded merged mesh built too). CGAL: `PMP::corefine` on two "
@@ -280,10 +304,8 @@ def split(repeat):
         return fmt(m["median_ms"]) if m.get("ok") else m.get("error", "?").strip()
 
     for name, a, b, extra in rows:
-        text = subprocess.run([str(BUILD / "benchmarks" / "bench_split"), "--repeat", str(repeat),
-                               *extra, str(a), str(b)], capture_output=True, text=True,
-                              check=True).stdout
-        methods = {m["method"]: m for m in json.loads(text)["methods"]}
+        methods = split_rounds([str(BUILD / "benchmarks" / "bench_split"), "--repeat",
+                                str(repeat), *extra, str(a), str(b)], rounds)
         o = methods.get("meshmend_split_refine") or methods["meshmend_split_sample"]
         merged = methods.get("meshmend_split")
         plain, checked = methods.get("cgal_corefine"), methods.get("cgal_corefine_checked")
