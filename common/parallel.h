@@ -1,11 +1,21 @@
-// Minimal data parallelism over index ranges with std::thread.
+// Minimal data parallelism over index ranges, on a few helper threads kept
+// between jobs.
+//
+// Starting a thread costs tens of microseconds, as much as a small mesh's
+// whole stage: a split of two small meshes has four parallel stages. So the
+// helpers (one fewer than the cores) are started on first use and wait for
+// the next job; each leaves after a moment without work, so an idle
+// process keeps no threads. The thread that posts a job takes its chunks
+// too, and runs every chunk no helper has taken by the time it has
+// finished its own: every chunk runs exactly once, also when no thread can
+// be started, and a job posted from inside another job's chunk (nested
+// parallelism) never waits for a chunk that nobody runs.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
 #include <exception>
 #include <functional>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -19,9 +29,41 @@ inline unsigned workerCount() {
   return count;
 }
 
+namespace detail {
+
+// A job of `count` chunks: run(context, i) runs chunk i. Owned by the
+// thread that posts it, which waits in runJob() until every chunk is done.
+struct Job {
+  void (*run)(void* context, std::size_t chunk);
+  void* context;
+  std::size_t count;
+  std::size_t claimed = 0;   // chunks taken (by any thread), under the pool's lock
+  std::size_t finished = 0;  // chunks done, under the pool's lock
+};
+
+// Posts the job to the helpers, runs the chunks they have not taken on the
+// calling thread, and returns once every chunk has finished. run() must
+// not throw.
+void runJob(Job& job);
+
+// Posts a job and returns at once; finishJob() then runs the chunks still
+// untaken on the calling thread (or, unless `runUntaken`, drops them) and
+// waits for those a helper has taken.
+void postJob(Job& job);
+void finishJob(Job& job, bool runUntaken);
+
+}  // namespace detail
+
+// Asks the helper threads to leave and waits until they have (the next job
+// starts them again). For a process about to give up its threads, and for
+// tests that must see threads started afresh.
+void releaseHelperThreads();
+
 // Splits [0, n) into one contiguous chunk per worker and calls
 // body(begin, end, worker) on each, in parallel; small ranges run inline.
-// The first exception thrown by a worker is rethrown after all have joined.
+// `worker` is the chunk's number (0..workerCount()-1): no two chunks of one
+// call share it, so it can index per-chunk results. The first exception
+// thrown by a chunk is rethrown after all chunks have finished.
 template <class Body>
 void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4096) {
   const std::size_t workers = std::max<std::size_t>(
@@ -30,64 +72,62 @@ void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4
     body(std::size_t(0), n, 0u);
     return;
   }
-  std::vector<std::exception_ptr> errors(workers);
-  auto run = [&](std::size_t w) {
-    try {
-      body(n * w / workers, n * (w + 1) / workers, unsigned(w));
-    } catch (...) {
-      errors[w] = std::current_exception();
-    }
-  };
-  // The calling thread takes the first chunk: one thread fewer to start.
-  // When no thread can be started (std::system_error) or the list of them
-  // cannot grow, the chunks left run here too: every chunk runs exactly
-  // once, so callers that must finish a job (re-pointing a moved mesh's
-  // faces) can rely on it, and no started thread is left unjoined.
-  std::vector<std::thread> threads;
-  std::size_t started = 1;
-  try {
-    threads.reserve(workers - 1);
-    for (; started < workers; ++started) threads.emplace_back(run, started);
-  } catch (...) {
-  }
-  run(0);
-  for (std::size_t w = started; w < workers; ++w) run(w);
-  for (std::thread& t : threads) t.join();
-  for (const std::exception_ptr& e : errors)
+  struct Context {
+    Body& body;
+    std::size_t n, workers;
+    std::vector<std::exception_ptr> errors;
+  } context{body, n, workers, std::vector<std::exception_ptr>(workers)};
+  detail::Job job{[](void* c, std::size_t w) {
+                    Context& x = *static_cast<Context*>(c);
+                    try {
+                      x.body(x.n * w / x.workers, x.n * (w + 1) / x.workers, unsigned(w));
+                    } catch (...) {
+                      x.errors[w] = std::current_exception();
+                    }
+                  },
+                  &context, workers};
+  detail::runJob(job);
+  for (const std::exception_ptr& e : context.errors)
     if (e) std::rethrow_exception(e);
 }
 
-// Runs a task on a second thread while the caller works on, or, when no
-// thread can be started, on the calling thread once it is waited for: the
-// task runs exactly once either way (if waited for). The destructor joins
-// a started thread (an error on the caller's side leaves nothing running).
+// Runs a task on a helper thread while the caller works on, or, when no
+// helper takes it first, on the calling thread once it is waited for: the
+// task runs exactly once either way (if waited for), and wait() rethrows
+// what it threw. The destructor waits for a task a helper has taken and
+// drops one none has (an error on the caller's side leaves nothing running).
 class TaskAlongside {
  public:
-  explicit TaskAlongside(std::function<void()> task) : task_(std::move(task)) {
-    try {
-      thread_ = std::thread(task_);
-      task_ = nullptr;
-    } catch (const std::system_error&) {  // no thread to spare: wait() runs it
-    }
+  explicit TaskAlongside(std::function<void()> task)
+      : task_(std::move(task)),
+        job_{[](void* self, std::size_t) {
+               TaskAlongside& t = *static_cast<TaskAlongside*>(self);
+               try {
+                 t.task_();
+               } catch (...) {
+                 t.error_ = std::current_exception();
+               }
+             },
+             this, 1} {
+    detail::postJob(job_);
   }
   TaskAlongside(const TaskAlongside&) = delete;
   TaskAlongside& operator=(const TaskAlongside&) = delete;
   ~TaskAlongside() {
-    if (thread_.joinable()) thread_.join();
+    if (!waited_) detail::finishJob(job_, false);
   }
   void wait() {
-    if (thread_.joinable()) {
-      thread_.join();
-    } else if (task_) {
-      std::function<void()> task = std::move(task_);
-      task_ = nullptr;
-      task();
-    }
+    if (waited_) return;
+    waited_ = true;
+    detail::finishJob(job_, true);
+    if (error_) std::rethrow_exception(error_);
   }
 
  private:
   std::function<void()> task_;
-  std::thread thread_;
+  std::exception_ptr error_;
+  bool waited_ = false;
+  detail::Job job_;  // last: made once the members its task uses are
 };
 
 }  // namespace meshmend

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <system_error>
 #include <thread>
@@ -1290,34 +1291,20 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
   const std::size_t builtAside =
       mergedArrays ? meshes.size() : meshes.size() - 1;  // separate meshes the thread builds
-  std::thread separateBuilder;
-  std::exception_ptr separateError;
+  std::optional<TaskAlongside>
+      separateBuilder;  // destroyed (waited for) also when the merged output throws
   if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096 &&
       builtAside > 0 && !separateBuilt) {
     r.meshes.resize(meshes.size());
-    try {
-      separateBuilder = std::thread([&] {
-        try {
-          for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
-        } catch (...) {
-          separateError = std::current_exception();
-        }
-      });
-    } catch (const std::system_error&) {  // no thread to spare: finishSeparate builds them all
-    }
+    separateBuilder.emplace([&] {
+      for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
+    });
   }
-  struct JoinOnExit {  // also when the merged output throws
-    std::thread& thread;
-    ~JoinOnExit() {
-      if (thread.joinable()) thread.join();
-    }
-  } joinOnExit{separateBuilder};
-  // The separate meshes not built on the thread (all of them when snapping
-  // rebuilt them), once the thread has finished.
+  // The separate meshes not built alongside (all of them when snapping
+  // rebuilt them), once the task alongside has finished.
   auto finishSeparate = [&] {
-    if (separateBuilder.joinable()) {
-      separateBuilder.join();
-      if (separateError) std::rethrow_exception(separateError);
+    if (separateBuilder) {
+      separateBuilder->wait();
       for (std::size_t m = builtAside; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     } else if (options.separate_meshes && !separateBuilt) {
       r.meshes.resize(meshes.size());

@@ -1,13 +1,20 @@
 // parallel.h: every chunk runs exactly once, also when no thread can be
-// started (a process at its thread limit, a container with few PIDs), and
-// the work that relies on it (hole filling re-points a moved mesh's faces
-// in parallel) still finishes with the same result.
+// started (a process at its thread limit, a container with few PIDs), in
+// jobs posted from inside other jobs' chunks and in a child of fork(); the
+// helpers serve job after job; and the work that relies on it (hole
+// filling re-points a moved mesh's faces in parallel) still finishes with
+// the same result.
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 #include <pthread.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "common/holes.h"
@@ -37,8 +44,13 @@ extern "C" int pthread_create(pthread_t* thread, const pthread_attr_t* attribute
 }
 
 namespace {
+// Helpers kept from earlier work are released first: the work under test
+// must ask for threads, and be refused.
 struct NoThreads {
-  NoThreads() { refuseThreads = true, threadsRefused = 0; }
+  NoThreads() {
+    releaseHelperThreads();
+    refuseThreads = true, threadsRefused = 0;
+  }
   ~NoThreads() { refuseThreads = false; }
 };
 
@@ -64,6 +76,122 @@ TEST(ParallelChunks, EveryChunkRunsOnceWhenNoThreadStarts) {
   // The refusal was met, not avoided (with one core no thread is asked for).
   EXPECT_EQ(threadsRefused.load() > 0, workerCount() > 1);
   for (int v : visits) ASSERT_EQ(v, 1);
+}
+
+TEST(ParallelChunks, JobsPostedFromChunksFinish) {
+  // Every chunk of the outer job posts a job of its own and a task
+  // alongside: with all helpers busy, their posters run them.
+  std::vector<std::atomic<int>> visits(64 * 1000);
+  std::atomic<int> tasks{0};
+  parallelChunks(
+      64,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t i = begin; i < end; ++i) {
+          TaskAlongside task([&] { ++tasks; });
+          parallelChunks(
+              1000,
+              [&](std::size_t b, std::size_t e, unsigned) {
+                for (std::size_t k = b; k < e; ++k) ++visits[i * 1000 + k];
+              },
+              100);
+          task.wait();
+        }
+      },
+      1);
+  EXPECT_EQ(tasks.load(), 64);
+  for (const auto& v : visits) ASSERT_EQ(v.load(), 1);
+}
+
+TEST(ParallelChunks, AnErrorOfOneChunkIsRethrownOnceAllHaveRun) {
+  std::vector<std::atomic<int>> visits(workerCount());
+  EXPECT_THROW(parallelChunks(
+                   workerCount(),
+                   [&](std::size_t begin, std::size_t, unsigned worker) {
+                     ++visits[begin];
+                     if (worker == 0) throw std::runtime_error("chunk 0");
+                   },
+                   1),
+               std::runtime_error);
+  for (const auto& v : visits) EXPECT_EQ(v.load(), 1);
+}
+
+TEST(TaskAlongside, RethrowsOnWaitAndIsDroppedWhenNotWaitedFor) {
+  TaskAlongside failing([] { throw std::runtime_error("task"); });
+  EXPECT_THROW(failing.wait(), std::runtime_error);
+  // No helper to take it: left unwaited, the task never runs.
+  std::atomic<int> runs{0};
+  {
+    NoThreads none;
+    TaskAlongside dropped([&] { ++runs; });
+  }
+  EXPECT_EQ(runs.load(), 0);
+  // With no helper, wait() runs it here, once.
+  {
+    NoThreads none;
+    TaskAlongside waited([&] { ++runs; });
+    waited.wait();
+    waited.wait();
+  }
+  EXPECT_EQ(runs.load(), 1);
+}
+
+TEST(ParallelChunks, HelpersServeJobAfterJob) {
+  // Chunks run on the caller and on helpers; a helper that serves job
+  // after job counts more than one in its thread's counter (a thread per
+  // job would count one each).
+  static thread_local int chunksHere = 0;
+  std::atomic<int> mostOnAHelper{0};
+  const auto caller = std::this_thread::get_id();
+  for (int job = 0; job < 20; ++job)
+    parallelChunks(
+        workerCount(),
+        [&](std::size_t, std::size_t, unsigned) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));  // long enough to be shared
+          if (std::this_thread::get_id() == caller) return;
+          const int here = ++chunksHere;
+          for (int m = mostOnAHelper; m < here && !mostOnAHelper.compare_exchange_weak(m, here);) {
+          }
+        },
+        1);
+  if (workerCount() > 1)
+    EXPECT_GE(mostOnAHelper.load(), 2);
+  else
+    EXPECT_EQ(mostOnAHelper.load(), 0);  // one core: the caller runs every chunk
+}
+
+TEST(ParallelChunks, AChildOfForkRunsJobsWithoutItsParentsHelpers) {
+  parallelChunks(
+      1000, [](std::size_t, std::size_t, unsigned) {}, 1);  // helpers started
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    alarm(60);  // a hang fails the test instead of stopping it
+    std::vector<int> visits(100000, 0);
+    parallelChunks(visits.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t i = begin; i < end; ++i) ++visits[i];
+    });
+    bool ran = false;
+    TaskAlongside task([&] { ran = true; });
+    task.wait();
+    for (int v : visits)
+      if (v != 1) _exit(2);
+    if (!ran) _exit(3);
+    // And the child has helpers of its own: slow chunks are shared.
+    const auto caller = std::this_thread::get_id();
+    std::atomic<int> elsewhere{0};
+    parallelChunks(
+        workerCount(),
+        [&](std::size_t, std::size_t, unsigned) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+          if (std::this_thread::get_id() != caller) ++elsewhere;
+        },
+        1);
+    _exit((elsewhere > 0) == (workerCount() > 1) ? 0 : 4);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child was stopped by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
 TEST(ParallelChunks, HoleFillingWithoutThreadsGivesTheSameMesh) {

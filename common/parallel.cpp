@@ -1,0 +1,165 @@
+#include "common/parallel.h"
+
+#include <pthread.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <new>
+#include <system_error>
+
+namespace meshmend {
+
+namespace {
+
+// The helpers and the jobs posted to them. One per process (per copy of the
+// core library: each plugin links its own); never destroyed while helpers
+// may run, see the destructor.
+class HelperPool {
+ public:
+  static HelperPool& instance() {
+    static HelperPool* pool = [] {
+      // A child of fork() has none of its parent's helpers and perhaps a
+      // lock some helper held: it starts from a new pool (the old one's
+      // memory is left as it is; destroying it would wait for threads
+      // that are not there).
+      pthread_atfork(nullptr, nullptr, [] { current() = new HelperPool; });
+      current() = new HelperPool;
+      static Release release;
+      return current();
+    }();
+    (void)pool;
+    return *current();
+  }
+
+  void post(detail::Job& job) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    pending_.push_back(&job);
+    // Enough idle helpers for this job's chunks beyond the first (which its
+    // poster takes; a task alongside has one chunk, for a helper).
+    const std::size_t need = job.count - (job.count > 1);
+    while (idle_ < need && helpers_ < workerCount() - 1) {
+      try {
+        std::thread(&HelperPool::serve, this).detach();
+      } catch (const std::system_error&) {
+        break;  // no thread to spare (the process is at its limit): the chunks run here
+      }
+      ++helpers_;
+      ++idle_;  // counted as waiting until it takes a chunk
+    }
+    work_.notify_all();
+  }
+
+  void finish(detail::Job& job, bool runUntaken) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (job.claimed < job.count) {
+      if (!runUntaken) {
+        job.finished += job.count - job.claimed;
+        job.claimed = job.count;
+        unlinkIfDone(job);
+        break;
+      }
+      const std::size_t chunk = claim(job);
+      lock.unlock();
+      job.run(job.context, chunk);
+      lock.lock();
+      ++job.finished;
+    }
+    done_.wait(lock, [&] { return job.finished == job.count; });
+  }
+
+  void release() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    stop_ = true;
+    work_.notify_all();
+    done_.wait(lock, [&] { return helpers_ == 0; });
+    stop_ = false;
+  }
+
+ private:
+  // Releases the helpers when the library leaves the process (exit, or a
+  // plugin's library unloaded): no helper is left to run unmapped code.
+  struct Release {
+    ~Release() { current()->release(); }
+  };
+
+  static HelperPool*& current() {
+    static HelperPool* pool = nullptr;
+    return pool;
+  }
+
+  // Takes the job's next chunk (under the lock); a job whose chunks are
+  // all taken leaves the queue.
+  std::size_t claim(detail::Job& job) {
+    const std::size_t chunk = job.claimed++;
+    unlinkIfDone(job);
+    return chunk;
+  }
+  void unlinkIfDone(detail::Job& job) {
+    if (job.claimed < job.count) return;
+    for (auto it = pending_.begin(); it != pending_.end(); ++it)
+      if (*it == &job) {
+        pending_.erase(it);
+        break;
+      }
+  }
+
+  void serve() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      if (!stop_ && pending_.empty())
+        work_.wait_for(lock, kIdle, [&] { return stop_ || !pending_.empty(); });
+      if (stop_ || pending_.empty()) break;  // released, or idle for kIdle
+      --idle_;
+      detail::Job& job = *pending_.front();
+      const std::size_t chunk = claim(job);
+      lock.unlock();
+      job.run(job.context, chunk);
+      lock.lock();
+      ++idle_;
+      if (++job.finished == job.count) done_.notify_all();
+    }
+    --idle_;
+    --helpers_;
+    done_.notify_all();
+  }
+
+  // How long a helper waits for work before it leaves: long enough to
+  // span the gaps between one operation's stages, short against a user's
+  // pause.
+  static constexpr std::chrono::milliseconds kIdle{200};
+
+  std::mutex mutex_;
+  std::condition_variable work_;  // a job was posted, or stop_ set
+  std::condition_variable done_;  // a chunk or a helper finished
+  std::deque<detail::Job*> pending_;
+  std::size_t helpers_ = 0;  // started and not yet gone
+  std::size_t idle_ = 0;     // of those, waiting for a chunk
+  bool stop_ = false;
+};
+
+}  // namespace
+
+namespace detail {
+
+void postJob(Job& job) {
+  HelperPool::instance().post(job);
+}
+
+void finishJob(Job& job, bool runUntaken) {
+  HelperPool::instance().finish(job, runUntaken);
+}
+
+void runJob(Job& job) {
+  postJob(job);
+  finishJob(job, true);
+}
+
+}  // namespace detail
+
+void releaseHelperThreads() {
+  HelperPool::instance().release();
+}
+
+}  // namespace meshmend
