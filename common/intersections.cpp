@@ -33,7 +33,9 @@ struct Soup {
   std::vector<Box> boxes;
   std::vector<PlaneFilter> planes;
 
-  Soup(const MeshArrays& mesh, bool withTree) : points(mesh.points), triangles(mesh.triangles) {
+  explicit Soup(const MeshArrays& mesh) : points(mesh.points), triangles(mesh.triangles) {}
+  // The bounds and degenerate faces, and with `withTree` the boxes and planes.
+  void prepare(bool withTree) {
     Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
     for (const Point3& p : points)
       for (int k = 0; k < 3; ++k) {
@@ -194,7 +196,15 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   // faces near the other mesh.
   std::vector<Soup> soups;
   soups.reserve(n);
-  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m], options.self);
+  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m]);
+  // Each mesh on its own, side by side (a large mesh's own stages take the
+  // threads a small one leaves).
+  parallelChunks(
+      n,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t m = begin; m < end; ++m) soups[m].prepare(options.self);
+      },
+      1);
   // A pair found between meshes keeps the plane sides its test computed:
   // the contact classification needs the same ones.
   struct Found {
@@ -237,8 +247,15 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
       for (std::size_t k = m + 1; k < n; ++k) {
         reportProgress(options.progress, 50, "Intersections between meshes");
         if (!overlap(soups[m].bounds, soups[k].bounds)) continue;
-        Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
-                              facesTouching(soups[k], soups[m].bounds)};
+        Candidates near[2];
+        parallelChunks(
+            2,
+            [&](std::size_t begin, std::size_t end, unsigned) {
+              for (std::size_t i = begin; i < end; ++i)
+                near[i] = i == 0 ? facesTouching(soups[m], soups[k].bounds)
+                                 : facesTouching(soups[k], soups[m].bounds);
+            },
+            1);
         // A tree over the smaller set of candidates, queried by the other's.
         const bool swap = near[0].faces.size() > near[1].faces.size();
         const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];

@@ -48,32 +48,41 @@ class HelperPool {
       ++helpers_;
       ++idle_;  // counted as waiting until it takes a chunk
     }
-    work_.notify_all();
+    changed_.notify_all();
   }
 
+  // While its own job has chunks left, the poster takes them; then, until
+  // the helpers have finished theirs, it takes chunks of other jobs: those
+  // its helpers' chunks post (a stage of one mesh inside a job over meshes)
+  // would otherwise have only their own poster.
   void finish(detail::Job& job, bool runUntaken) {
     std::unique_lock<std::mutex> lock(mutex_);
-    while (job.claimed < job.count) {
-      if (!runUntaken) {
-        job.finished += job.count - job.claimed;
-        job.claimed = job.count;
-        unlinkIfDone(job);
-        break;
-      }
-      const std::size_t chunk = claim(job);
-      lock.unlock();
-      job.run(job.context, chunk);
-      lock.lock();
-      ++job.finished;
+    if (!runUntaken && job.claimed < job.count) {  // dropped: only the taken ones run
+      job.finished += job.count - job.claimed;
+      job.claimed = job.count;
+      unlinkIfDone(job);
     }
-    done_.wait(lock, [&] { return job.finished == job.count; });
+    while (job.finished < job.count) {
+      detail::Job* next = job.claimed < job.count ? &job
+                          : pending_.empty()      ? nullptr
+                                                  : pending_.front();
+      if (!next) {
+        changed_.wait(lock);
+        continue;
+      }
+      const std::size_t chunk = claim(*next);
+      lock.unlock();
+      next->run(next->context, chunk);
+      lock.lock();
+      if (++next->finished == next->count) changed_.notify_all();
+    }
   }
 
   void release() {
     std::unique_lock<std::mutex> lock(mutex_);
     stop_ = true;
-    work_.notify_all();
-    done_.wait(lock, [&] { return helpers_ == 0; });
+    changed_.notify_all();
+    changed_.wait(lock, [&] { return helpers_ == 0; });
     stop_ = false;
   }
 
@@ -109,7 +118,7 @@ class HelperPool {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
       if (!stop_ && pending_.empty())
-        work_.wait_for(lock, kIdle, [&] { return stop_ || !pending_.empty(); });
+        changed_.wait_for(lock, kIdle, [&] { return stop_ || !pending_.empty(); });
       if (stop_ || pending_.empty()) break;  // released, or idle for kIdle
       --idle_;
       detail::Job& job = *pending_.front();
@@ -118,11 +127,11 @@ class HelperPool {
       job.run(job.context, chunk);
       lock.lock();
       ++idle_;
-      if (++job.finished == job.count) done_.notify_all();
+      if (++job.finished == job.count) changed_.notify_all();
     }
     --idle_;
     --helpers_;
-    done_.notify_all();
+    changed_.notify_all();
   }
 
   // How long a helper waits for work before it leaves: long enough to
@@ -131,8 +140,8 @@ class HelperPool {
   static constexpr std::chrono::milliseconds kIdle{200};
 
   std::mutex mutex_;
-  std::condition_variable work_;  // a job was posted, or stop_ set
-  std::condition_variable done_;  // a chunk or a helper finished
+  // A job was posted, a job's last chunk or a helper finished, or stop_ set.
+  std::condition_variable changed_;
   std::deque<detail::Job*> pending_;
   std::size_t helpers_ = 0;  // started and not yet gone
   std::size_t idle_ = 0;     // of those, waiting for a chunk

@@ -8,8 +8,10 @@
 // process keeps no threads. The thread that posts a job takes its chunks
 // too, and runs every chunk no helper has taken by the time it has
 // finished its own: every chunk runs exactly once, also when no thread can
-// be started, and a job posted from inside another job's chunk (nested
-// parallelism) never waits for a chunk that nobody runs.
+// be started. While it waits for the helpers' chunks it takes chunks of
+// the jobs those post (nested parallelism: a stage of one mesh inside a job
+// over meshes), so a nested job has every idle thread, and no thread waits
+// for a chunk that nobody runs.
 #pragma once
 
 #include <algorithm>

@@ -1152,21 +1152,31 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   SplitResult r;
   // The inputs as arrays, with their seams closed when asked; each keeps
   // the input index of its vertices and faces.
+  // Meshes side by side; an error names the first mesh at fault.
   std::vector<WeldedArrays> inputs(meshes.size());
+  std::vector<std::size_t> duplicateFaces(meshes.size(), 0);
+  parallelChunks(
+      meshes.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t m = begin; m < end; ++m) {
+          requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+          WeldedArrays& in = inputs[m];
+          if (options.weld_duplicates) {
+            in = weldCoincident(arraysOf(*meshes[m]));
+          } else {
+            in.mesh = arraysOf(*meshes[m]);
+            in.vertex_origin.resize(in.mesh.points.size());
+            std::iota(in.vertex_origin.begin(), in.vertex_origin.end(), 0);
+            in.face_origin.resize(in.mesh.triangles.size());
+            std::iota(in.face_origin.begin(), in.face_origin.end(), 0);
+          }
+          if (options.remove_duplicate_faces) duplicateFaces[m] = removeDuplicateFaces(in);
+        }
+      },
+      1);
   for (std::size_t m = 0; m < meshes.size(); ++m) {
-    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
-    WeldedArrays& in = inputs[m];
-    if (options.weld_duplicates) {
-      in = weldCoincident(arraysOf(*meshes[m]));
-      r.vertices_welded += in.vertices_merged;
-    } else {
-      in.mesh = arraysOf(*meshes[m]);
-      in.vertex_origin.resize(in.mesh.points.size());
-      std::iota(in.vertex_origin.begin(), in.vertex_origin.end(), 0);
-      in.face_origin.resize(in.mesh.triangles.size());
-      std::iota(in.face_origin.begin(), in.face_origin.end(), 0);
-    }
-    if (options.remove_duplicate_faces) r.duplicate_faces_removed += removeDuplicateFaces(in);
+    r.vertices_welded += inputs[m].vertices_merged;
+    r.duplicate_faces_removed += duplicateFaces[m];
   }
   std::vector<const MeshArrays*> arrays;
   for (const WeldedArrays& in : inputs) arrays.push_back(&in.mesh);

@@ -13,6 +13,8 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <mutex>
+#include <set>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -100,6 +102,41 @@ TEST(ParallelChunks, JobsPostedFromChunksFinish) {
       1);
   EXPECT_EQ(tasks.load(), 64);
   for (const auto& v : visits) ASSERT_EQ(v.load(), 1);
+}
+
+TEST(ParallelChunks, AWaitingPosterHelpsWithJobsPostedByHelpers) {
+  // The outer job's chunk on a helper posts an inner job of slow chunks
+  // while the caller, done with its own chunk, waits: it takes one of them.
+  const auto caller = std::this_thread::get_id();
+  std::mutex mutex;
+  std::set<std::thread::id> innerThreads;
+  bool innerRan = false;
+  for (int attempt = 0; attempt < 50 && !innerRan; ++attempt)
+    parallelChunks(
+        2,
+        [&](std::size_t, std::size_t, unsigned) {
+          if (std::this_thread::get_id() == caller) {  // leaves the other chunk to a helper
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            return;
+          }
+          parallelChunks(
+              2,
+              [&](std::size_t, std::size_t, unsigned) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                std::lock_guard<std::mutex> lock(mutex);
+                innerThreads.insert(std::this_thread::get_id());
+              },
+              1);
+          innerRan = true;
+        },
+        1);
+  if (workerCount() > 1) {
+    ASSERT_TRUE(innerRan) << "no outer chunk ran on a helper in 50 jobs";
+    EXPECT_EQ(innerThreads.size(), 2u);
+    EXPECT_EQ(innerThreads.count(caller), 1u);
+  } else {
+    EXPECT_FALSE(innerRan);  // one core: the caller runs every chunk
+  }
 }
 
 TEST(ParallelChunks, AnErrorOfOneChunkIsRethrownOnceAllHaveRun) {
