@@ -435,7 +435,10 @@ class MeshSplitter {
     std::vector<Triangle>& triangles = out.triangles;
     std::vector<FaceOrigin>& birthFaces = out.face_origin;
     std::vector<VertexOrigin>& origins = out.vertex_origin;
-    positions = points_;
+    // Room for the new vertices too (a copy's exact size would move every
+    // position at the first one).
+    positions.reserve(points_.size() + 4 * work_.size());
+    positions.assign(points_.begin(), points_.end());
     // The input's vertices and kept faces (nearly all of a large mesh)
     // written by index: a third fewer instructions than a push_back each.
     origins.reserve(points_.size() + 4 * work_.size());
