@@ -14,8 +14,8 @@ namespace meshmend {
 namespace {
 
 // The helpers and the jobs posted to them. One per process (per copy of the
-// core library: each plugin links its own); never destroyed while helpers
-// may run, see the destructor.
+// core library: each plugin links its own), never destroyed: Release sends
+// the helpers away when the library leaves the process.
 class HelperPool {
  public:
   static HelperPool& instance() {

@@ -213,14 +213,22 @@ TEST(ParallelChunks, AChildOfForkRunsJobsWithoutItsParentsHelpers) {
     for (int v : visits)
       if (v != 1) _exit(2);
     if (!ran) _exit(3);
-    // And the child has helpers of its own: slow chunks are shared.
+    // And the child has helpers of its own: a chunk on the caller waits (up
+    // to five seconds: a sanitizer's thread start is slow) until a helper
+    // has taken another.
     const auto caller = std::this_thread::get_id();
     std::atomic<int> elsewhere{0};
     parallelChunks(
         workerCount(),
         [&](std::size_t, std::size_t, unsigned) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(20));
-          if (std::this_thread::get_id() != caller) ++elsewhere;
+          if (std::this_thread::get_id() != caller) {
+            ++elsewhere;
+            return;
+          }
+          const auto start = std::chrono::steady_clock::now();
+          while (elsewhere == 0 &&
+                 std::chrono::steady_clock::now() - start < std::chrono::seconds(5))
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
         },
         1);
     _exit((elsewhere > 0) == (workerCount() > 1) ? 0 : 4);
