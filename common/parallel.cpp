@@ -6,7 +6,6 @@
 #include <condition_variable>
 #include <deque>
 #include <mutex>
-#include <new>
 #include <system_error>
 
 namespace meshmend {
@@ -19,7 +18,7 @@ namespace {
 class HelperPool {
  public:
   static HelperPool& instance() {
-    static HelperPool* pool = [] {
+    static const bool made = [] {
       // A child of fork() has none of its parent's helpers and perhaps a
       // lock some helper held: it starts from a new pool (the old one's
       // memory is left as it is; destroying it would wait for threads
@@ -27,9 +26,9 @@ class HelperPool {
       pthread_atfork(nullptr, nullptr, [] { current() = new HelperPool; });
       current() = new HelperPool;
       static Release release;
-      return current();
+      return true;
     }();
-    (void)pool;
+    (void)made;
     return *current();
   }
 

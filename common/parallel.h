@@ -34,7 +34,7 @@ inline unsigned workerCount() {
 namespace detail {
 
 // A job of `count` chunks: run(context, i) runs chunk i. Owned by the
-// thread that posts it, which waits in runJob() until every chunk is done.
+// thread that posts it, which waits in finishJob() until every chunk is done.
 struct Job {
   void (*run)(void* context, std::size_t chunk);
   void* context;

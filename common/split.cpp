@@ -11,8 +11,6 @@
 #include <numeric>
 #include <optional>
 #include <set>
-#include <system_error>
-#include <thread>
 #include <tuple>
 #include <unordered_map>
 
@@ -1154,8 +1152,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         "nothing to output: ask for the separate meshes, the merged mesh or both");
   SplitResult r;
   // The inputs as arrays, with their seams closed when asked; each keeps
-  // the input index of its vertices and faces.
-  // Meshes side by side; an error names the first mesh at fault.
+  // the input index of its vertices and faces. Meshes side by side; an
+  // error names the first mesh at fault.
   std::vector<WeldedArrays> inputs(meshes.size());
   std::vector<std::size_t> duplicateFaces(meshes.size(), 0);
   parallelChunks(
@@ -1233,8 +1231,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // cores are busy already). Only when the work (points and segments
   // received, not faces: a coarse mesh's faces receive many each) is shared
   // fairly evenly (as between two meshes that cross, where every curve
-  // segment goes into both) and there is enough of it to pay for a thread start (a few dozen
-  // faces); otherwise one mesh after the other, each on every core. With
+  // segment goes into both) and there is enough of it to be worth sharing
+  // (a few dozen faces); otherwise one mesh after the other, each on every core. With
   // more than two cores, each mesh still re-triangulates on several.
   // Without snapping, which rebuilds them, each mesh's output is final once
   // built, and side by side its thread makes its vcglib mesh too.
@@ -1297,9 +1295,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // Without snapping, each input's output is final here: unless built
   // already, vcglib meshes are built on a second thread while the merged
   // one is made (without it, while the curves are counted and the last
-  // input's is built here), once there are enough faces to pay for starting
-  // a thread (a few thousand faces take a few hundred microseconds; a thread
-  // start, tens).
+  // input's is built here), once there are enough faces to be worth
+  // handing to a helper (a few thousand faces take a few hundred
+  // microseconds).
   std::size_t outputFaces = 0;
   for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
   const std::size_t builtAside =
