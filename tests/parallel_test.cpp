@@ -196,45 +196,83 @@ TEST(ParallelChunks, HelpersServeJobAfterJob) {
     EXPECT_EQ(mostOnAHelper.load(), 0);  // one core: the caller runs every chunk
 }
 
-TEST(ParallelChunks, AChildOfForkRunsJobsWithoutItsParentsHelpers) {
-  parallelChunks(
-      1000, [](std::size_t, std::size_t, unsigned) {}, 1);  // helpers started
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    alarm(60);  // a hang fails the test instead of stopping it
-    std::vector<int> visits(100000, 0);
-    parallelChunks(visits.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-      for (std::size_t i = begin; i < end; ++i) ++visits[i];
-    });
-    bool ran = false;
-    TaskAlongside task([&] { ran = true; });
-    task.wait();
-    for (int v : visits)
-      if (v != 1) _exit(2);
-    if (!ran) _exit(3);
-    // And the child has helpers of its own: a chunk on the caller waits (up
-    // to five seconds: a sanitizer's thread start is slow) until a helper
-    // has taken another.
-    const auto caller = std::this_thread::get_id();
-    std::atomic<int> elsewhere{0};
-    parallelChunks(
-        workerCount(),
-        [&](std::size_t, std::size_t, unsigned) {
-          if (std::this_thread::get_id() != caller) {
-            ++elsewhere;
-            return;
-          }
-          const auto start = std::chrono::steady_clock::now();
-          while (elsewhere == 0 &&
-                 std::chrono::steady_clock::now() - start < std::chrono::seconds(5))
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        },
-        1);
-    _exit((elsewhere > 0) == (workerCount() > 1) ? 0 : 4);
+namespace {
+// Waits (up to five seconds: a sanitizer's thread start is slow) until
+// `done` holds.
+template <class Condition>
+bool waitFor(Condition done) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!done()) {
+    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(5)) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
+  return true;
+}
+
+// What a child of fork() checks, as its exit code: its jobs run every
+// chunk once, a task alongside runs, and it has helpers of its own (a
+// chunk on the caller waits until a helper has taken another).
+int checkJobsInForkedChild() {
+  std::vector<int> visits(100000, 0);
+  parallelChunks(visits.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t i = begin; i < end; ++i) ++visits[i];
+  });
+  bool ran = false;
+  TaskAlongside task([&] { ran = true; });
+  task.wait();
+  for (int v : visits)
+    if (v != 1) return 2;
+  if (!ran) return 3;
+  const auto caller = std::this_thread::get_id();
+  std::atomic<int> elsewhere{0};
+  parallelChunks(
+      workerCount(),
+      [&](std::size_t, std::size_t, unsigned) {
+        if (std::this_thread::get_id() != caller)
+          ++elsewhere;
+        else
+          waitFor([&] { return elsewhere > 0; });
+      },
+      1);
+  return (elsewhere > 0) == (workerCount() > 1) ? 0 : 4;
+}
+}  // namespace
+
+// The parent forks from inside a job while its helpers are busy with the
+// job's other chunks: the child inherits a pool that counts them, though
+// they are not there. The helpers wait in the test's own code, where they
+// hold no lock (a sanitizer's allocator, unlike the C library's, is not
+// made safe across fork: a helper allocating at that moment would leave
+// its lock held in the child).
+TEST(ParallelChunks, AChildOfForkRunsJobsWithoutItsParentsHelpers) {
+  const auto caller = std::this_thread::get_id();
+  const unsigned helpers = workerCount() - 1;
+  std::atomic<unsigned> helpersInside{0};
+  std::atomic<bool> forked{false};
+  bool helpersWereInside = false;
+  pid_t child = -1;
   int status = 0;
-  ASSERT_EQ(waitpid(child, &status, 0), child);
+  parallelChunks(
+      workerCount(),
+      [&](std::size_t, std::size_t, unsigned) {
+        if (std::this_thread::get_id() != caller) {
+          ++helpersInside;
+          waitFor([&] { return forked.load(); });
+          return;
+        }
+        if (forked) return;  // the caller took a second chunk
+        helpersWereInside = waitFor([&] { return helpersInside == helpers; });
+        child = fork();
+        if (child == 0) {
+          alarm(60);  // a hang fails the test instead of stopping it
+          _exit(checkJobsInForkedChild());
+        }
+        forked = true;
+        if (child > 0 && waitpid(child, &status, 0) != child) child = -1;
+      },
+      1);
+  EXPECT_TRUE(helpersWereInside) << "the parent's helpers did not take their chunks";
+  ASSERT_GT(child, 0) << "fork or waitpid failed";
   ASSERT_TRUE(WIFEXITED(status)) << "the child was stopped by signal " << WTERMSIG(status);
   EXPECT_EQ(WEXITSTATUS(status), 0);
 }
