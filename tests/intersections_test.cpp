@@ -243,5 +243,44 @@ TEST(BoxTree, BoxesAreConservative) {
   }
 }
 
+// Each side of a box is the float nearest the coordinate on its side:
+// the largest float not above it (lo), the smallest not below it (hi), for
+// floats, numbers between floats, both zeros, the smallest and largest
+// magnitudes and numbers beyond the largest float.
+TEST(BoxTree, BoxesAreTheTightestFloatBoxes) {
+  std::vector<double> xs = {0.0,
+                            -0.0,
+                            0.1,
+                            -0.1,
+                            1.0,
+                            -1.0,
+                            1e-45,
+                            -1e-45,
+                            1e-300,
+                            -1e-300,
+                            double(std::numeric_limits<float>::max()),
+                            -double(std::numeric_limits<float>::max()),
+                            1e39,
+                            -1e39,
+                            1e300,
+                            -1e300};
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (int i = 0; i < 2000; ++i)
+    xs.push_back(unit(random) * std::pow(10.0, int(random() % 60) - 30));
+  for (double x : xs) {
+    const Box b = boxOf(Point3(x, x, x));
+    float lo = float(x), hi = float(x);  // the float nearest x, then stepped with nextafter
+    if (double(lo) > x) lo = std::nextafter(lo, -std::numeric_limits<float>::infinity());
+    if (double(hi) < x) hi = std::nextafter(hi, std::numeric_limits<float>::infinity());
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(b.lo[k], lo) << "x = " << x;
+      EXPECT_EQ(b.hi[k], hi) << "x = " << x;
+      EXPECT_LE(double(b.lo[k]), x);
+      EXPECT_GE(double(b.hi[k]), x);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace meshmend
