@@ -36,9 +36,12 @@ inline Box hull(const Box& a, const Box& b, const Box& c) {
   return h;
 }
 
+// All six comparisons, then one branch on the result (in a tree descent
+// each comparison's outcome is as good as random: a branch per comparison
+// was mispredicted often).
 inline bool overlap(const Box& x, const Box& y) {
-  return x.lo[0] <= y.hi[0] && y.lo[0] <= x.hi[0] && x.lo[1] <= y.hi[1] && y.lo[1] <= x.hi[1] &&
-         x.lo[2] <= y.hi[2] && y.lo[2] <= x.hi[2];
+  return (x.lo[0] <= y.hi[0]) & (y.lo[0] <= x.hi[0]) & (x.lo[1] <= y.hi[1]) & (y.lo[1] <= x.hi[1]) &
+         (x.lo[2] <= y.hi[2]) & (y.lo[2] <= x.hi[2]);
 }
 
 // A coarse occupancy grid over the cells that some boxes touch: it turns
