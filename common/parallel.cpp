@@ -2,8 +2,10 @@
 
 #include <pthread.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <mutex>
 #include <system_error>
@@ -47,7 +49,7 @@ class HelperPool {
       ++helpers_;
       ++idle_;  // counted as waiting until it takes a chunk
     }
-    changed_.notify_all();
+    signal();
   }
 
   // While its own job has chunks left, the poster takes them; then, until
@@ -66,21 +68,23 @@ class HelperPool {
                           : pending_.empty()      ? nullptr
                                                   : pending_.front();
       if (!next) {
-        changed_.wait(lock);
+        const std::uint64_t seen = epoch_;
+        if (!spinUntilChange(lock, seen, std::chrono::steady_clock::now() + kSpin))
+          changed_.wait(lock, [&] { return epoch_ != seen; });
         continue;
       }
       const std::size_t chunk = claim(*next);
       lock.unlock();
       next->run(next->context, chunk);
       lock.lock();
-      if (++next->finished == next->count) changed_.notify_all();
+      if (++next->finished == next->count) signal();
     }
   }
 
   void release() {
     std::unique_lock<std::mutex> lock(mutex_);
     stop_ = true;
-    changed_.notify_all();
+    signal();
     changed_.wait(lock, [&] { return helpers_ == 0; });
     stop_ = false;
   }
@@ -116,8 +120,13 @@ class HelperPool {
   void serve() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-      if (!stop_ && pending_.empty())
-        changed_.wait_for(lock, kIdle, [&] { return stop_ || !pending_.empty(); });
+      if (!stop_ && pending_.empty()) {
+        const auto deadline = std::chrono::steady_clock::now() + kSpin;
+        while (!stop_ && pending_.empty() && spinUntilChange(lock, epoch_, deadline)) {
+        }
+        if (!stop_ && pending_.empty())
+          changed_.wait_for(lock, kIdle, [&] { return stop_ || !pending_.empty(); });
+      }
       if (stop_ || pending_.empty()) break;  // released, or idle for kIdle
       --idle_;
       detail::Job& job = *pending_.front();
@@ -126,12 +135,53 @@ class HelperPool {
       job.run(job.context, chunk);
       lock.lock();
       ++idle_;
-      if (++job.finished == job.count) changed_.notify_all();
+      if (++job.finished == job.count) signal();
     }
     --idle_;
     --helpers_;
+    signal();
+  }
+
+  // Wakes the waiting threads; a spinning one sees the epoch change.
+  // Always under the lock, so that a thread that finds the epoch as it was
+  // there and then sleeps cannot miss a change.
+  void signal() {
+    epoch_.store(epoch_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
     changed_.notify_all();
   }
+
+  // Before a thread sleeps on the condition, it watches the epoch with the
+  // lock released, until it changes from `seen` (true) or the deadline
+  // passes (false). The stages of one operation follow each other closely,
+  // and a sleeping thread takes tens of microseconds to wake (as long as a
+  // small mesh's stage); worse, the scheduler tends to wake it on the CPU
+  // of the thread that woke it, and two threads then share one CPU for
+  // milliseconds. Spinning, neither sleeps between the stages.
+  bool spinUntilChange(std::unique_lock<std::mutex>& lock, std::uint64_t seen,
+                       std::chrono::steady_clock::time_point deadline) {
+    lock.unlock();
+    bool changed = false;
+    for (int i = 1;; ++i) {
+      if (epoch_.load(std::memory_order_acquire) != seen) {
+        changed = true;
+        break;
+      }
+      relax();
+      if (i % 64 == 0 && std::chrono::steady_clock::now() > deadline) break;
+    }
+    lock.lock();
+    return changed;
+  }
+  static void relax() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+
+  // How long a waiting thread spins before it sleeps: a little longer than
+  // the gaps between the parallel stages of a small operation, short
+  // against anything a user waits for.
+  static constexpr std::chrono::microseconds kSpin{200};
 
   // How long a helper waits for work before it leaves: long enough to
   // span the gaps between one operation's stages, short against a user's
@@ -141,6 +191,7 @@ class HelperPool {
   std::mutex mutex_;
   // A job was posted, a job's last chunk or a helper finished, or stop_ set.
   std::condition_variable changed_;
+  std::atomic<std::uint64_t> epoch_{0};  // counts the changes, made under the lock
   std::deque<detail::Job*> pending_;
   std::size_t helpers_ = 0;  // started and not yet gone
   std::size_t idle_ = 0;     // of those, waiting for a chunk
