@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #include "common/errors.h"
@@ -42,11 +43,28 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
   return std::atan2((u ^ v).Norm(), u * v);
 }
 
+namespace {
+// `condition ? x : y` by a mask of the bits (compilers branch on a ternary).
+double select(bool condition, double x, double y) {
+  std::uint64_t bx, by;
+  std::memcpy(&bx, &x, sizeof bx);
+  std::memcpy(&by, &y, sizeof by);
+  const std::uint64_t take = -std::uint64_t(condition);
+  bx = (bx & take) | (by & ~take);
+  std::memcpy(&x, &bx, sizeof x);
+  return x;
+}
+}  // namespace
+
 double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
   const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
   const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
-  // sin² at the apex opposite the shortest side = 4 area² / (product of the two others).
-  const double others = ab <= bc && ab <= ca ? bc * ca : bc <= ca ? ab * ca : ab * bc;
+  // sin² at the apex opposite the shortest side = 4 area² / (product of the
+  // two others). The products chosen by selects, not branches: which side
+  // is shortest is as good as random, and the re-triangulation's flips ask
+  // this of every candidate triangle.
+  const double others =
+      select((ab <= bc) & (ab <= ca), bc * ca, select(bc <= ca, ab * ca, ab * bc));
   return others > 0 ? cross / others : 0;
 }
 
