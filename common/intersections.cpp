@@ -45,10 +45,17 @@ struct Soup {
     if (!points.empty()) bounds = boxOf(lo, hi, hi);
     degenerate.resize(triangles.size());
     if (!withTree) {
-      for (std::size_t f = 0; f < triangles.size(); ++f) {
-        const Triangle& t = triangles[f];
-        degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
-      }
+      // In chunks: a large mesh's share goes to the threads a small one's
+      // leaves (the meshes are prepared side by side).
+      parallelChunks(
+          triangles.size(),
+          [&](std::size_t begin, std::size_t end, unsigned) {
+            for (std::size_t f = begin; f < end; ++f) {
+              const Triangle& t = triangles[f];
+              degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
+            }
+          },
+          2048);
       return;
     }
     // Each point rounded to float once (about six faces share it), then
@@ -100,21 +107,39 @@ Candidates facesTouching(const Soup& s, const Box& other) {
     hi[k] = std::nextafter(other.hi[k], INFINITY);
   }
   std::vector<std::uint8_t> beyond(s.points.size());
-  for (std::size_t v = 0; v < s.points.size(); ++v) {
-    const Point3& p = s.points[v];
-    beyond[v] = std::uint8_t((p[0] < lo[0]) | (p[0] > hi[0]) << 1 | (p[1] < lo[1]) << 2 |
-                             (p[1] > hi[1]) << 3 | (p[2] < lo[2]) << 4 | (p[2] > hi[2]) << 5);
+  // In chunks, each keeping its own candidates, then joined in order: the
+  // two meshes' searches run side by side, and a large mesh's chunks go to
+  // the threads a small one's search leaves.
+  std::vector<Candidates> parts(workerCount());
+  parallelChunks(
+      s.points.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t v = begin; v < end; ++v) {
+          const Point3& p = s.points[v];
+          beyond[v] = std::uint8_t((p[0] < lo[0]) | (p[0] > hi[0]) << 1 | (p[1] < lo[1]) << 2 |
+                                   (p[1] > hi[1]) << 3 | (p[2] < lo[2]) << 4 | (p[2] > hi[2]) << 5);
+        }
+      },
+      4096);
+  parallelChunks(
+      s.triangles.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        Candidates& c = parts[worker];
+        for (std::size_t f = begin; f < end; ++f) {
+          const Triangle& t = s.triangles[f];
+          if ((beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) || s.degenerate[f]) continue;
+          const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
+          if (!overlap(box, other)) continue;
+          c.faces.push_back(std::uint32_t(f));
+          c.boxes.push_back(box);
+        }
+      },
+      2048);
+  for (std::size_t w = 1; w < parts.size(); ++w) {
+    parts[0].faces.insert(parts[0].faces.end(), parts[w].faces.begin(), parts[w].faces.end());
+    parts[0].boxes.insert(parts[0].boxes.end(), parts[w].boxes.begin(), parts[w].boxes.end());
   }
-  Candidates c;
-  for (std::size_t f = 0; f < s.triangles.size(); ++f) {
-    const Triangle& t = s.triangles[f];
-    if ((beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) || s.degenerate[f]) continue;
-    const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
-    if (!overlap(box, other)) continue;
-    c.faces.push_back(std::uint32_t(f));
-    c.boxes.push_back(box);
-  }
-  return c;
+  return std::move(parts[0]);
 }
 
 // Are all three corners of face g of `gs` strictly on one side of the plane
