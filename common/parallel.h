@@ -4,8 +4,9 @@
 // Starting a thread costs tens of microseconds, as much as a small mesh's
 // whole stage: a split of two small meshes has four parallel stages. So the
 // helpers (one fewer than the cores) are started on first use and wait for
-// the next job; each leaves after a moment without work, so an idle
-// process keeps no threads. The thread that posts a job takes its chunks
+// the next job (spinning a moment before they sleep, as the stages of one
+// operation follow each other closely); each leaves after a moment without
+// work, so an idle process keeps no threads. The thread that posts a job takes its chunks
 // too, and runs every chunk no helper has taken by the time it has
 // finished its own: every chunk runs exactly once, also when no thread can
 // be started. While it waits for the helpers' chunks it takes chunks of
