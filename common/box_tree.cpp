@@ -120,6 +120,68 @@ bool BoxGrid::covers(const Box& b) const {
   return true;
 }
 
+HashedBoxGrid::HashedBoxGrid(std::vector<Box> boxes) : boxes_(std::move(boxes)) {
+  if (boxes_.empty()) return;
+  bounds_ = boxes_[0];
+  double extent[3] = {0, 0, 0};
+  for (const Box& b : boxes_) {
+    grow(bounds_, b);
+    for (int k = 0; k < 3; ++k) extent[k] += double(b.hi[k]) - b.lo[k];
+  }
+  // Cells twice as large as the boxes along each axis on average (a box
+  // lists in about three; as large as them, eight, and the search took
+  // longer), at most kAxisCells along one.
+  for (int k = 0; k < 3; ++k) {
+    const double size = std::max(2 * extent[k] / double(boxes_.size()),
+                                 (double(bounds_.hi[k]) - bounds_.lo[k]) / kAxisCells);
+    cellsPerUnit_[k] = size > 0 ? float(1 / size) : 0;  // flat along k: one cell
+  }
+  firstCell_.resize(boxes_.size());
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < boxes_.size(); ++i) {
+    std::size_t cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      const int lo = cell(boxes_[i].lo[k], k);
+      firstCell_[i][k] = std::uint16_t(lo);
+      cells *= std::size_t(cell(boxes_[i].hi[k], k) - lo + 1);
+    }
+    if (cells > kMostCells) {  // boxes of very different sizes: a tree's case
+      usable_ = false;
+      firstCell_ = {};
+      return;
+    }
+    total += cells;
+  }
+  // About one bucket per entry (a power of two, the hash's top bits).
+  int bits = 1;
+  while ((std::size_t(1) << bits) < total && bits < 30) ++bits;
+  shift_ = 32 - bits;
+  start_.assign((std::size_t(1) << bits) + 1, 0);
+  auto forEachCell = [&](std::uint32_t i, auto&& f) {
+    const Box& b = boxes_[i];
+    const int hx = cell(b.hi[0], 0), hy = cell(b.hi[1], 1), hz = cell(b.hi[2], 2);
+    for (int x = firstCell_[i][0]; x <= hx; ++x)
+      for (int y = firstCell_[i][1]; y <= hy; ++y)
+        for (int z = firstCell_[i][2]; z <= hz; ++z) f(key(x, y, z));
+  };
+  for (std::uint32_t i = 0; i < boxes_.size(); ++i)
+    forEachCell(i, [&](std::uint32_t k) { ++start_[bucket(k) + 1]; });
+  for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+  entries_.resize(total);
+  std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+  for (std::uint32_t i = 0; i < boxes_.size(); ++i)
+    forEachCell(i, [&](std::uint32_t k) { entries_[fill[bucket(k)]++] = {k, i}; });
+}
+
+bool HashedBoxGrid::suits(const std::vector<Box>& queries) const {
+  if (!usable_) return false;
+  std::size_t wide = 0;
+  for (const Box& q : queries) wide += cellsOf(q) > kMostCells;
+  // A wide query tests every box: worth it while those tests cost no more
+  // than the cell visits of all the queries, a few dozen tests each.
+  return wide * boxes_.size() <= 64 * queries.size();
+}
+
 BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
     : boxes_(std::move(boxes)), order_(boxes_.size()) {
   std::iota(order_.begin(), order_.end(), 0u);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "common/box_tree.h"
@@ -294,12 +295,28 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
         // a tree descent (for a small mesh, its set-up would cost more).
         std::unique_ptr<BoxGrid> nearSmall;
         if (lc.faces.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(sc.boxes);
-        const BoxTree tree(sc.boxes, options.layout == 1 ? BoxTree::Layout::kMorton
-                                                         : BoxTree::Layout::kMedianSplit);
+        // The candidates near a curve are faces of similar sizes: a hashed
+        // grid finds their overlaps with a fraction of a tree's work (no
+        // median splits to build it, no descent from the root for a face
+        // far from all). A tree where the sizes differ too much for a grid.
+        std::optional<HashedBoxGrid> grid;
+        std::optional<BoxTree> tree;
         std::vector<PlaneSide> planes(sc.faces.size());
-        for (std::size_t i = 0; i < sc.faces.size(); ++i) {
-          const TrianglePoints t = s.at(sc.faces[i]);
-          planes[i] = PlaneSide(t[0], t[1], t[2]);
+        {
+          // The planes on a second thread while this one builds.
+          TaskAlongside planesAside([&] {
+            for (std::size_t i = 0; i < sc.faces.size(); ++i) {
+              const TrianglePoints t = s.at(sc.faces[i]);
+              planes[i] = PlaneSide(t[0], t[1], t[2]);
+            }
+          });
+          if (options.layout == 0) grid.emplace(sc.boxes);
+          if (!grid || !grid->suits(lc.boxes)) {
+            grid.reset();
+            tree.emplace(sc.boxes, options.layout == 1 ? BoxTree::Layout::kMorton
+                                                       : BoxTree::Layout::kMedianSplit);
+          }
+          planesAside.wait();
         }
         r.build_ms += msSince(treeStart);
         // A query face costs about a microsecond (a descent and its
@@ -313,7 +330,7 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
                 const TrianglePoints tg = l.at(g);
                 PlaneSide planeOfG;  // made when a face first reaches g's plane
                 bool planeOfGMade = false;
-                tree.query(lc.boxes[i], worker, [&](std::uint32_t j, unsigned w) {
+                auto candidate = [&](std::uint32_t j, unsigned w) {
                   ++found[w].candidates;
                   // side[0]: f's corners against g's plane; side[1]: g's against f's.
                   PlaneSides side;
@@ -335,7 +352,11 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
                     for (int c = 0; c < 3; ++c)
                       x.side[t][c] = std::int8_t(side[flip ? 1 - t : t][c]);
                   found[w].pairs.push_back(x);
-                });
+                };
+                if (grid)
+                  grid->query(lc.boxes[i], [&](std::uint32_t j) { candidate(j, worker); });
+                else
+                  tree->query(lc.boxes[i], worker, candidate);
               }
             },
             256);

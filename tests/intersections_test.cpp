@@ -234,6 +234,75 @@ TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
   EXPECT_EQ(hits, expectedHits);
 }
 
+// Every query reports exactly the boxes that overlap it (touching counts),
+// each once, against brute force.
+void expectGridFindsEveryOverlapOnce(const HashedBoxGrid& grid, const std::vector<Box>& boxes,
+                                     const std::vector<Box>& queries) {
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    std::vector<std::uint32_t> hits, expected;
+    grid.query(queries[q], [&](std::uint32_t i) { hits.push_back(i); });
+    for (std::uint32_t i = 0; i < boxes.size(); ++i)
+      if (overlap(boxes[i], queries[q])) expected.push_back(i);
+    std::sort(hits.begin(), hits.end());
+    ASSERT_EQ(hits, expected) << "query " << q;
+  }
+}
+
+TEST(HashedBoxGrid, QueriesFindEveryOverlapOnce) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 10), size(0.05, 0.3);
+  auto randomBox = [&](double scale) {
+    const Point3 a(u(rng), u(rng), 0.3 * u(rng));  // a slab, as faces near a curve
+    return boxOf(a, a + Point3(size(rng), size(rng), size(rng)) * scale,
+                 a + Point3(size(rng), -size(rng), size(rng)) * scale);
+  };
+  std::vector<Box> boxes, queries;
+  for (int i = 0; i < 3000; ++i) boxes.push_back(randomBox(1));
+  for (int i = 0; i < 2000; ++i) queries.push_back(randomBox(1));
+  for (int i = 0; i < 20; ++i) queries.push_back(randomBox(30));  // wide: every box tested
+  for (int i = 0; i < 50; ++i) queries.push_back(boxes[i]);       // the same box
+  for (int i = 50; i < 100; ++i) {  // touching a box at its corner only
+    Box b = boxes[i];
+    for (int k = 0; k < 3; ++k) b.lo[k] = b.hi[k], b.hi[k] += 0.1f;
+    queries.push_back(b);
+  }
+  queries.push_back({{-5, -5, -5}, {-4, -4, -4}});  // beyond the grid
+  queries.push_back({{-1e30f, -1e30f, -1e30f}, {1e30f, 1e30f, 1e30f}});
+  const HashedBoxGrid grid(boxes);
+  EXPECT_TRUE(grid.suits(queries));
+  expectGridFindsEveryOverlapOnce(grid, boxes, queries);
+}
+
+TEST(HashedBoxGrid, FlatAndMixedSizedBoxes) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Box> flat, queries;
+  for (int i = 0; i < 500; ++i) {
+    const Point3 a(u(rng), u(rng), 2);
+    flat.push_back(boxOf(a, a + Point3(0.02, 0.01, 0), a + Point3(0.01, 0.03, 0)));
+    const Point3 q(u(rng), u(rng), 1.99);
+    queries.push_back(boxOf(q, q + Point3(0.03, 0.01, 0.02), q + Point3(0.01, 0.02, 0.01)));
+  }
+  const HashedBoxGrid flatGrid(flat);  // one cell across the plane
+  EXPECT_TRUE(flatGrid.suits(queries));
+  expectGridFindsEveryOverlapOnce(flatGrid, flat, queries);
+  // One box across everything: listed, it would fill every cell; the grid
+  // lists none, leaves the search to a tree, and still answers right.
+  std::vector<Box> mixed(flat.begin(), flat.end());
+  mixed.push_back(boxOf(Point3(-1, -1, 1), Point3(2, 2, 3), Point3(2, -1, 1)));
+  const HashedBoxGrid mixedGrid(mixed);
+  EXPECT_FALSE(mixedGrid.suits(queries));
+  expectGridFindsEveryOverlapOnce(mixedGrid, mixed, queries);
+  // Queries each wider than many cells: every one would test every box.
+  std::vector<Box> wide(100, boxOf(Point3(0, 0, 1), Point3(1, 1, 3), Point3(1, 0, 1)));
+  EXPECT_FALSE(flatGrid.suits(wide));
+  expectGridFindsEveryOverlapOnce(flatGrid, flat, wide);
+  const HashedBoxGrid empty({});
+  std::size_t hits = 0;
+  empty.query(queries[0], [&](std::uint32_t) { ++hits; });
+  EXPECT_EQ(hits, 0u);
+}
+
 TEST(BoxTree, BoxesAreConservative) {
   const double x = 0.1;  // not a float: the box must still contain it
   const Box b = boxOf({x, x, x}, {x, x, x}, {x, x, x});
