@@ -433,6 +433,7 @@ class MeshSplitter {
     std::vector<Triangle>& triangles = out.triangles;
     std::vector<FaceOrigin>& birthFaces = out.face_origin;
     std::vector<VertexOrigin>& origins = out.vertex_origin;
+    slivers_ = 0;
     // Room for the new vertices too (a copy's exact size would move every
     // position at the first one).
     positions.reserve(points_.size() + 4 * work_.size());
@@ -516,6 +517,8 @@ class MeshSplitter {
         if (sine < smallestSine) smallestSine = sine, smallestFace = {a, b, c};
         triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
         birthFaces.push_back({int(index_), faceOrigin_[f]});
+        slivers_ +=
+            isSliver(positions[global[t[0]]], positions[global[t[1]]], positions[global[t[2]]]);
       }
       for (const auto& e : patch.constrained_edges)
         curves.push_back(
@@ -541,6 +544,9 @@ class MeshSplitter {
   std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
+  // New faces with an angle under 1°, positions as built (the merged
+  // output's too, unless snapping moves them).
+  std::size_t slivers() const { return slivers_; }
   const std::vector<int>& contactVertices() const { return contactVertices_; }
   // Per output vertex: the curve point id at it, or -1.
   const std::vector<int>& pointOfVertex() const { return pointOfVertex_; }
@@ -570,6 +576,7 @@ class MeshSplitter {
   std::size_t degenerateKept_ = 0;
   std::size_t keptFaces_ = 0;
   double smallestAngle_ = M_PI;
+  std::size_t slivers_ = 0;
   std::vector<int> contactVertices_;  // output vertices at contact points
   std::vector<int> pointOfVertex_;
 };
@@ -1214,12 +1221,21 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
   table.mergeCoincident();
   for (int& id : contactIds) id = table.representative(id);
-  for (std::size_t i = 0; i < found.pairs.size(); ++i) {
-    const int* ids = contactIds.data() + contactStart[i];
-    const std::size_t n = contactStart[i + 1] - contactStart[i];
-    splitters[found.pairs[i].a.mesh].addContact(found.pairs[i].a.face, ids, n);
-    splitters[found.pairs[i].b.mesh].addContact(found.pairs[i].b.face, ids, n);
-  }
+  // Each mesh's faces receive their contacts on their own thread, in the
+  // pairs' order.
+  parallelChunks(
+      meshes.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t m = begin; m < end; ++m)
+          for (std::size_t i = 0; i < found.pairs.size(); ++i) {
+            const int* ids = contactIds.data() + contactStart[i];
+            const std::size_t n = contactStart[i + 1] - contactStart[i];
+            const IntersectingPair& pair = found.pairs[i];
+            if (pair.a.mesh == m) splitters[m].addContact(pair.a.face, ids, n);
+            if (pair.b.mesh == m) splitters[m].addContact(pair.b.face, ids, n);
+          }
+      },
+      1);
   reportProgress(options.progress, 55, "Re-triangulating crossed faces");
   std::vector<std::vector<ExactPoint>> exactNew(meshes.size());
   std::vector<OutputArrays> outputs(meshes.size());
@@ -1370,14 +1386,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       // Only what the merged output would tell: its slivers (the new faces
       // of each mesh, positions as they are there) and its curves, a graph
       // on the welded curve points (the merged output's curve vertices).
-      std::size_t slivers = 0;
-      for (std::size_t m = 0; m < meshes.size(); ++m) {
-        const OutputArrays& mesh = outputs[m];
-        for (std::size_t f = splitters[m].keptFaces(); f < mesh.triangles.size(); ++f) {
-          const Triangle& t = mesh.triangles[f];
-          slivers += isSliver(mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
-        }
-      }
+      std::size_t slivers = 0;  // counted as each mesh was built
+      for (const MeshSplitter& s : splitters) slivers += s.slivers();
       r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers;
       std::vector<std::array<int, 2>> curves;
       for (std::size_t m = 0; m < meshes.size(); ++m)
