@@ -190,6 +190,20 @@ TEST(Intersections, BetweenMeshesMatchesBruteForceAtTheEdgeOfTheirBounds) {
   EXPECT_GT(pairs, 0u);
   expectCrossMatchesBruteForce(t, s, pairs);
   EXPECT_GT(pairs, 0u);
+  // Faces of very different sizes (a large triangle across the coarse
+  // sphere, too wide for the search's grid cells): the same pairs.
+  std::vector<Point3> p = positionsOf(t);
+  std::vector<Triangle> f = trianglesOf(t);
+  const int n = int(p.size());
+  p.push_back({-1.5, -1.5, -0.9});
+  p.push_back({2.5, -1.2, 0.9});
+  p.push_back({0.4, 2.5, 0.1});
+  f.push_back({n, n + 1, n + 2});
+  const Mesh mixed = makeMesh(p, f);
+  expectCrossMatchesBruteForce(s, mixed, pairs);
+  EXPECT_GT(pairs, 0u);
+  expectCrossMatchesBruteForce(mixed, s, pairs);
+  EXPECT_GT(pairs, 0u);
 }
 
 TEST(Intersections, BadInput) {
