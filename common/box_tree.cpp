@@ -139,12 +139,8 @@ HashedBoxGrid::HashedBoxGrid(std::vector<Box> boxes) : boxes_(std::move(boxes)) 
   firstCell_.resize(boxes_.size());
   std::size_t total = 0;
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
-    std::size_t cells = 1;
-    for (int k = 0; k < 3; ++k) {
-      const int lo = cell(boxes_[i].lo[k], k);
-      firstCell_[i][k] = std::uint16_t(lo);
-      cells *= std::size_t(cell(boxes_[i].hi[k], k) - lo + 1);
-    }
+    for (int k = 0; k < 3; ++k) firstCell_[i][k] = std::uint16_t(cell(boxes_[i].lo[k], k));
+    const std::size_t cells = cellsOf(boxes_[i]);
     if (cells > kMostCells) {  // boxes of very different sizes: a tree's case
       usable_ = false;
       firstCell_ = {};

@@ -81,14 +81,13 @@ class BoxGrid {
 // there. Built in two linear passes (no sorting: a tree's median splits,
 // their comparisons as good as random, took a fifth to two fifths of a
 // search between two small meshes), and a query far from every box
-// touches only empty cells. The cells are about twice as large as the boxes on average, so
-// that a box lists in a few; a query box that touches many cells tests
-// every box instead.
+// touches only empty cells. The cells are about twice as large as the
+// boxes on average, so that a box lists in a few; a query box that
+// touches many cells tests every box instead.
 class HashedBoxGrid {
  public:
   explicit HashedBoxGrid(std::vector<Box> boxes);
 
-  std::size_t size() const { return boxes_.size(); }
   // Whether the grid serves these queries (in number of box tests) about
   // as well as a tree would: false when one of its own boxes spans many
   // cells (it lists none then) or too many of the queries do (each of
