@@ -19,18 +19,15 @@
 #include <cstddef>
 #include <exception>
 #include <functional>
-#include <thread>
 #include <vector>
 
 namespace meshmend {
 
-// Number of worker threads used by parallelChunks (at least 1).
-// hardware_concurrency reads /sys on every call (two file opens), which
-// costs more than a small job's work: asked once.
-inline unsigned workerCount() {
-  static const unsigned count = std::max(1u, std::thread::hardware_concurrency());
-  return count;
-}
+// Number of worker threads used by parallelChunks (at least 1): the CPUs
+// the process may run on (taskset, cgroup cpusets), asked once, where
+// hardware_concurrency counts every CPU of the machine (and reads /sys on
+// every call, which costs more than a small job's work).
+unsigned workerCount();
 
 namespace detail {
 
@@ -42,6 +39,7 @@ struct Job {
   std::size_t count;
   std::size_t claimed = 0;   // chunks taken (by any thread), under the pool's lock
   std::size_t finished = 0;  // chunks done, under the pool's lock
+  int poster_cpu = -1;       // the CPU the posting thread was on (-1: unknown)
 };
 
 // Posts the job to the helpers, runs the chunks they have not taken on the
@@ -54,6 +52,12 @@ void runJob(Job& job);
 // waits for those a helper has taken.
 void postJob(Job& job);
 void finishJob(Job& job, bool runUntaken);
+
+// Moves the calling thread off `cpu` (where it runs) onto another CPU it
+// may run on, keeping the CPUs it may run on as they were. False when it
+// has no other CPU (or may not run on `cpu`). The pool uses it to keep a
+// helper off the CPU of the thread whose chunk it runs (parallel.cpp).
+bool moveOffCpu(int cpu);
 
 }  // namespace detail
 

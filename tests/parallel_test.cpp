@@ -1,12 +1,14 @@
 // parallel.h: every chunk runs exactly once, also when no thread can be
 // started (a process at its thread limit, a container with few PIDs), in
 // jobs posted from inside other jobs' chunks and in a child of fork(); the
-// helpers serve job after job; and the work that relies on it (hole
+// helpers serve job after job, on the CPUs the process may run on and off
+// the CPU of the thread whose chunks they take; and the work that relies on it (hole
 // filling re-points a moved mesh's faces in parallel) still finishes with
 // the same result.
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 #include <pthread.h>
+#include <sched.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -194,6 +196,86 @@ TEST(ParallelChunks, HelpersServeJobAfterJob) {
     EXPECT_GE(mostOnAHelper.load(), 2);
   else
     EXPECT_EQ(mostOnAHelper.load(), 0);  // one core: the caller runs every chunk
+}
+
+namespace {
+cpu_set_t allowedCpus() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  EXPECT_EQ(sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  return allowed;
+}
+}  // namespace
+
+TEST(ParallelChunks, WorkerCountIsTheCpusTheProcessMayRunOn) {
+  cpu_set_t allowed = allowedCpus();
+  EXPECT_EQ(workerCount(), unsigned(CPU_COUNT(&allowed)));
+}
+
+// moveOffCpu leaves the CPU it is given and keeps the set the thread may run
+// on; with no other CPU to go to it says so and stays.
+TEST(ParallelChunks, MoveOffCpuLeavesTheCpuAndKeepsTheAllowedSet) {
+  std::thread([] {
+    const cpu_set_t allowed = allowedCpus();
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      const int cpu = sched_getcpu();
+      ASSERT_GE(cpu, 0);
+      const bool moved = detail::moveOffCpu(cpu);
+      EXPECT_EQ(moved, CPU_COUNT(&allowed) > 1);
+      if (moved) {
+        EXPECT_NE(sched_getcpu(), cpu);  // not moved back by the restored set
+      }
+      cpu_set_t now = allowedCpus();
+      EXPECT_TRUE(CPU_EQUAL(&now, &allowed));
+    }
+    // Pinned to one CPU, there is nowhere to go.
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    const int cpu = sched_getcpu();
+    CPU_SET(cpu, &one);
+    ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof one, &one), 0);
+    EXPECT_FALSE(detail::moveOffCpu(cpu));
+    EXPECT_EQ(sched_getcpu(), cpu);
+  }).join();
+}
+
+// A helper never runs a chunk on the CPU its poster was on when it posted:
+// the poster, pinned to one CPU, posts jobs whose chunks take long enough
+// for a helper to take one; each chunk notes where it ran.
+TEST(ParallelChunks, HelpersRunChunksOffThePostersCpu) {
+  if (workerCount() < 2) {
+    EXPECT_EQ(workerCount(), 1u);  // one CPU: the caller runs every chunk (HelpersServeJobAfterJob)
+    return;
+  }
+  parallelChunks(
+      2, [](std::size_t, std::size_t, unsigned) {}, 1);  // helpers with every CPU
+  std::thread([] {
+    const int posterCpu = sched_getcpu();
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(posterCpu, &one);
+    ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof one, &one), 0);
+    const auto poster = std::this_thread::get_id();
+    std::atomic<int> onHelpers{0}, onPostersCpu{0};
+    for (int job = 0; job < 20; ++job) {
+      // Let the helpers fall asleep now and then: a woken helper may start
+      // out next to its waker, a spinning one may be put there.
+      if (job % 4 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      parallelChunks(
+          2,
+          [&](std::size_t, std::size_t, unsigned) {
+            const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2);
+            while (std::chrono::steady_clock::now() < until) {
+            }
+            if (std::this_thread::get_id() == poster) return;
+            ++onHelpers;
+            if (sched_getcpu() == posterCpu) ++onPostersCpu;
+          },
+          1);
+    }
+    EXPECT_GT(onHelpers.load(), 0);
+    EXPECT_EQ(onPostersCpu.load(), 0);
+  }).join();
 }
 
 namespace {
