@@ -534,6 +534,18 @@ class MeshSplitter {
     facesAdded += triangles.size() - triangles_.size();
   }
 
+  // Frees what only the split itself needs (the faces' work, the patches,
+  // the input faces) on the thread that split the mesh, side by side with
+  // the other meshes, where freeing everything at the end took a serial
+  // tenth of a small split.
+  void releaseWorkingMemory() {
+    facesSplit_ = facesSplit();
+    std::vector<Patch>().swap(patches_);
+    work_ = FaceWorkTable(0);
+    std::vector<Triangle>().swap(triangles_);
+    std::vector<std::uint32_t>().swap(order_);
+  }
+
   std::size_t facesWithPoints() const { return work_.size(); }
   // The re-triangulation's work, roughly: the points and segments received.
   std::size_t pointsAndSegments() const {
@@ -541,7 +553,9 @@ class MeshSplitter {
     for (const auto& [f, w] : work_) n += w.points.size() + w.segments.size();
     return n;
   }
-  std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
+  std::size_t facesSplit() const {
+    return facesSplit_ != kUnknown ? facesSplit_ : order_.size() - degenerateKept_;
+  }
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
   // New faces with an angle under 1°, positions as built (the merged
@@ -574,6 +588,8 @@ class MeshSplitter {
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
+  static constexpr std::size_t kUnknown = std::size_t(-1);
+  std::size_t facesSplit_ = kUnknown;  // kept by releaseWorkingMemory
   std::size_t keptFaces_ = 0;
   double smallestAngle_ = M_PI;
   std::size_t slivers_ = 0;
@@ -1261,6 +1277,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       splitters[m].retriangulateFaces(table, !sideBySide || workerCount() > 2);
       splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
       if (separateBuilt) outputs[m].toMesh(r.meshes[m]);
+      splitters[m].releaseWorkingMemory();
     }
   };
   std::size_t facesWithPoints = 0, work = 0, mostWork = 0;
