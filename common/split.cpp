@@ -539,11 +539,9 @@ class MeshSplitter {
   // the other meshes, where freeing everything at the end took a serial
   // tenth of a small split.
   void releaseWorkingMemory() {
-    facesSplit_ = facesSplit();
     std::vector<Patch>().swap(patches_);
     work_ = FaceWorkTable(0);
     std::vector<Triangle>().swap(triangles_);
-    std::vector<std::uint32_t>().swap(order_);
   }
 
   std::size_t facesWithPoints() const { return work_.size(); }
@@ -553,9 +551,7 @@ class MeshSplitter {
     for (const auto& [f, w] : work_) n += w.points.size() + w.segments.size();
     return n;
   }
-  std::size_t facesSplit() const {
-    return facesSplit_ != kUnknown ? facesSplit_ : order_.size() - degenerateKept_;
-  }
+  std::size_t facesSplit() const { return order_.size() - degenerateKept_; }
   std::size_t keptFaces() const { return keptFaces_; }     // output faces before the new ones
   double smallestAngle() const { return smallestAngle_; }  // of the new faces, radians
   // New faces with an angle under 1°, positions as built (the merged
@@ -588,8 +584,6 @@ class MeshSplitter {
   std::vector<std::uint32_t> order_;
   std::vector<Patch> patches_;
   std::size_t degenerateKept_ = 0;
-  static constexpr std::size_t kUnknown = std::size_t(-1);
-  std::size_t facesSplit_ = kUnknown;  // kept by releaseWorkingMemory
   std::size_t keptFaces_ = 0;
   double smallestAngle_ = M_PI;
   std::size_t slivers_ = 0;
