@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -1353,7 +1354,11 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     // All meshes in one; curve vertices with the same exact position merge:
     // those at one curve point by its id, the others (crossings of two
     // curves inside a face) by comparing exactly.
-    std::vector<ExactPoint> curvePoints;  // one per curve point id used, then the others
+    // One per curve point id used, then the others, by reference (each
+    // copied would cost more than the rest of this stage); an input vertex
+    // on a curve without an id is kept in `inputCurvePoints`.
+    std::vector<const ExactPoint*> curvePoints;
+    std::deque<ExactPoint> inputCurvePoints;
     std::vector<int> curvePointOfId(table.size(), -1);
     std::size_t notAtCurvePoints = 0;  // curve vertices without an id: crossings made in a face
     std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
@@ -1369,7 +1374,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
           int& point = curvePointOfId[id];
           if (point < 0) {
             point = int(curvePoints.size());
-            curvePoints.push_back(table.point(id));
+            curvePoints.push_back(&table.point(id));
           }
           index[v] = point;
           return;
@@ -1377,19 +1382,21 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         ++notAtCurvePoints;
         index[v] = int(curvePoints.size());
         const std::size_t inputVertices = splitters[m].points().size();
-        curvePoints.push_back(std::size_t(v) < inputVertices ? ExactPoint(mesh.positions[v])
-                                                             : exactNew[m][v - inputVertices]);
+        if (std::size_t(v) < inputVertices) {
+          inputCurvePoints.emplace_back(mesh.positions[v]);
+          curvePoints.push_back(&inputCurvePoints.back());
+        } else {
+          curvePoints.push_back(&exactNew[m][v - inputVertices]);
+        }
       };
       for (const auto& e : r.curve_edges[m]) mark(e[0]), mark(e[1]);
       for (int v : splitters[m].contactVertices()) mark(v);
     }
-    std::vector<const ExactPoint*> curvePointers;
-    for (const ExactPoint& p : curvePoints) curvePointers.push_back(&p);
     // Distinct curve points never coincide (the table merged those): only
     // points made inside a face can coincide with another.
     std::vector<int> weldedTo(curvePoints.size());
     if (notAtCurvePoints > 0)
-      weldedTo = coincidentGroups(curvePointers);
+      weldedTo = coincidentGroups(curvePoints);
     else
       std::iota(weldedTo.begin(), weldedTo.end(), 0);
     r.smallest_new_angle_deg_unsnapped = r.smallest_new_angle_deg;
