@@ -1555,6 +1555,10 @@ float above(double x) {
 
 }  // namespace
 
+// How many floats away from its exact value roundToFloat may put a
+// coordinate of a new vertex (the nearest below or above is one away).
+constexpr int kFarthestRounding = 4;
+
 std::size_t roundToFloat(SplitResult& r, int passes) {
   requireMergedOutput(r, "rounding to float");
   Mesh& merged = r.merged;
@@ -1579,8 +1583,10 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
     }
   }
   if (changed.empty()) return 0;
-  // Candidates: boxes widened by a few float steps (re-rounding moves a vertex by one).
-  const std::vector<std::array<std::uint32_t, 2>> pairs = pairsWithChangedFaces(P, T, isChanged, 3);
+  // Candidates: boxes widened by more float steps than re-rounding moves a
+  // vertex (at most kFarthestRounding from its exact position).
+  const std::vector<std::array<std::uint32_t, 2>> pairs =
+      pairsWithChangedFaces(P, T, isChanged, kFarthestRounding + 2);
   // Candidates of each changed face, both ways (compressed rows).
   std::vector<std::uint32_t> offsets(changed.size() + 1, 0), others;
   for (const auto& [f, g] : pairs) {
@@ -1623,6 +1629,12 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   std::size_t remaining = 0;
   std::vector<std::array<std::uint32_t, 2>> crossing = intersectingOf(P, T, pairs);
   std::vector<char> moved(P.size(), 0);  // re-rounded in the last pass
+  // Each coordinate goes to one of the `reach` floats below its exact value
+  // or the `reach` above. One each way first (the two nearest); where faces
+  // meet at a very small angle, neither may keep them apart, and the next
+  // float out may.
+  int reach = 1, passesAtReach = 0;
+  std::size_t before = std::numeric_limits<std::size_t>::max();  // crossings before the last pass
   for (int pass = 0;; ++pass) {
     if (pass > 0) {
       // Only pairs with a face at a vertex that moved can have changed: the
@@ -1640,7 +1652,14 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
       std::fill(moved.begin(), moved.end(), 0);
     }
     remaining = crossing.size();
-    if (remaining == 0 || pass == passes) break;
+    if (remaining == 0) break;
+    if (passesAtReach == passes || remaining >= before) {  // this reach has done what it can
+      if (reach == kFarthestRounding) break;
+      ++reach;
+      passesAtReach = 0;
+    }
+    before = remaining;
+    ++passesAtReach;
     std::set<int> candidates;
     for (const auto& p : crossing)
       for (std::uint32_t f : p)
@@ -1648,14 +1667,27 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
           if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
     for (int v : candidates) {
       const Point3 e = exact[v], start = P[v];
+      // Per coordinate, the floats nearest first: below, above, then the
+      // next ones out.
+      std::array<std::array<float, 2 * kFarthestRounding>, 3> options;
+      for (int k = 0; k < 3; ++k) {
+        float lo = below(e[k]), hi = above(e[k]);
+        for (int j = 0; j < reach; ++j) {
+          options[k][2 * j] = lo;
+          options[k][2 * j + 1] = hi;
+          lo = std::nextafter(lo, -INFINITY);
+          hi = std::nextafter(hi, INFINITY);
+        }
+      }
       Point3 best = start;
       std::size_t bestCount = localCrossings(v);
-      for (int choice = 0; choice < 8 && bestCount > 0; ++choice) {
-        P[v] =
-            Point3(choice & 1 ? above(e[0]) : below(e[0]), choice & 2 ? above(e[1]) : below(e[1]),
-                   choice & 4 ? above(e[2]) : below(e[2]));
-        const std::size_t n = localCrossings(v);
-        if (n < bestCount) best = P[v], bestCount = n;
+      const int n = 2 * reach;
+      for (int choice = 0; choice < n * n * n && bestCount > 0; ++choice) {
+        P[v] = Point3(options[0][choice % n], options[1][choice / n % n],
+                      options[2][choice / (n * n)]);
+        if (P[v] == start) continue;
+        const std::size_t count = localCrossings(v);
+        if (count < bestCount) best = P[v], bestCount = count;
       }
       moved[v] = best != start;
       P[v] = best;

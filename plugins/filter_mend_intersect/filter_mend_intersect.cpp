@@ -326,6 +326,10 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     Log("  check of the %s result: %zu intersecting pairs remain%s",
         kHostStoresFloat ? "float" : "double", remaining,
         checkWhole ? "" : " (all with a new face: the others are input faces as they were)");
+  if (verify && remaining > 0 && kHostStoresFloat && options.snap_tolerance <= 0)
+    Log("  warning: where curve points lie a few float steps apart (surfaces meeting at a very "
+        "small angle), no float rounding keeps every face apart: run again with a quality "
+        "snapping tolerance of 0.05, which merges such points");
   JsonObject report = toJson(r);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;

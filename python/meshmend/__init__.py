@@ -241,7 +241,13 @@ def intersect_and_split(vertices1, faces1, vertices2, faces2, **options) -> Spli
     crossed faces are re-triangulated, every other face stays as it was.
     report['remaining_intersecting_pairs'] (verify=True) counts the pairs
     still intersecting in `merged` (faces meeting only along a shared curve
-    edge or vertex do not count)."""
+    edge or vertex do not count). The output is exact to double; a float
+    file (STL, most PLY) rounds it, and rounding to nearest can make faces
+    that meet along a curve cross: round_to_float=True rounds it the way
+    that keeps them apart (as the MeshLab filter does) and checks the float
+    result. Where curve points lie a few float steps apart, no rounding
+    keeps every face apart and the report counts what remains:
+    snap_tolerance=0.05 merges such points."""
     return _split([(vertices1, faces1), (vertices2, faces2)], options)
 
 

@@ -104,7 +104,8 @@ std::size_t countSelfIntersections(py::handle vertices, py::handle faces) {
 
 struct SplitCall {
   SplitOptions core;
-  bool verify = true;  // count the intersecting pairs left in the merged output
+  bool round_to_float = false;  // prepare the output for float storage (roundToFloat)
+  bool verify = true;           // count the intersecting pairs left in the merged output
 };
 
 OptionTable<SplitCall> splitTable() {
@@ -129,6 +130,11 @@ OptionTable<SplitCall> splitTable() {
       "quality snapping, a fraction of the local edge length in [0, 0.5); 0 = off, 0.05 removes "
       "most slivers");
   t.add(
+      "round_to_float", [](SplitCall& c) -> bool& { return c.round_to_float; },
+      "round the output to float (as MeshLab and STL, float PLY or OBJ files store it), "
+      "re-rounding curve points where rounding to nearest would make faces cross; the check "
+      "then counts the float output");
+  t.add(
       "verify", [](SplitCall& c) -> bool& { return c.verify; },
       "count the intersecting pairs left in the merged output (remaining_intersecting_pairs)");
   return t;
@@ -147,9 +153,11 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   for (const Mesh& m : inputs) pointers.push_back(&m);
   SplitResult r = call([&] { return splitAlongIntersections(pointers, c.core); });
   std::size_t remaining = 0;
-  if (c.verify) {  // the whole merged output as returned (double), by the self-intersection rule
-    const auto start = std::chrono::steady_clock::now();
-    remaining = call([&] { return remainingIntersections(r, false); });
+  const auto start = std::chrono::steady_clock::now();
+  if (c.round_to_float) call([&] { return roundToFloat(r); });
+  if (c.verify)  // the whole merged output as returned, by the self-intersection rule
+    remaining = call([&] { return remainingIntersections(r, c.round_to_float); });
+  if (c.round_to_float || c.verify) {
     r.time_ms +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }

@@ -267,6 +267,63 @@ def test_split_self_intersections_of_one_mesh(two_spheres):
         mm.split_self_intersections(V, F, self=False)
 
 
+def as_float(a):
+    return np.asarray(a).astype(np.float32).astype(np.float64)
+
+
+def nearly_coincident_pair(seed):
+    """A bumpy sphere far from the origin (float steps of 6e-5) and a copy
+    turned by a few degrees, both in float coordinates: like two scans of
+    one object, the surfaces cross at small angles along many curves."""
+    V, F = icosphere(3)
+    rng = np.random.default_rng(seed)
+    W = V * (1 + 0.05 * rng.random((len(V), 1)))
+    angle = 0.05 + 0.2 * rng.random()
+    axis = rng.normal(size=3)
+    axis /= np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    X = W @ R.T + rng.normal(size=3) * 0.01
+    return (as_float(W + 1000), F), (as_float(X + 1000), F)
+
+
+def test_split_rounded_to_float_keeps_faces_apart(tmp_path):
+    (A, F), (B, G) = nearly_coincident_pair(1)
+    exact = mm.intersect_and_split(A, F, B, G)
+    MV, MF = exact.merged
+    assert exact.report["remaining_intersecting_pairs"] == 0
+    # Rounded to nearest (as writing a float file does), faces that met along
+    # a curve cross: the check can fail.
+    nearest = meshcheck(write_off(tmp_path / "nearest.off", as_float(MV), MF))
+    assert nearest["self_intersecting_pairs"] > 0
+    out = mm.intersect_and_split(A, F, B, G, round_to_float=True)
+    RV, RF = out.merged
+    # Floats, a few float steps from the exact points, nothing crossing, the
+    # same mesh otherwise.
+    assert np.array_equal(as_float(RV), RV)
+    assert all(np.array_equal(as_float(V), V) for V, _ in out.meshes)
+    assert np.all(np.abs(RV - MV) <= 4 * np.spacing(np.abs(MV).astype(np.float32)))
+    assert np.array_equal(RF, MF) and out.report["curve_loops"] == exact.report["curve_loops"]
+    assert out.report["remaining_intersecting_pairs"] == 0
+    assert meshcheck(write_off(tmp_path / "rounded.off", RV, RF))["self_intersecting_pairs"] == 0
+    for (V, _), (W, _) in zip(out.meshes, exact.meshes):
+        assert len(V) == len(W)
+
+
+def test_split_rounded_to_float_counts_what_only_snapping_removes(tmp_path):
+    # Here curve points lie a few float steps apart: no rounding keeps every
+    # face apart, and the report says how many pairs cross.
+    (A, F), (B, G) = nearly_coincident_pair(3)
+    out = mm.intersect_and_split(A, F, B, G, round_to_float=True)
+    left = out.report["remaining_intersecting_pairs"]
+    assert left > 0
+    assert meshcheck(write_off(tmp_path / "rounded.off", *out.merged))["self_intersecting_pairs"] == left
+    snapped = mm.intersect_and_split(A, F, B, G, round_to_float=True, snap_tolerance=0.05)
+    assert snapped.report["vertices_snapped"] + snapped.report["edges_snapped"] > 0
+    assert snapped.report["remaining_intersecting_pairs"] == 0
+    assert meshcheck(write_off(tmp_path / "snapped.off", *snapped.merged))["self_intersecting_pairs"] == 0
+
+
 def test_split_gives_the_plugin_s_counts_and_keys(tmp_path, two_spheres):
     """The same inputs (rounded to float, as MeshLab stores them) through the
     MeshLab filter (meshlabserver, report_file) and through the module."""
