@@ -994,9 +994,11 @@ class CurveSnapper {
     if (T_[g][(k + 1) % 3] != a) return false;  // inconsistently oriented
     const int c = T_[g][(k + 2) % 3];
     if (c == v) return false;
+    // vc an edge already: of this mesh, it would be in four faces; of
+    // another (v and c both curve points), the meshes would share an edge
+    // that is no curve.
     for (std::uint32_t f : facesAround(v))
-      if (mesh(f) == mesh(s) && (T_[f][0] == c || T_[f][1] == c || T_[f][2] == c))
-        return false;  // vc is an edge already
+      if (T_[f][0] == c || T_[f][1] == c || T_[f][2] == c) return false;
     const std::vector<Triangle> after{{b, v, c}, {v, a, c}};
     const Point3 n = normalOf(at(T_[g]));
     for (const Triangle& t : after) {

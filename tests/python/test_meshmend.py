@@ -322,6 +322,13 @@ def test_split_rounded_to_float_counts_what_only_snapping_removes(tmp_path):
     assert snapped.report["vertices_snapped"] + snapped.report["edges_snapped"] > 0
     assert snapped.report["remaining_intersecting_pairs"] == 0
     assert meshcheck(write_off(tmp_path / "snapped.off", *snapped.merged))["self_intersecting_pairs"] == 0
+    # Snapping joins the meshes only along curves: every edge of both is a
+    # curve edge (an input edge split at a curve point must not make an
+    # edge the other mesh has already), so a boolean keeps a closed manifold.
+    assert mm.inspect(*snapped.merged)["non_manifold_edges"] == snapped.report["curve_edges"]
+    difference = mm.boolean(A, F, B, G, "difference", round_to_float=True, snap_tolerance=0.05)
+    assert difference.report["is_closed"] and difference.report["non_manifold_edges"] == 0
+    assert mm.count_self_intersections(difference.vertices, difference.faces) == 0
 
 
 def test_split_gives_the_plugin_s_counts_and_keys(tmp_path, two_spheres):
