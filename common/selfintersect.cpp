@@ -956,8 +956,9 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
 
 }  // namespace
 
-SelfIntersectionResult removeSelfIntersections(const Mesh& input,
-                                               const SelfIntersectionOptions& options) {
+namespace {
+
+SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   auto lap = start;
   // Milliseconds since the previous lap.
@@ -1046,10 +1047,16 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
 
   // §2.3 Valid region growing.
   reportProgress(options.progress, 60, "growing the valid region");
+  // The planes the radial order decides on: each face's birth face, or its
+  // own, where snapping moved it off that plane (deciding on the birth plane
+  // there let the growing pass from the outer surface into the inner one).
   std::vector<TrianglePoints> births(cut.triangles.size());
   {
     FaceOriginHandle birth = faceOrigins(split.merged);
-    for (std::size_t f = 0; f < births.size(); ++f) births[f] = pointsOf(P, T[birth[f].face]);
+    const std::vector<char>& snapped = split.merged_snapped_face;
+    for (std::size_t f = 0; f < births.size(); ++f)
+      births[f] = f < snapped.size() && snapped[f] ? pointsOf(cut.points, cut.triangles[f])
+                                                   : pointsOf(P, T[birth[f].face]);
   }
   ValidRegionGrowing growing(cut.points, cut.triangles, split.merged_new_face, std::move(births));
   const std::vector<char> valid = growing.grow();
@@ -1176,6 +1183,40 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   return r;
 }
 
+// How far a result falls short of a valid outer surface: intersecting
+// pairs left, non-manifold edges made, a closed input opened.
+std::array<std::size_t, 3> shortfall(const SelfIntersectionResult& r) {
+  return {r.verified ? r.remaining_intersecting_pairs : 0,
+          r.non_manifold_edges_after > r.non_manifold_edges_before
+              ? r.non_manifold_edges_after - r.non_manifold_edges_before
+              : 0,
+          std::size_t(r.input_closed && !r.output_closed)};
+}
+
+}  // namespace
+
+SelfIntersectionResult removeSelfIntersections(const Mesh& input,
+                                               const SelfIntersectionOptions& options) {
+  SelfIntersectionResult r = removeOnce(input, options);
+  // Snapping moves the surface near the curves by up to its tolerance:
+  // where two sheets lie closer than that (nearly coincident scans), it can
+  // carry one through the other, and the growing then passes into the inner
+  // sheet. Without snapping every decision is exact: such a result is made
+  // again without it, and the better of the two returned.
+  const std::array<std::size_t, 3> zero{0, 0, 0};
+  if (options.snap_tolerance > 0 && shortfall(r) != zero) {
+    SelfIntersectionOptions exact = options;
+    exact.snap_tolerance = 0;
+    SelfIntersectionResult again = removeOnce(input, exact);
+    if (shortfall(again) <= shortfall(r)) {
+      again.snapping_dropped = true;
+      again.time_ms += r.time_ms;
+      return again;
+    }
+  }
+  return r;
+}
+
 JsonObject toJson(const SelfIntersectionResult& r) {
   JsonObject j;
   j.set("faces_in", r.faces_in)
@@ -1207,7 +1248,8 @@ JsonObject toJson(const SelfIntersectionResult& r) {
       .set("inside_out", r.inside_out)
       .set("vertices_duplicated", r.vertices_duplicated)
       .set("vertices_separated", r.vertices_separated)
-      .set("edges_duplicated", r.edges_duplicated);
+      .set("edges_duplicated", r.edges_duplicated)
+      .set("snapping_dropped", r.snapping_dropped);
   if (r.verified) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
   j.set("time_ms", r.time_ms);
   const auto& t = r.stage_ms;

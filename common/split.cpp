@@ -656,6 +656,7 @@ class CurveSnapper {
         newFace_(newFace),
         tolerance_(tolerance),
         alive_(T_.size(), 1),
+        snapped_(T_.size(), 0),
         around_(T_, P_.size()),
         snappedTo_(P_.size(), -1),
         fixed_(P_.size(), 0) {
@@ -756,13 +757,15 @@ class CurveSnapper {
     }
     for (std::size_t v = 0; v < P_.size(); ++v)
       if (snappedTo_[v] >= 0) index[v] = index[snappedTo_[v]];
-    std::vector<char> newFace;
+    std::vector<char> newFace, snapped;
     for (std::size_t f = 0; f < T_.size(); ++f) {
       if (!alive_[f]) continue;
       out.triangles.push_back({index[T_[f][0]], index[T_[f][1]], index[T_[f][2]]});
       out.face_origin.push_back(faceOrigin_[f]);
       newFace.push_back(newFace_[f]);
+      snapped.push_back(snapped_[f]);
     }
+    snapped_ = std::move(snapped);
     std::set<std::array<int, 2>> curves;
     for (auto e : curves_) {
       e = {index[e[0]], index[e[1]]};
@@ -775,6 +778,9 @@ class CurveSnapper {
   }
 
   const std::vector<int>& snappedTo() const { return snappedTo_; }
+  // Per face (after compact()): did snapping reshape or make it? Such a face
+  // may lie off the plane of the input face it was born from.
+  const std::vector<char>& snappedFaces() const { return snapped_; }
 
  private:
   int mesh(std::uint32_t f) const { return faceOrigin_[f].layer; }
@@ -960,6 +966,7 @@ class CurveSnapper {
     for (std::size_t i = 0; i < moved.size(); ++i) {
       T_[moved[i]] = after[i];
       newFace_[moved[i]] = 1;
+      snapped_[moved[i]] = 1;
       around_.edit(w).push_back(moved[i]);
     }
     around_.edit(v).clear();
@@ -1025,6 +1032,8 @@ class CurveSnapper {
     faceOrigin_.push_back(faceOrigin_[g]);
     newFace_.push_back(1);
     newFace_[g] = 1;
+    snapped_.push_back(1);
+    snapped_[g] = 1;
     for (int x : {v, a, c}) around_.edit(x).push_back(added);
     around_.edit(v).push_back(g);
     return true;
@@ -1038,6 +1047,7 @@ class CurveSnapper {
   std::vector<char>& newFace_;
   double tolerance_;
   std::vector<char> alive_;
+  std::vector<char> snapped_;  // per face: reshaped or made by snapping
   FacesAroundVertices around_;
   std::vector<int> snappedTo_;
   std::vector<char> fixed_;  // snapping targets
@@ -1489,6 +1499,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       const std::vector<int> snappedTo = snapper.snappedTo();
       std::vector<int> index;
       snapper.compact(merged, index);
+      r.merged_snapped_face = snapper.snappedFaces();
       if (options.separate_meshes) {
         rebuildSeparate(merged, index, snappedTo, curveSet, outputs, r.merged_vertex,
                         r.curve_edges);
@@ -1520,6 +1531,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       r.merged_curve_edges.clear();
       r.merged_vertex.clear();
       r.merged_new_face.clear();
+      r.merged_snapped_face.clear();
     }
   }
   reportProgress(options.progress, 100, "Done");

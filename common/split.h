@@ -59,6 +59,9 @@ struct SplitResult {
   std::vector<std::array<int, 2>> merged_curve_edges;
   std::vector<std::vector<int>> merged_vertex;  // per mesh, per vertex: its vertex in `merged`
   std::vector<char> merged_new_face;            // per face of `merged`: 1 when a split made it
+  // Per face of `merged` (empty without snapping): 1 when quality snapping
+  // reshaped or made it, so that it may lie off its birth face's plane.
+  std::vector<char> merged_snapped_face;
   // Every intersecting pair of the inputs was searched for (and split): each
   // mesh's own and those between meshes. Faces left as they were then cross
   // nothing, so the intersections left are among pairs with a new face.

@@ -132,6 +132,9 @@ void SelfIntersectPlugin::apply(QAction*, MeshDocument& md, const RichParameterL
   if (r.inside_out)
     Log("  note: the mesh is closed and inside out (negative volume); it stays so: run "
         "Filters > Normals > Invert Faces Orientation if that is not intended");
+  if (r.snapping_dropped)
+    Log("  note: snapping left crossings or non-manifold edges (sheets closer than its "
+        "tolerance): the result was made again without snapping");
   if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
   reportProgress(options.progress, 100, "MeshMend: done");
 }

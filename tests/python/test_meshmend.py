@@ -388,6 +388,30 @@ def test_remove_self_intersections_keeps_the_union(two_spheres, tmp_path):
     assert volume(out.vertices, out.faces) == pytest.approx(volume(union.vertices, union.faces), rel=1e-9)
 
 
+
+@pytest.mark.parametrize("seed, shift, snapping_dropped", [(1, 1000.0, False), (3, 0.0, True)])
+def test_remove_self_intersections_merges_nearly_coincident_sheets(seed, shift, snapping_dropped, tmp_path):
+    """Two overlapping scans of one object, as one mesh: the sheets cross at
+    small angles and lie closer than the snapping tolerance between the
+    curves. Snapped faces decide the growing on their own planes (on their
+    birth faces' the growing passed into the inner sheet and kept every
+    face); where snapping would still carry a sheet through the other
+    (seed 3, far from the origin), the result is made again without it."""
+    (A, F), (B, G) = nearly_coincident_pair(seed)
+    A, B = as_float(A - shift), as_float(B - shift)
+    V, Fj = joined((A, F), (B, G))
+    out = mm.remove_self_intersections(V, Fj)
+    r = out.report
+    assert r["snapping_dropped"] is snapping_dropped
+    assert r["faces_removed"] > 0 and r["output_closed"] is True and r["non_manifold_edges_after"] == 0
+    assert r["remaining_intersecting_pairs"] == 0
+    assert mm.count_self_intersections(out.vertices, out.faces) == 0
+    checked = meshcheck(write_off(tmp_path / "clean.off", out.vertices, out.faces))
+    assert checked["self_intersecting_pairs"] == 0 and checked["is_closed"] and checked["non_manifold_edges"] == 0
+    union = mm.boolean(A, F, B, G, "union")
+    assert volume(out.vertices, out.faces) == pytest.approx(volume(union.vertices, union.faces), rel=1e-4)
+
+
 # ---------------------------------------------------------------- holes
 
 
