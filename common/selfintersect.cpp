@@ -1184,13 +1184,13 @@ SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptio
 }
 
 // How far a result falls short of a valid outer surface: intersecting
-// pairs left, non-manifold edges made, a closed input opened.
-std::array<std::size_t, 3> shortfall(const SelfIntersectionResult& r) {
+// pairs left, non-manifold edges made. (A closed input with fins may open
+// at them either way: see fin_edges_before.)
+std::array<std::size_t, 2> shortfall(const SelfIntersectionResult& r) {
   return {r.verified ? r.remaining_intersecting_pairs : 0,
           r.non_manifold_edges_after > r.non_manifold_edges_before
               ? r.non_manifold_edges_after - r.non_manifold_edges_before
-              : 0,
-          std::size_t(r.input_closed && !r.output_closed)};
+              : 0};
 }
 
 }  // namespace
@@ -1202,13 +1202,13 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   // where two sheets lie closer than that (nearly coincident scans), it can
   // carry one through the other, and the growing then passes into the inner
   // sheet. Without snapping every decision is exact: such a result is made
-  // again without it, and the better of the two returned.
-  const std::array<std::size_t, 3> zero{0, 0, 0};
+  // again without it, and returned instead where it falls short less.
+  const std::array<std::size_t, 2> zero{0, 0};
   if (options.snap_tolerance > 0 && shortfall(r) != zero) {
     SelfIntersectionOptions exact = options;
     exact.snap_tolerance = 0;
     SelfIntersectionResult again = removeOnce(input, exact);
-    if (shortfall(again) <= shortfall(r)) {
+    if (shortfall(again) < shortfall(r)) {
       again.snapping_dropped = true;
       again.time_ms += r.time_ms;
       return again;

@@ -30,8 +30,8 @@ struct SelfIntersectionOptions {
   // or edge merge into it instead of leaving slivers, whose rounded corners
   // could cross again. Moves the surface by at most that much near a curve.
   // Where that leaves crossings or non-manifold edges (sheets closer than
-  // the tolerance), the result is made again without snapping
-  // (result.snapping_dropped).
+  // the tolerance), the result is made again without snapping and, if that
+  // one has fewer, returned instead (result.snapping_dropped).
   double snap_tolerance = 0.05;
   // Work on float coordinates (MeshLab's storage): the input is taken as
   // float, and new vertices are rounded before the region growing decides,
@@ -85,7 +85,7 @@ struct SelfIntersectionResult {
   // Genus of a closed, edge-manifold mesh (summed over components), else -1.
   int genus_before = -1, genus_after = -1;
   // Snapping left crossings or non-manifold edges (sheets closer than its
-  // tolerance), so the result was made again without it.
+  // tolerance): this result was made again without it.
   bool snapping_dropped = false;
   bool verified = false;                         // remaining_intersecting_pairs was counted
   std::size_t remaining_intersecting_pairs = 0;  // in the result, as stored (float if rounded)
