@@ -1203,8 +1203,7 @@ SelfIntersectionResult removeSelfIntersections(const Mesh& input,
   // carry one through the other, and the growing then passes into the inner
   // sheet. Without snapping every decision is exact: such a result is made
   // again without it, and returned instead where it falls short less.
-  const std::array<std::size_t, 2> zero{0, 0};
-  if (options.snap_tolerance > 0 && shortfall(r) != zero) {
+  if (options.snap_tolerance > 0 && shortfall(r) != std::array<std::size_t, 2>{}) {
     SelfIntersectionOptions exact = options;
     exact.snap_tolerance = 0;
     SelfIntersectionResult again = removeOnce(input, exact);

@@ -157,10 +157,8 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   if (c.round_to_float) call([&] { return roundToFloat(r); });
   if (c.verify)  // the whole merged output as returned, by the self-intersection rule
     remaining = call([&] { return remainingIntersections(r, c.round_to_float); });
-  if (c.round_to_float || c.verify) {
-    r.time_ms +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  }
+  r.time_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   JsonObject report = toJson(r);
   if (c.verify) report.set("remaining_intersecting_pairs", remaining);
   report.set("output", c.core.separate_meshes ? "separate" : "merged");
