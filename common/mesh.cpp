@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <stdexcept>
 
 #include "common/errors.h"
 
@@ -43,31 +44,6 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
   return std::atan2((u ^ v).Norm(), u * v);
 }
 
-namespace {
-// `condition ? x : y` by a mask of the bits (compilers branch on a ternary).
-double select(bool condition, double x, double y) {
-  std::uint64_t bx, by;
-  std::memcpy(&bx, &x, sizeof bx);
-  std::memcpy(&by, &y, sizeof by);
-  const std::uint64_t take = -std::uint64_t(condition);
-  bx = (bx & take) | (by & ~take);
-  std::memcpy(&x, &bx, sizeof x);
-  return x;
-}
-}  // namespace
-
-double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
-  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
-  const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
-  // sin² at the apex opposite the shortest side = 4 area² / (product of the
-  // two others). The products chosen by selects, not branches: which side
-  // is shortest is as good as random, and the re-triangulation's flips ask
-  // this of every candidate triangle.
-  const double others =
-      select((ab <= bc) & (ab <= ca), bc * ca, select(bc <= ca, ab * ca, ab * bc));
-  return others > 0 ? cross / others : 0;
-}
-
 bool isFinite(const Point3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
@@ -79,8 +55,11 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
   return mesh;
 }
 
-void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
-               const std::vector<Triangle>& triangles, int layer) {
+namespace {
+
+// The vertices and faces of buildMesh, without their origins.
+void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
+                   const std::vector<Triangle>& triangles) {
   const int n = int(positions.size());
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (int v : triangles[f])
@@ -96,12 +75,31 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
   auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
   for (std::size_t f = 0; f < triangles.size(); ++f, ++fi)
     for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[triangles[f][k]];
+}
 
+}  // namespace
+
+void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
+               const std::vector<Triangle>& triangles, int layer) {
+  buildGeometry(mesh, positions, triangles);
   VertexOriginHandle vo = vertexOrigins(mesh);
   for (std::size_t i = 0; i < mesh.vert.size(); ++i)
     vo[i] = VertexOrigin{layer, int(i), -1, {0, 0, 0}};
   FaceOriginHandle fo = faceOrigins(mesh);
   for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
+}
+
+void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
+               const std::vector<Triangle>& triangles,
+               const std::vector<VertexOrigin>& vertexOrigin,
+               const std::vector<FaceOrigin>& faceOrigin) {
+  if (vertexOrigin.size() != positions.size() || faceOrigin.size() != triangles.size())
+    throw std::invalid_argument("buildMesh: one origin per vertex and per face");
+  buildGeometry(mesh, positions, triangles);
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  for (std::size_t v = 0; v < vertexOrigin.size(); ++v) vo[v] = vertexOrigin[v];
+  FaceOriginHandle fo = faceOrigins(mesh);
+  for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
 }
 
 MeshArrays arraysOf(const Mesh& mesh) {

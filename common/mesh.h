@@ -3,6 +3,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -83,6 +85,12 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
 // copying a million faces costs as much as building them.
 void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<Triangle>& triangles, int layer = 0);
+// The same with the origins given, one per vertex and one per face (each
+// written once: a split's output is built in the time it takes to copy it).
+void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
+               const std::vector<Triangle>& triangles,
+               const std::vector<VertexOrigin>& vertexOrigin,
+               const std::vector<FaceOrigin>& faceOrigin);
 
 // A mesh as plain arrays, for the inner loops of the core.
 struct MeshArrays {
@@ -132,10 +140,33 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh);
 // opposite the shortest side (one atan2 instead of three).
 double smallestAngle(const Point3& a, const Point3& b, const Point3& c);
 
+namespace detail {
+// `condition ? x : y` by a mask of the bits (compilers branch on a ternary).
+inline double select(bool condition, double x, double y) {
+  std::uint64_t bx, by;
+  std::memcpy(&bx, &x, sizeof bx);
+  std::memcpy(&by, &y, sizeof by);
+  const std::uint64_t take = -std::uint64_t(condition);
+  bx = (bx & take) | (by & ~take);
+  std::memcpy(&x, &bx, sizeof x);
+  return x;
+}
+}  // namespace detail
+
 // A measure that grows with the smallest angle of triangle (a, b, c), cheaper
 // than the angle: the squared sine of the angle opposite the shortest side
-// (at most 60°, where the sine still grows), 0 when degenerate.
-double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c);
+// (at most 60°, where the sine still grows), 0 when degenerate. Inline: the
+// re-triangulation's flips ask it of every candidate triangle.
+inline double smallestAngleMeasure(const Point3& a, const Point3& b, const Point3& c) {
+  const double ab = (b - a).SquaredNorm(), bc = (c - b).SquaredNorm(), ca = (a - c).SquaredNorm();
+  const double cross = ((b - a) ^ (c - a)).SquaredNorm();  // 4 area²
+  // sin² at the apex opposite the shortest side = 4 area² / (product of the
+  // two others). The products chosen by selects, not branches: which side
+  // is shortest is as good as random.
+  const double others =
+      detail::select((ab <= bc) & (ab <= ca), bc * ca, detail::select(bc <= ca, ab * ca, ab * bc));
+  return others > 0 ? cross / others : 0;
+}
 
 bool isFinite(const Point3& p);
 

@@ -217,11 +217,7 @@ struct OutputArrays {
   std::vector<FaceOrigin> face_origin;
 
   void toMesh(Mesh& mesh) const {
-    buildMesh(mesh, positions, triangles);
-    VertexOriginHandle vo = vertexOrigins(mesh);
-    FaceOriginHandle fo = faceOrigins(mesh);
-    for (std::size_t v = 0; v < vertex_origin.size(); ++v) vo[v] = vertex_origin[v];
-    for (std::size_t f = 0; f < face_origin.size(); ++f) fo[f] = face_origin[f];
+    buildMesh(mesh, positions, triangles, vertex_origin, face_origin);
   }
 };
 
@@ -1273,17 +1269,14 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // segment goes into both) and there is enough of it to be worth sharing
   // (a few dozen faces); otherwise one mesh after the other, each on every core. With
   // more than two cores, each mesh still re-triangulates on several.
-  // Without snapping, which rebuilds them, each mesh's output is final once
-  // built, and side by side its thread makes its vcglib mesh too.
   std::atomic<std::size_t> nextMesh{0};
   std::vector<std::size_t> facesAdded(meshes.size(), 0);
-  bool sideBySide = false, separateBuilt = false;
+  bool sideBySide = false;
   auto splitMeshes = [&] {
     for (std::size_t m; (m = nextMesh++) < meshes.size();) {
       splitters[m].shareEdgePoints(table);
       splitters[m].retriangulateFaces(table, !sideBySide || workerCount() > 2);
       splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
-      if (separateBuilt) outputs[m].toMesh(r.meshes[m]);
       splitters[m].releaseWorkingMemory();
     }
   };
@@ -1295,8 +1288,6 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   }
   if (facesWithPoints >= 32 && 3 * mostWork <= 2 * work) {
     sideBySide = true;
-    separateBuilt = options.separate_meshes && options.snap_tolerance <= 0;
-    if (separateBuilt) r.meshes.resize(meshes.size());
     std::exception_ptr asideError;
     TaskAlongside aside([&] {
       try {
@@ -1332,32 +1323,37 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // from them), so it needs them even when the merged mesh is not asked for.
   const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
-  // Without snapping, each input's output is final here: unless built
-  // already, vcglib meshes are built on a second thread while the merged
-  // one is made (without it, while the curves are counted and the last
-  // input's is built here), once there are enough faces to be worth
-  // handing to a helper (a few thousand faces take a few hundred
-  // microseconds).
-  std::size_t outputFaces = 0;
-  for (const OutputArrays& o : outputs) outputFaces += o.triangles.size();
-  const std::size_t builtAside =
-      mergedArrays ? meshes.size() : meshes.size() - 1;  // separate meshes the thread builds
+  // Without snapping, each input's output is final here: its vcglib mesh
+  // is built on a second thread while the merged one is made (without it,
+  // all but the one with the fewest faces, while the curves are counted
+  // and that one is built here, as a small mesh's split finishes first and
+  // a large one's vcglib mesh costs as much as the welding), once there are
+  // enough faces to be worth handing to a helper (a few thousand faces take
+  // a few hundred microseconds).
+  std::size_t outputFaces = 0, fewestFaces = 0;
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    outputFaces += outputs[m].triangles.size();
+    if (outputs[m].triangles.size() < outputs[fewestFaces].triangles.size()) fewestFaces = m;
+  }
+  const std::size_t builtHere = mergedArrays ? meshes.size() : fewestFaces;  // or none
   std::optional<TaskAlongside>
       separateBuilder;  // destroyed (waited for) also when the merged output throws
   if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096 &&
-      builtAside > 0 && !separateBuilt) {
+      (mergedArrays || meshes.size() > 1)) {
     r.meshes.resize(meshes.size());
     separateBuilder.emplace([&] {
-      for (std::size_t m = 0; m < builtAside; ++m) outputs[m].toMesh(r.meshes[m]);
+      for (std::size_t m = 0; m < meshes.size(); ++m)
+        if (m != builtHere) outputs[m].toMesh(r.meshes[m]);
     });
   }
-  // The separate meshes not built alongside (all of them when snapping
-  // rebuilt them), once the task alongside has finished.
+  // The separate meshes not built alongside (the one with the fewest faces,
+  // or all of them when snapping rebuilt them), and the task alongside
+  // finished.
   auto finishSeparate = [&] {
     if (separateBuilder) {
+      if (builtHere < meshes.size()) outputs[builtHere].toMesh(r.meshes[builtHere]);
       separateBuilder->wait();
-      for (std::size_t m = builtAside; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
-    } else if (options.separate_meshes && !separateBuilt) {
+    } else if (options.separate_meshes) {
       r.meshes.resize(meshes.size());
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
@@ -1427,9 +1423,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         }
       std::sort(curves.begin(), curves.end());
       curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
-      finishSeparate();
       r.curve_edges_welded = curves.size();
       countCurves(curvePoints.size(), curves, r.curve_loops, r.open_curves);
+      finishSeparate();
       if (!options.separate_meshes) r.curve_edges.assign(meshes.size(), {});
       reportProgress(options.progress, 100, "Done");
       r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

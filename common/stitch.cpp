@@ -104,18 +104,6 @@ Adjacency adjacencyOf(const std::vector<EdgeUse>& uses, int vertexCount) {
   return adj;
 }
 
-// Copies provenance of the kept elements into a rebuilt mesh.
-void rebuildWithOrigins(Mesh& out, const std::vector<Point3>& points,
-                        const std::vector<Triangle>& triangles,
-                        const std::vector<VertexOrigin>& vertexOrigin,
-                        const std::vector<FaceOrigin>& faceOrigin) {
-  buildMesh(out, points, triangles);
-  VertexOriginHandle vo = vertexOrigins(out);
-  FaceOriginHandle fo = faceOrigins(out);
-  for (std::size_t v = 0; v < vertexOrigin.size(); ++v) vo[v] = vertexOrigin[v];
-  for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
-}
-
 // ================================================================ trimming
 
 // The loop through selected vertices. A sharp turn of the path makes a
@@ -451,7 +439,7 @@ TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
   std::vector<int> removedIndex;
   {
     const auto [points, tris, vorig, forig] = part(true, removedIndex);
-    rebuildWithOrigins(result.removed, points, tris, vorig, forig);
+    buildMesh(result.removed, points, tris, vorig, forig);
   }
   result.border_edges_before = borderEdgesOf(T);
   {
@@ -459,7 +447,7 @@ TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
     result.faces_kept = tris.size();
     result.faces_removed = T.size() - tris.size();
     result.border_edges_after = borderEdgesOf(tris);
-    rebuildWithOrigins(mesh, points, tris, vorig, forig);
+    buildMesh(mesh, points, tris, vorig, forig);
   }
   reportProgress(options.progress, 100, "Done");
   result.time_ms = msSince(start);
@@ -2115,7 +2103,7 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
       forig.push_back(fo[f]);
       keptChanged.push_back(merged);
     }
-    rebuildWithOrigins(mesh, points, kept, vorig, forig);
+    buildMesh(mesh, points, kept, vorig, forig);
     P = points;
     T = kept;
     changedFace = keptChanged;
