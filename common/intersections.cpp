@@ -27,7 +27,12 @@ double msSince(Clock::time_point t) {
 struct Soup {
   const std::vector<Point3>& points;
   const std::vector<Triangle>& triangles;
+  // Per face: collinear. With `withTree` known for every face; otherwise
+  // only for those the search between meshes looks at (facesTouching()),
+  // the rest stay 0: most of a mesh lies far from the others, and asking
+  // each of its faces cost as much as the search.
   std::vector<char> degenerate;
+  bool degenerateKnown = false;
   Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
   // Only for the search within the mesh (`withTree`): every face's box and
   // the filter of its exact plane sides (side()).
@@ -35,7 +40,7 @@ struct Soup {
   std::vector<PlaneFilter> planes;
 
   explicit Soup(const MeshArrays& mesh) : points(mesh.points), triangles(mesh.triangles) {}
-  // The bounds and degenerate faces, and with `withTree` the boxes and planes.
+  // The bounds, and with `withTree` the degenerate faces, boxes and planes.
   void prepare(bool withTree) {
     Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
     for (const Point3& p : points)
@@ -45,20 +50,8 @@ struct Soup {
       }
     if (!points.empty()) bounds = boxOf(lo, hi, hi);
     degenerate.resize(triangles.size());
-    if (!withTree) {
-      // In chunks: a large mesh's share goes to the threads a small one's
-      // leaves (the meshes are prepared side by side).
-      parallelChunks(
-          triangles.size(),
-          [&](std::size_t begin, std::size_t end, unsigned) {
-            for (std::size_t f = begin; f < end; ++f) {
-              const Triangle& t = triangles[f];
-              degenerate[f] = collinear(points[t[0]], points[t[1]], points[t[2]]);
-            }
-          },
-          2048);
-      return;
-    }
+    degenerateKnown = withTree;
+    if (!withTree) return;
     // Each point rounded to float once (about six faces share it), then
     // each face's box from its corners'.
     std::vector<Box> pointBoxes(points.size());
@@ -97,7 +90,7 @@ struct Candidates {
   std::vector<Box> boxes;  // parallel to faces
 };
 
-Candidates facesTouching(const Soup& s, const Box& other) {
+Candidates facesTouching(Soup& s, const Box& other) {
   // A face whose corners all lie beyond the float next to a side of `other`
   // has its box (rounded outward, never past that float) beyond the side:
   // turned away in double, by one bit per corner and side, its box is never
@@ -128,14 +121,17 @@ Candidates facesTouching(const Soup& s, const Box& other) {
         Candidates& c = parts[worker];
         for (std::size_t f = begin; f < end; ++f) {
           const Triangle& t = s.triangles[f];
-          if ((beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) || s.degenerate[f]) continue;
-          const Box box = boxOf(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
+          if (beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) continue;
+          const Point3 &p = s.points[t[0]], &q = s.points[t[1]], &r = s.points[t[2]];
+          const Box box = boxOf(p, q, r);
           if (!overlap(box, other)) continue;
+          if (!s.degenerateKnown) s.degenerate[f] = collinear(p, q, r);
+          if (s.degenerate[f]) continue;
           c.faces.push_back(std::uint32_t(f));
           c.boxes.push_back(box);
         }
       },
-      2048);
+      1024);
   for (std::size_t w = 1; w < parts.size(); ++w) {
     parts[0].faces.insert(parts[0].faces.end(), parts[w].faces.begin(), parts[w].faces.end());
     parts[0].boxes.insert(parts[0].boxes.end(), parts[w].boxes.begin(), parts[w].boxes.end());

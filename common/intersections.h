@@ -46,8 +46,10 @@ struct FindIntersectionsResult {
   std::size_t cross_pairs = 0;                   // pairs between different meshes
   std::vector<std::size_t> cross_faces;          // per mesh: distinct faces in cross pairs
   std::vector<std::vector<bool>> face_involved;  // per mesh, per face: in any pair
-  std::vector<std::size_t> degenerate_faces;     // per mesh: collinear faces (never compared)
-  std::size_t candidate_pairs = 0;               // box pairs tested exactly
+  // Per mesh: collinear faces, skipped (never compared). With `self`, all
+  // of the mesh's; between meshes only, those within another mesh's bounds.
+  std::vector<std::size_t> degenerate_faces;
+  std::size_t candidate_pairs = 0;  // box pairs tested exactly
   double build_ms = 0, search_ms = 0, time_ms = 0;
 };
 

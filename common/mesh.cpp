@@ -57,9 +57,8 @@ Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>&
 
 namespace {
 
-// The vertices and faces of buildMesh, without their origins.
-void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
-                   const std::vector<Triangle>& triangles) {
+void requireIndicesInRange(const std::vector<Point3>& positions,
+                           const std::vector<Triangle>& triangles) {
   const int n = int(positions.size());
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (int v : triangles[f])
@@ -67,7 +66,12 @@ void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
         throw InvalidInputError("face " + std::to_string(f) + " refers to vertex " +
                                 std::to_string(v) + ", but the mesh has only " + std::to_string(n) +
                                 " vertices");
+}
 
+// The vertices and faces of buildMesh, without their origins.
+void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
+                   const std::vector<Triangle>& triangles) {
+  requireIndicesInRange(positions, triangles);
   mesh.Clear();
   mesh.ClearAttributes();
   auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
@@ -93,13 +97,60 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<Triangle>& triangles,
                const std::vector<VertexOrigin>& vertexOrigin,
                const std::vector<FaceOrigin>& faceOrigin) {
+  MeshBuilder builder(mesh, positions, triangles, vertexOrigin, faceOrigin);
+  for (int part = 0; part < MeshBuilder::kParts; ++part) builder.build(MeshBuilder::Part(part));
+  builder.link();
+}
+
+MeshBuilder::MeshBuilder(Mesh& mesh, const std::vector<Point3>& positions,
+                         const std::vector<Triangle>& triangles,
+                         const std::vector<VertexOrigin>& vertexOrigin,
+                         const std::vector<FaceOrigin>& faceOrigin)
+    : mesh_(mesh),
+      positions_(positions),
+      triangles_(triangles),
+      vertexOrigin_(vertexOrigin),
+      faceOrigin_(faceOrigin) {
   if (vertexOrigin.size() != positions.size() || faceOrigin.size() != triangles.size())
     throw std::invalid_argument("buildMesh: one origin per vertex and per face");
-  buildGeometry(mesh, positions, triangles);
-  VertexOriginHandle vo = vertexOrigins(mesh);
-  for (std::size_t v = 0; v < vertexOrigin.size(); ++v) vo[v] = vertexOrigin[v];
-  FaceOriginHandle fo = faceOrigins(mesh);
-  for (std::size_t f = 0; f < faceOrigin.size(); ++f) fo[f] = faceOrigin[f];
+  requireIndicesInRange(positions, triangles);
+  mesh.Clear();
+  mesh.ClearAttributes();
+  // The attributes now, while the mesh is empty: adding one edits state
+  // that vertex and face attributes share (vcglib's attribute counter).
+  vo_ = vertexOrigins(mesh);
+  fo_ = faceOrigins(mesh);
+}
+
+// vcglib's Allocator::AddVertices and AddFaces each resize the elements and
+// their attributes together; on an empty mesh (no pointers to update) that
+// is all they do, so the parts resize each array on its own.
+void MeshBuilder::build(Part part) {
+  switch (part) {
+    case kVertices:
+      mesh_.vert.resize(positions_.size());
+      for (std::size_t v = 0; v < positions_.size(); ++v) mesh_.vert[v].P() = positions_[v];
+      break;
+    case kVertexOrigins:
+      vo_._handle->Resize(vertexOrigin_.size());
+      for (std::size_t v = 0; v < vertexOrigin_.size(); ++v) vo_[v] = vertexOrigin_[v];
+      break;
+    case kFaces:
+      mesh_.face.resize(triangles_.size());
+      break;
+    case kFaceOrigins:
+      fo_._handle->Resize(faceOrigin_.size());
+      for (std::size_t f = 0; f < faceOrigin_.size(); ++f) fo_[f] = faceOrigin_[f];
+      break;
+  }
+}
+
+void MeshBuilder::link() {
+  Vertex* vertices = mesh_.vert.data();
+  for (std::size_t f = 0; f < triangles_.size(); ++f)
+    for (int k = 0; k < 3; ++k) mesh_.face[f].V(k) = vertices + triangles_[f][k];
+  mesh_.vn = int(mesh_.vert.size());
+  mesh_.fn = int(mesh_.face.size());
 }
 
 MeshArrays arraysOf(const Mesh& mesh) {

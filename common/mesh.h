@@ -92,6 +92,35 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<VertexOrigin>& vertexOrigin,
                const std::vector<FaceOrigin>& faceOrigin);
 
+// That buildMesh in parts that may run on different threads at once. A
+// large mesh's arrays are new memory, whose first touch (a page fault per
+// 4 KiB) costs more than the copy into them: parts on two threads share
+// it. Each part writes only its own array of the mesh; link() (the faces'
+// corners, which point into the vertices, and the element counts) runs
+// after all of them. The arrays given must outlive the builder.
+class MeshBuilder {
+ public:
+  enum Part { kVertices, kVertexOrigins, kFaces, kFaceOrigins };
+  static constexpr int kParts = 4;
+
+  // Checks the sizes and indices (throws as buildMesh), clears `mesh` and
+  // gives it empty origin attributes.
+  MeshBuilder(Mesh& mesh, const std::vector<Point3>& positions,
+              const std::vector<Triangle>& triangles, const std::vector<VertexOrigin>& vertexOrigin,
+              const std::vector<FaceOrigin>& faceOrigin);
+  void build(Part part);
+  void link();
+
+ private:
+  Mesh& mesh_;
+  const std::vector<Point3>& positions_;
+  const std::vector<Triangle>& triangles_;
+  const std::vector<VertexOrigin>& vertexOrigin_;
+  const std::vector<FaceOrigin>& faceOrigin_;
+  VertexOriginHandle vo_;
+  FaceOriginHandle fo_;
+};
+
 // A mesh as plain arrays, for the inner loops of the core.
 struct MeshArrays {
   std::vector<Point3> points;

@@ -1149,23 +1149,30 @@ std::size_t removeDuplicateFaces(WeldedArrays& in) {
 // Closed and open components of a curve graph.
 void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& edges,
                  std::size_t& loops, std::size_t& open) {
+  // Components of the curve graph (union-find with path halving); one is a
+  // loop when each of its vertices has even degree.
   std::vector<int> parent(vertices), degree(vertices, 0);
-  for (std::size_t v = 0; v < vertices; ++v) parent[v] = int(v);
-  std::function<int(int)> find = [&](int x) {
-    return parent[x] == x ? x : parent[x] = find(parent[x]);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
   };
   for (const auto& e : edges) {
     ++degree[e[0]], ++degree[e[1]];
     parent[find(e[0])] = find(e[1]);
   }
-  std::map<int, bool> closed;  // component root -> every vertex of even degree
-  for (const auto& e : edges)
-    for (int v : e) {
-      auto [it, added] = closed.emplace(find(v), true);
-      if (degree[v] % 2) it->second = false;
-    }
-  loops = open = 0;
-  for (const auto& [root, c] : closed) (c ? loops : open) += 1;
+  enum : std::uint8_t { kNone, kEven, kOdd };  // per component root: its vertices' degrees
+  std::vector<std::uint8_t> component(vertices, kNone);
+  for (std::size_t v = 0; v < vertices; ++v) {
+    if (degree[v] == 0) continue;
+    std::uint8_t& c = component[find(int(v))];
+    if (degree[v] % 2)
+      c = kOdd;
+    else if (c == kNone)
+      c = kEven;
+  }
+  loops = std::size_t(std::count(component.begin(), component.end(), kEven));
+  open = std::size_t(std::count(component.begin(), component.end(), kOdd));
 }
 
 }  // namespace
@@ -1324,35 +1331,52 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
   // Without snapping, each input's output is final here: its vcglib mesh
-  // is built on a second thread while the merged one is made (without it,
-  // all but the one with the fewest faces, while the curves are counted
-  // and that one is built here, as a small mesh's split finishes first and
-  // a large one's vcglib mesh costs as much as the welding), once there are
-  // enough faces to be worth handing to a helper (a few thousand faces take
-  // a few hundred microseconds).
-  std::size_t outputFaces = 0, fewestFaces = 0;
-  for (std::size_t m = 0; m < meshes.size(); ++m) {
-    outputFaces += outputs[m].triangles.size();
-    if (outputs[m].triangles.size() < outputs[fewestFaces].triangles.size()) fewestFaces = m;
-  }
-  const std::size_t builtHere = mergedArrays ? meshes.size() : fewestFaces;  // or none
+  // is built in parts (MeshBuilder: vertices, faces and their origins, new
+  // memory whose page faults cost more than the copy) that a second thread
+  // takes one after the other, the largest first, while this one makes the
+  // merged mesh or counts the curves, then takes the parts left. Once there
+  // are enough faces to be worth handing to a helper (a few thousand faces
+  // take a few hundred microseconds).
+  std::size_t outputFaces = 0;
+  for (const OutputArrays& out : outputs) outputFaces += out.triangles.size();
+  std::vector<MeshBuilder> builders;
+  struct BuildPart {
+    std::size_t mesh;
+    MeshBuilder::Part part;
+    std::size_t bytes;  // what it writes
+  };
+  std::vector<BuildPart> buildParts;
+  std::atomic<std::size_t> nextBuildPart{0};
+  auto buildSomeParts = [&] {
+    for (std::size_t k; (k = nextBuildPart++) < buildParts.size();)
+      builders[buildParts[k].mesh].build(buildParts[k].part);
+  };
   std::optional<TaskAlongside>
       separateBuilder;  // destroyed (waited for) also when the merged output throws
-  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096 &&
-      (mergedArrays || meshes.size() > 1)) {
+  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096) {
     r.meshes.resize(meshes.size());
-    separateBuilder.emplace([&] {
-      for (std::size_t m = 0; m < meshes.size(); ++m)
-        if (m != builtHere) outputs[m].toMesh(r.meshes[m]);
-    });
+    builders.reserve(meshes.size());
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const OutputArrays& out = outputs[m];
+      builders.emplace_back(r.meshes[m], out.positions, out.triangles, out.vertex_origin,
+                            out.face_origin);
+      const std::size_t nv = out.positions.size(), nf = out.triangles.size();
+      buildParts.push_back({m, MeshBuilder::kVertices, nv * sizeof(Vertex)});
+      buildParts.push_back({m, MeshBuilder::kVertexOrigins, nv * sizeof(VertexOrigin)});
+      buildParts.push_back({m, MeshBuilder::kFaces, nf * sizeof(Face)});
+      buildParts.push_back({m, MeshBuilder::kFaceOrigins, nf * sizeof(FaceOrigin)});
+    }
+    std::sort(buildParts.begin(), buildParts.end(),
+              [](const BuildPart& a, const BuildPart& b) { return a.bytes > b.bytes; });
+    separateBuilder.emplace(buildSomeParts);
   }
-  // The separate meshes not built alongside (the one with the fewest faces,
-  // or all of them when snapping rebuilt them), and the task alongside
-  // finished.
+  // The separate meshes: the parts no helper took, then their faces'
+  // corners; or all of them here, when snapping rebuilt their arrays.
   auto finishSeparate = [&] {
     if (separateBuilder) {
-      if (builtHere < meshes.size()) outputs[builtHere].toMesh(r.meshes[builtHere]);
+      buildSomeParts();
       separateBuilder->wait();
+      for (MeshBuilder& b : builders) b.link();
     } else if (options.separate_meshes) {
       r.meshes.resize(meshes.size());
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -47,6 +49,57 @@ TEST(Mesh, RejectsIndexOutOfRange) {
     EXPECT_NE(std::string(e.what()).find("face 0 refers to vertex 7"), std::string::npos);
   }
   EXPECT_THROW(makeMesh({{0, 0, 0}}, {{0, 0, -1}}), InvalidInputError);
+}
+
+// The parts of a MeshBuilder, in any order and on two threads at once,
+// build the mesh buildMesh builds; and it keeps working after elements are
+// added the usual way (its counts and attributes are vcglib's own).
+TEST(Mesh, BuilderPartsOnTwoThreadsBuildTheSameMesh) {
+  const Mesh source = testing::box(1, 2, 3);
+  const std::vector<Point3> positions = positionsOf(source);
+  const std::vector<Triangle> triangles = trianglesOf(source);
+  std::vector<VertexOrigin> vo(positions.size());
+  std::vector<FaceOrigin> fo(triangles.size());
+  for (std::size_t v = 0; v < vo.size(); ++v) vo[v] = {1, int(v), -1, {0, 0, 0}};
+  for (std::size_t f = 0; f < fo.size(); ++f) fo[f] = {2, int(f) + 10};
+  Mesh serial, parallel;
+  buildMesh(serial, positions, triangles, vo, fo);
+  {
+    MeshBuilder builder(parallel, positions, triangles, vo, fo);
+    std::thread other([&] {
+      builder.build(MeshBuilder::kFaceOrigins);
+      builder.build(MeshBuilder::kVertices);
+    });
+    builder.build(MeshBuilder::kFaces);
+    builder.build(MeshBuilder::kVertexOrigins);
+    other.join();
+    builder.link();
+  }
+  for (const Mesh* m : {&serial, &parallel}) {
+    EXPECT_EQ(positionsOf(*m), positions);
+    EXPECT_EQ(trianglesOf(*m), triangles);
+    EXPECT_EQ(m->vn, int(positions.size()));
+    EXPECT_EQ(m->fn, int(triangles.size()));
+    Mesh& mesh = const_cast<Mesh&>(*m);
+    EXPECT_EQ(vertexOrigins(mesh)[5].layer, 1);
+    EXPECT_EQ(vertexOrigins(mesh)[5].vertex, 5);
+    EXPECT_EQ(faceOrigins(mesh)[3].layer, 2);
+    EXPECT_EQ(faceOrigins(mesh)[3].face, 13);
+  }
+  vcg::tri::Allocator<Mesh>::AddVertices(parallel, 2);
+  EXPECT_EQ(parallel.vn, int(positions.size()) + 2);
+  EXPECT_EQ(vertexOrigins(parallel)[positions.size() + 1].vertex, -1);
+  EXPECT_EQ(vertexOrigins(parallel)[5].vertex, 5);
+}
+
+TEST(Mesh, BuilderRefusesMismatchedOriginsAndBadIndices) {
+  Mesh m = testing::tetrahedron();
+  const std::vector<Point3> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<VertexOrigin> vo(3);
+  const std::vector<FaceOrigin> fo(1);
+  EXPECT_THROW(MeshBuilder(m, p, {{0, 1, 2}}, vo, {}), std::invalid_argument);
+  EXPECT_THROW(MeshBuilder(m, p, {{0, 1, 3}}, vo, fo), InvalidInputError);
+  EXPECT_EQ(m.fn, 4);  // refused before the mesh was touched
 }
 
 TEST(Mesh, NonFiniteCoordinatesAreRejectedByTheCapabilityCheck) {
