@@ -253,8 +253,14 @@ class SmallList {
 
 // The curve points and segments one face receives (representative ids).
 struct FaceWork {
+  // Beside the edge bits: the point is known to lie strictly inside the
+  // face (so on none of its edges).
+  static constexpr std::uint8_t kInside = 1 << 3;
+  static constexpr std::uint8_t kEdgeBits = 7;
+
   SmallList<int, 6> points;
-  SmallList<std::uint8_t, 6> edges;           // per point: the face's edges it lies inside (bits)
+  // Per point: the face's edges it lies inside (bit i: edge i), or kInside.
+  SmallList<std::uint8_t, 6> edges;
   SmallList<std::array<int, 2>, 6> segments;  // indices into points
   std::int8_t proper = -1;  // is the face a proper triangle (not collinear)? -1: not asked yet
 
@@ -314,10 +320,14 @@ class MeshSplitter {
   }
 
   // The contact of a pair (curve point ids), seen from this mesh's face f.
-  void addContact(std::uint32_t f, const int* contact, std::size_t n) {
+  // A pair's contact (n curve point ids) on face f; `inside[i] & insideBit`
+  // when point i is known to lie strictly inside f.
+  void addContact(std::uint32_t f, const int* contact, const std::uint8_t* inside,
+                  std::uint8_t insideBit, std::size_t n) {
     FaceWork& w = work_[f];
     int ids[6];  // a contact has at most six points (two coplanar triangles' overlap)
-    for (std::size_t i = 0; i < n; ++i) ids[i] = w.add(contact[i]);
+    for (std::size_t i = 0; i < n; ++i)
+      ids[i] = w.add(contact[i], inside[i] & insideBit ? FaceWork::kInside : 0);
     if (n == 2 && ids[0] != ids[1]) w.segments.push_back({ids[0], ids[1]});
     if (n > 2)
       for (std::size_t i = 0; i < n; ++i)
@@ -366,6 +376,7 @@ class MeshSplitter {
         return w.proper == 1;
       };
       for (std::size_t p = 0; p < w.points.size(); ++p) {
+        if (w.edges[p] & FaceWork::kInside) continue;
         // A point known to lie inside one edge of a proper triangle lies on
         // no other (two edges share only a corner): the other tests are spared.
         std::uint8_t edges = 0;
@@ -413,7 +424,9 @@ class MeshSplitter {
             for (int k = 0; k < 3; ++k) in.corners[k] = ExactPoint(t[k]);
             in.points.clear();
             for (int id : w.points) in.points.push_back(table.point(id));
-            in.on_edges.assign(w.edges.begin(), w.edges.end());
+            in.on_edges.resize(w.edges.size());
+            for (std::size_t p = 0; p < w.edges.size(); ++p)
+              in.on_edges[p] = w.edges[p] & FaceWork::kEdgeBits;
             in.segments.clear();
             for (const auto& s : w.segments) in.segments.push_back({3 + s[0], 3 + s[1]});
             patches_[i] = retriangulate(in);
@@ -1233,16 +1246,23 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   std::vector<const std::vector<Triangle>*> triangles;
   for (const MeshSplitter& s : splitters) triangles.push_back(&s.triangles());
   CurvePoints table(2 * found.pairs.size());
-  // Each pair's contact as curve point ids, all pairs in one array.
+  // Each pair's contact as curve point ids, all pairs in one array, and
+  // per point the face of the pair it is known to lie strictly inside
+  // (FaceWork::kInside: bit 0 the pair's first face, bit 1 its second).
   std::vector<int> contactIds;
+  std::vector<std::uint8_t> contactInside;
   std::vector<std::size_t> contactStart(found.pairs.size() + 1, 0);
   contactIds.reserve(2 * found.pairs.size());
+  contactInside.reserve(2 * found.pairs.size());
   for (std::size_t i = 0; i < found.pairs.size(); ++i) {
     const FaceRef faces[2] = {found.pairs[i].a, found.pairs[i].b};
     const TriangleContact& c = found.contacts[i];
     if (c.points.size() > 6) throw std::logic_error("a contact of more than six points");
-    for (std::size_t k = 0; k < c.points.size(); ++k)
+    for (std::size_t k = 0; k < c.points.size(); ++k) {
       contactIds.push_back(table.add(c.points[k], c.exact[k], faces, triangles));
+      const ContactPoint& p = c.points[k];
+      contactInside.push_back(p.inside_other ? std::uint8_t(1 << (1 - p.triangle)) : 0);
+    }
     contactStart[i + 1] = contactIds.size();
   }
   table.mergeCoincident();
@@ -1255,10 +1275,11 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         for (std::size_t m = begin; m < end; ++m)
           for (std::size_t i = 0; i < found.pairs.size(); ++i) {
             const int* ids = contactIds.data() + contactStart[i];
+            const std::uint8_t* inside = contactInside.data() + contactStart[i];
             const std::size_t n = contactStart[i + 1] - contactStart[i];
             const IntersectingPair& pair = found.pairs[i];
-            if (pair.a.mesh == m) splitters[m].addContact(pair.a.face, ids, n);
-            if (pair.b.mesh == m) splitters[m].addContact(pair.b.face, ids, n);
+            if (pair.a.mesh == m) splitters[m].addContact(pair.a.face, ids, inside, 1, n);
+            if (pair.b.mesh == m) splitters[m].addContact(pair.b.face, ids, inside, 2, n);
           }
       },
       1);

@@ -375,6 +375,10 @@ bool classifyByOrder(const TrianglePoints& a, const TrianglePoints& b, const Pla
     p.kind = ContactPoint::Kind::kEdgeFace;
     p.triangle = e->triangle;
     p.index = e->edge;
+    // The other triangle's chord of the line of the two planes runs through
+    // its interior (none of its corners is on that line), and this end lies
+    // strictly inside that chord (the comparisons above were not ties).
+    p.inside_other = true;
     p.position = contact.exact.back().approx();
     contact.points.push_back(p);
   }

@@ -75,6 +75,9 @@ struct ContactPoint {
   std::uint8_t triangle = 0;
   std::uint8_t index = 0;
   std::uint8_t other_index = 0;
+  // Known to lie strictly inside the other triangle (off its edges and
+  // corners), from how the point was found; false when not known.
+  bool inside_other = false;
   Point3 position{0, 0, 0};  // the exact point, rounded to the nearest doubles
 };
 
