@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "common/errors.h"
+#include "common/parallel.h"
 
 namespace meshmend {
 
@@ -273,19 +274,29 @@ Mesh appended(const Mesh& a, const Mesh& b) {
   return out;
 }
 
+// Both copy in chunks on the helper threads: a large mesh's copy is the
+// first stage of an operation, and would leave the other cores idle.
 std::vector<Point3> positionsOf(const Mesh& mesh) {
-  std::vector<Point3> out;
-  out.reserve(mesh.vert.size());
-  for (const Vertex& v : mesh.vert) out.push_back(v.cP());
+  std::vector<Point3> out(mesh.vert.size());  // vcglib's Point3 leaves itself uninitialized
+  parallelChunks(
+      out.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t v = begin; v < end; ++v) out[v] = mesh.vert[v].cP();
+      },
+      1024);
   return out;
 }
 
 std::vector<Triangle> trianglesOf(const Mesh& mesh) {
-  std::vector<Triangle> out;
-  out.reserve(mesh.face.size());
-  for (const Face& f : mesh.face)
-    out.push_back({int(vcg::tri::Index(mesh, f.cV(0))), int(vcg::tri::Index(mesh, f.cV(1))),
-                   int(vcg::tri::Index(mesh, f.cV(2)))});
+  std::vector<Triangle> out(mesh.face.size());
+  const Vertex* first = mesh.vert.data();
+  parallelChunks(
+      out.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t f = begin; f < end; ++f)
+          for (int k = 0; k < 3; ++k) out[f][k] = int(mesh.face[f].cV(k) - first);
+      },
+      1024);
   return out;
 }
 
