@@ -1461,6 +1461,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       for (const MeshSplitter& s : splitters) slivers += s.slivers();
       r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers;
       std::vector<std::array<int, 2>> curves;
+      std::size_t curveEdges = 0;
+      for (const auto& edges : r.curve_edges) curveEdges += edges.size();
+      curves.reserve(curveEdges);
       for (std::size_t m = 0; m < meshes.size(); ++m)
         for (const auto& e : r.curve_edges[m]) {
           const int a = weldedTo[curveIndex[m][e[0]]], b = weldedTo[curveIndex[m][e[1]]];
