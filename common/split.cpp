@@ -319,9 +319,8 @@ class MeshSplitter {
     return {points_[triangles_[f][0]], points_[triangles_[f][1]], points_[triangles_[f][2]]};
   }
 
-  // The contact of a pair (curve point ids), seen from this mesh's face f.
-  // A pair's contact (n curve point ids) on face f; `inside[i] & insideBit`
-  // when point i is known to lie strictly inside f.
+  // A pair's contact (n curve point ids), seen from this mesh's face f;
+  // `inside[i] & insideBit` when point i is known to lie strictly inside f.
   void addContact(std::uint32_t f, const int* contact, const std::uint8_t* inside,
                   std::uint8_t insideBit, std::size_t n) {
     FaceWork& w = work_[f];

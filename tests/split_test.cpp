@@ -93,25 +93,36 @@ TEST(Split, QualitySnappingRemovesSliversAndKeepsTheResultValid) {
   }
 }
 
+// Also for outputs large enough to be built in parts on two threads
+// (MeshBuilder: from 4,096 output faces).
 TEST(Split, FacesNotCrossedStayBitIdentical) {
-  const Mesh a = uvSphere(16, 20), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
-  const SplitResult r = splitAlongIntersections({&a, &b});
-  const Mesh& out = r.meshes[0];
-  // Input vertices keep their index and coordinates.
-  for (std::size_t v = 0; v < a.vert.size(); ++v) EXPECT_EQ(out.vert[v].cP(), a.vert[v].cP());
-  // Every face not split appears unchanged (same corner indices), and the
-  // split ones are covered by faces that record them as their birth face.
-  FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(out));
-  std::vector<int> children(a.face.size(), 0);
-  for (std::size_t f = 0; f < out.face.size(); ++f) ++children[fo[f].face];
-  const std::vector<Triangle> in = trianglesOf(a), result = trianglesOf(out);
-  std::size_t unchanged = 0;
-  for (std::size_t f = 0; f < out.face.size(); ++f)
-    if (children[fo[f].face] == 1 && result[f] == in[fo[f].face]) ++unchanged;
-  const std::size_t splitFaces =
-      std::size_t(std::count_if(children.begin(), children.end(), [](int c) { return c > 1; }));
-  EXPECT_EQ(unchanged + splitFaces, a.face.size());
-  EXPECT_GT(unchanged, a.face.size() / 2);
+  for (const auto& [rings, segments] : {std::pair{16, 20}, std::pair{60, 80}}) {
+    SCOPED_TRACE(rings);
+    const Mesh a = uvSphere(rings, segments), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
+    const SplitResult r = splitAlongIntersections({&a, &b});
+    const Mesh& out = r.meshes[0];
+    // Input vertices keep their index, coordinates and origin.
+    VertexOriginHandle vo = vertexOrigins(const_cast<Mesh&>(out));
+    for (std::size_t v = 0; v < a.vert.size(); ++v) {
+      EXPECT_EQ(out.vert[v].cP(), a.vert[v].cP());
+      EXPECT_EQ(vo[v].vertex, int(v));
+    }
+    EXPECT_EQ(out.vn, int(out.vert.size()));
+    EXPECT_EQ(out.fn, int(out.face.size()));
+    // Every face not split appears unchanged (same corner indices), and the
+    // split ones are covered by faces that record them as their birth face.
+    FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(out));
+    std::vector<int> children(a.face.size(), 0);
+    for (std::size_t f = 0; f < out.face.size(); ++f) ++children[fo[f].face];
+    const std::vector<Triangle> in = trianglesOf(a), result = trianglesOf(out);
+    std::size_t unchanged = 0;
+    for (std::size_t f = 0; f < out.face.size(); ++f)
+      if (children[fo[f].face] == 1 && result[f] == in[fo[f].face]) ++unchanged;
+    const std::size_t splitFaces =
+        std::size_t(std::count_if(children.begin(), children.end(), [](int c) { return c > 1; }));
+    EXPECT_EQ(unchanged + splitFaces, a.face.size());
+    EXPECT_GT(unchanged, a.face.size() / 2);
+  }
 }
 
 TEST(Split, CurveThroughAVertexAndAlongAnEdge) {
