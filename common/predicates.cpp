@@ -16,9 +16,9 @@ namespace {
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon() / 2;  // 2^-53
 // Shewchuk's forward error bounds for the rounded determinants.
 constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
-constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient3dBound = PlaneFilter::kOrient3dBound;
 // Below this magnitude products may underflow and the bounds no longer hold.
-constexpr double kUnderflowGuard = 1e-250;
+constexpr double kUnderflowGuard = PlaneFilter::kUnderflowGuard;
 
 int sign(const mpq_class& q) {
   return sgn(q);
@@ -93,19 +93,6 @@ PlaneFilter::PlaneFilter(const Point3& a, const Point3& b, const Point3& c) {
   nAbs_[0] = std::fabs(by * cz) + std::fabs(bz * cy);
   nAbs_[1] = std::fabs(bz * cx) + std::fabs(bx * cz);
   nAbs_[2] = std::fabs(bx * cy) + std::fabs(by * cx);
-}
-
-int PlaneFilter::side(const Point3& a, const Point3& b, const Point3& c, const Point3& p) const {
-  const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
-  const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
-  const double permanent =
-      std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
-  const double bound = kOrient3dBound * permanent;
-  if (std::isfinite(det) && permanent > kUnderflowGuard) {
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  }
-  return orient3d(a, b, c, p);
 }
 
 int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {
