@@ -1,6 +1,10 @@
-// bench_split [--repeat N] [--limit S] [--sample] [--autorefine] A B:
+// bench_split [--repeat N] [--limit S] [--sample] [--autorefine]
+//             [--warm-allocator] A B:
 // intersect-and-split, ours against CGAL 5.5 on the same inputs in the same
-// run. Prints one JSON object.
+// run. Prints one JSON object. With --warm-allocator every method runs with
+// glibc's malloc as a host that has handled large meshes has it
+// (warmAllocator() in harness.h), so that no method's time includes memory
+// handed back to the system after one run and faulted in by the next.
 //
 // Ours: splitAlongIntersections with the merged output off
 // (meshmend_split_refine: the curves inserted into both meshes, the two
@@ -41,13 +45,15 @@ namespace {}  // namespace
 
 int main(int argc, char** argv) {
   int repeat = 3, limit = 600;
-  bool sample = false, autorefine = false;
+  bool sample = false, autorefine = false, warm = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--sample"))
       sample = true;
     else if (!std::strcmp(argv[i], "--autorefine"))
       autorefine = true;
+    else if (!std::strcmp(argv[i], "--warm-allocator"))
+      warm = true;
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
       repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
@@ -56,9 +62,12 @@ int main(int argc, char** argv) {
       files.push_back(argv[i]);
   }
   if (files.size() != 2) {
-    std::fprintf(stderr, "usage: bench_split [--repeat N] [--limit SECONDS] A B\n");
+    std::fprintf(stderr,
+                 "usage: bench_split [--repeat N] [--limit SECONDS] [--sample] [--autorefine] "
+                 "[--warm-allocator] A B\n");
     return 1;
   }
+  if (warm) warmAllocator();  // before the children fork: all methods alike
   const std::string a = files[0], b = files[1];
   std::vector<Method> methods;
   auto ours = [&](const char* name, const char* role, bool merged) {
@@ -115,6 +124,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "  %-20s %s\n", m.name.c_str(), toJson(r).str().c_str());
   }
   JsonObject out;
-  out.set("a", a).set("b", b).set("repeat", repeat).set("methods", results);
+  out.set("a", a)
+      .set("b", b)
+      .set("repeat", repeat)
+      .set("warm_allocator", warm)
+      .set("methods", results);
   std::printf("%s\n", out.str(true).c_str());
 }

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <sstream>
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,6 +21,12 @@ double maxRssMb() {
   return double(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
 }
 
+long minorFaults() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
+
 }  // namespace
 
 Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
@@ -32,7 +39,7 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
     return m;
   }
   const pid_t pid = fork();
-  if (pid == 0) {  // child: prepare, run, write "result baseline peak t1 t2 ..."
+  if (pid == 0) {  // child: prepare, run, write "result baseline peak faults t1 t2 ..."
     close(fds[0]);
     alarm(unsigned(timeLimitSeconds));
     std::ostringstream out;
@@ -41,14 +48,19 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
       const double baseline = maxRssMb();
       long result = 0;
       std::vector<double> times;
+      std::vector<long> faults;  // per run
       for (int i = 0; i < repeat; ++i) {
+        const long faultsBefore = minorFaults();
         const auto t0 = std::chrono::steady_clock::now();
         result = work();
         times.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                 .count());
+        faults.push_back(minorFaults() - faultsBefore);
       }
-      out << "ok " << result << ' ' << baseline << ' ' << maxRssMb();
+      std::sort(faults.begin(), faults.end());
+      out << "ok " << result << ' ' << baseline << ' ' << maxRssMb() << ' '
+          << (faults.empty() ? 0 : faults[faults.size() / 2]);
       for (double t : times) out << ' ' << t;
     } catch (const std::exception& e) {
       out << "error " << e.what();
@@ -82,7 +94,7 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds) {
     return m;
   }
   m.ok = true;
-  in >> m.result >> m.baseline_rss_mb >> m.peak_rss_mb;
+  in >> m.result >> m.baseline_rss_mb >> m.peak_rss_mb >> m.page_faults_per_run;
   for (double t; in >> t;) m.times_ms.push_back(t);
   std::vector<double> sorted = m.times_ms;
   std::sort(sorted.begin(), sorted.end());
@@ -100,7 +112,15 @@ JsonObject toJson(const Measurement& m) {
       .set("min_ms", m.min_ms)
       .set("times_ms", m.times_ms)
       .set("peak_rss_mb", m.peak_rss_mb)
-      .set("baseline_rss_mb", m.baseline_rss_mb);
+      .set("baseline_rss_mb", m.baseline_rss_mb)
+      .set("page_faults_per_run", m.page_faults_per_run);
+}
+
+void warmAllocator() {
+  // Setting the thresholds turns glibc's dynamic rule off, at the values it
+  // would have reached (DEFAULT_MMAP_THRESHOLD_MAX, twice that for trimming).
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
 }
 
 }  // namespace meshmend::bench

@@ -28,10 +28,25 @@ struct Measurement {
   double median_ms = 0, min_ms = 0;
   double peak_rss_mb = 0;      // the child's peak resident memory
   double baseline_rss_mb = 0;  // after preparing, before the timed work
+  // Pages a timed run touched for the first time (minor page faults; the
+  // median run): after the first runs, memory the allocator had given back
+  // to the system and took again. On a virtual machine each costs
+  // microseconds.
+  double page_faults_per_run = 0;
 };
 
 // Runs `method` `repeat` times in a child process (time limit in seconds).
 Measurement measure(const Method& method, int repeat, int timeLimitSeconds = 600);
+
+// Puts glibc's malloc, in this process and the children measure() forks
+// from it, in the state its own dynamic rule reaches in a process that has
+// freed a block of 32 MiB or more (a host that has loaded and dropped a mesh
+// of a few hundred thousand faces): blocks up to 32 MiB come from the heap,
+// and up to 64 MiB of freed memory at its top stays with the process.
+// Otherwise a fresh process keeps the thresholds of its largest block freed
+// so far, and a method whose result just exceeds them hands its memory back
+// to the system after every run and faults it in again in the next one.
+void warmAllocator();
 
 JsonObject toJson(const Measurement& m);
 
