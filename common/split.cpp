@@ -221,6 +221,112 @@ struct OutputArrays {
   }
 };
 
+// Where MeshSplitter::build writes a mesh's output: the input's vertices
+// (with their origins) and kept faces first, then the new vertices and
+// faces. ArraysOutput fills OutputArrays, which the merged output and
+// snapping work on; MeshOutput fills the output mesh itself, when that is
+// all that is asked for, so that the output is written once (a second copy
+// of it was a third of the memory a split touched, and on a virtual
+// machine memory first touched costs more than the copy).
+// The origin of the output vertex that is input vertex `vertex` of `layer`.
+VertexOrigin inputOrigin(int layer, int vertex) {
+  return {layer, vertex, -1, Point3(0, 0, 0)};  // (vcg leaves Point3{} unset)
+}
+
+class ArraysOutput {
+ public:
+  explicit ArraysOutput(OutputArrays& out) : out_(out) {}
+  // Room for `vertices` and `faces` in all; the input's vertices, and its
+  // kept faces to be written by index (a third fewer instructions than a
+  // push_back each).
+  void begin(const std::vector<Point3>& points, int layer, const std::vector<int>& pointOrigins,
+             std::size_t keptFaces, std::size_t vertices, std::size_t faces) {
+    out_.positions.reserve(vertices);
+    out_.positions.assign(points.begin(), points.end());
+    out_.vertex_origin.reserve(vertices);
+    out_.vertex_origin.resize(points.size());
+    for (std::size_t v = 0; v < points.size(); ++v)
+      out_.vertex_origin[v] = inputOrigin(layer, pointOrigins[v]);
+    out_.triangles.reserve(faces);
+    out_.triangles.resize(keptFaces);
+    out_.face_origin.reserve(faces);
+    out_.face_origin.resize(keptFaces);
+  }
+  void keptFace(std::size_t k, const Triangle& t, const FaceOrigin& origin) {
+    out_.triangles[k] = t;
+    out_.face_origin[k] = origin;
+  }
+  int addVertex(const Point3& p, const VertexOrigin& origin) {
+    out_.positions.push_back(p);
+    out_.vertex_origin.push_back(origin);
+    return int(out_.positions.size()) - 1;
+  }
+  void addFace(const Triangle& t, const FaceOrigin& origin) {
+    out_.triangles.push_back(t);
+    out_.face_origin.push_back(origin);
+  }
+  const Point3& position(int v) const { return out_.positions[v]; }
+  std::size_t vertices() const { return out_.positions.size(); }
+  std::size_t faces() const { return out_.triangles.size(); }
+  void end() {}
+
+ private:
+  OutputArrays& out_;
+};
+
+class MeshOutput {
+ public:
+  explicit MeshOutput(Mesh& mesh) : mesh_(mesh) {}
+  // `vertices` must bound the vertices added: faces point into the vertex
+  // array, which must not move.
+  void begin(const std::vector<Point3>& points, int layer, const std::vector<int>& pointOrigins,
+             std::size_t keptFaces, std::size_t vertices, std::size_t faces) {
+    mesh_.Clear();
+    mesh_.ClearAttributes();
+    vo_ = vertexOrigins(mesh_);
+    fo_ = faceOrigins(mesh_);
+    mesh_.vert.reserve(vertices);
+    mesh_.vert.resize(points.size());
+    for (std::size_t v = 0; v < points.size(); ++v) mesh_.vert[v].P() = points[v];
+    vo_._handle->data.reserve(vertices);
+    vo_._handle->data.resize(points.size());
+    for (std::size_t v = 0; v < points.size(); ++v) vo_[v] = inputOrigin(layer, pointOrigins[v]);
+    mesh_.face.reserve(faces);
+    mesh_.face.resize(keptFaces);
+    fo_._handle->data.reserve(faces);
+    fo_._handle->data.resize(keptFaces);
+  }
+  void keptFace(std::size_t k, const Triangle& t, const FaceOrigin& origin) {
+    Face& f = mesh_.face[k];
+    for (int i = 0; i < 3; ++i) f.V(i) = &mesh_.vert[t[i]];
+    fo_[k] = origin;
+  }
+  int addVertex(const Point3& p, const VertexOrigin& origin) {
+    if (mesh_.vert.size() == mesh_.vert.capacity())
+      throw std::logic_error("split output: more new vertices than its patches have");
+    mesh_.vert.emplace_back().P() = p;
+    vo_._handle->data.push_back(origin);
+    return int(mesh_.vert.size()) - 1;
+  }
+  void addFace(const Triangle& t, const FaceOrigin& origin) {
+    Face& f = mesh_.face.emplace_back();
+    for (int i = 0; i < 3; ++i) f.V(i) = &mesh_.vert[t[i]];
+    fo_._handle->data.push_back(origin);
+  }
+  Point3 position(int v) const { return mesh_.vert[v].cP(); }
+  std::size_t vertices() const { return mesh_.vert.size(); }
+  std::size_t faces() const { return mesh_.face.size(); }
+  void end() {
+    mesh_.vn = int(mesh_.vert.size());
+    mesh_.fn = int(mesh_.face.size());
+  }
+
+ private:
+  Mesh& mesh_;
+  VertexOriginHandle vo_;
+  FaceOriginHandle fo_;
+};
+
 // A list that keeps its first N elements in place and only a longer one on
 // the heap: a crossed face receives a few points and segments, and an
 // allocation for each would cost more than the rest of its bookkeeping.
@@ -434,56 +540,42 @@ class MeshSplitter {
         parallel ? 16 : order_.size() + 1);
   }
 
-  // Builds the output mesh and its curve edges; `exactNew` receives the
-  // exact positions of the new vertices.
-  void build(const CurvePoints& table, OutputArrays& out, std::vector<std::array<int, 2>>& curves,
+  // Builds the output mesh (into `out`, an ArraysOutput or a MeshOutput)
+  // and its curve edges; `exactNew` receives the exact positions of the new
+  // vertices.
+  template <class Output>
+  void build(const CurvePoints& table, Output&& out, std::vector<std::array<int, 2>>& curves,
              std::vector<ExactPoint>& exactNew, std::size_t& facesAdded) {
-    std::vector<Point3>& positions = out.positions;
-    std::vector<Triangle>& triangles = out.triangles;
-    std::vector<FaceOrigin>& birthFaces = out.face_origin;
-    std::vector<VertexOrigin>& origins = out.vertex_origin;
     slivers_ = 0;
-    // Room for the new vertices too (a copy's exact size would move every
-    // position at the first one).
-    positions.reserve(points_.size() + 4 * work_.size());
-    positions.assign(points_.begin(), points_.end());
-    // The input's vertices and kept faces (nearly all of a large mesh)
-    // written by index: a third fewer instructions than a push_back each.
-    origins.reserve(points_.size() + 4 * work_.size());
-    origins.resize(points_.size());
-    for (std::size_t v = 0; v < points_.size(); ++v)
-      origins[v] = {int(index_), vertexOrigin_[v], -1, Point3(0, 0, 0)};  // (vcg leaves {} unset)
-    triangles.reserve(triangles_.size() + 8 * work_.size());
-    birthFaces.reserve(triangles.capacity());
+    // The output's exact face count, and a bound on its vertices: each new
+    // vertex is a point or crossing of one of the patches.
+    std::vector<char> split(triangles_.size(), 0);
+    std::size_t splitCount = 0, newFaces = 0, newVerticesAtMost = 0;
+    for (std::size_t i = 0; i < order_.size(); ++i) {
+      const Patch& patch = patches_[i];
+      split[order_[i]] = !patch.triangles.empty();
+      if (patch.triangles.empty()) continue;
+      ++splitCount;
+      newFaces += patch.triangles.size();
+      newVerticesAtMost += patch.vertices.size() - 3;
+    }
+    keptFaces_ = triangles_.size() - splitCount;
+    out.begin(points_, int(index_), vertexOrigin_, keptFaces_, points_.size() + newVerticesAtMost,
+              keptFaces_ + newFaces);
+    for (std::size_t f = 0, k = 0; f < triangles_.size(); ++f)
+      if (!split[f]) out.keptFace(k++, triangles_[f], {int(index_), faceOrigin_[f]});
     std::vector<int> vertexOfPoint(table.size(), -1);        // curve point id -> output vertex
     std::vector<std::array<int, 2>> pointOfVertex;           // (output vertex, curve point id)
     std::map<RationalPoint, int, ExactLess> crossingPoints;  // made inside one face
+    exactNew.reserve(exactNew.size() + 2 * order_.size());
     auto newVertex = [&](const ExactPoint& p, std::uint32_t f) {
-      positions.push_back(p.approx());
       exactNew.push_back(p);
       const TrianglePoints t = at(f);
-      origins.push_back(
-          {int(index_), -1, faceOrigin_[f], barycentric(p.approx(), t[0], t[1], t[2])});
-      return int(positions.size()) - 1;
+      return out.addVertex(
+          p.approx(), {int(index_), -1, faceOrigin_[f], barycentric(p.approx(), t[0], t[1], t[2])});
     };
-    std::vector<char> split(triangles_.size(), 0);
-    std::size_t splitCount = 0;
-    for (std::size_t i = 0; i < order_.size(); ++i) {
-      split[order_[i]] = !patches_[i].triangles.empty();
-      splitCount += split[order_[i]];
-    }
-    keptFaces_ = triangles_.size() - splitCount;
-    triangles.resize(keptFaces_);
-    birthFaces.resize(keptFaces_);
-    for (std::size_t f = 0, k = 0; f < triangles_.size(); ++f)
-      if (!split[f]) {
-        triangles[k] = triangles_[f];
-        birthFaces[k] = {int(index_), faceOrigin_[f]};
-        ++k;
-      }
     curves.clear();
-    std::vector<int> global;  // per patch vertex: its output vertex
-    exactNew.reserve(exactNew.size() + 2 * order_.size());
+    std::vector<int> global;             // per patch vertex: its output vertex
     std::array<Point3, 3> smallestFace;  // the new face with the smallest angle
     double smallestSine = 2;             // its measure (smallestAngleMeasure)
     for (std::size_t i = 0; i < order_.size(); ++i) {
@@ -524,10 +616,9 @@ class MeshSplitter {
                      &c = patch.vertices[t[2]].approx();
         const double sine = smallestAngleMeasure(a, b, c);
         if (sine < smallestSine) smallestSine = sine, smallestFace = {a, b, c};
-        triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
-        birthFaces.push_back({int(index_), faceOrigin_[f]});
-        slivers_ +=
-            isSliver(positions[global[t[0]]], positions[global[t[1]]], positions[global[t[2]]]);
+        out.addFace({global[t[0]], global[t[1]], global[t[2]]}, {int(index_), faceOrigin_[f]});
+        slivers_ += isSliver(out.position(global[t[0]]), out.position(global[t[1]]),
+                             out.position(global[t[2]]));
       }
       for (const auto& e : patch.constrained_edges)
         curves.push_back(
@@ -538,9 +629,10 @@ class MeshSplitter {
     if (smallestSine < 2)  // one angle computed, not one per face
       smallestAngle_ = meshmend::smallestAngle(smallestFace[0], smallestFace[1], smallestFace[2]);
     // Later entries win, as each curve point is met again in every face it is in.
-    pointOfVertex_.assign(positions.size(), -1);
+    pointOfVertex_.assign(out.vertices(), -1);
     for (const auto& [vertex, id] : pointOfVertex) pointOfVertex_[vertex] = id;
-    facesAdded += triangles.size() - triangles_.size();
+    facesAdded += out.faces() - triangles_.size();
+    out.end();
   }
 
   // Frees what only the split itself needs (the faces' work, the patches,
@@ -1233,7 +1325,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   find.progress = [&](int percent, const char* stage) {
     return !options.progress || options.progress(percent * 4 / 10, stage);
   };
-  const FindIntersectionsResult found = findIntersectionsInArrays(arrays, find);
+  FindIntersectionsResult found = findIntersectionsInArrays(arrays, find);
   r.intersecting_pairs = found.pairs.size();
   r.complete = options.self && (options.between_meshes || meshes.size() == 1);
 
@@ -1264,6 +1356,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     }
     contactStart[i + 1] = contactIds.size();
   }
+  // The contacts' exact points are in the table now: their memory (a third
+  // of a small split's) goes back before the outputs are made.
+  std::vector<TriangleContact>().swap(found.contacts);
   table.mergeCoincident();
   for (int& id : contactIds) id = table.representative(id);
   // Each mesh's faces receive their contacts on their own thread, in the
@@ -1296,6 +1391,11 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // segment goes into both) and there is enough of it to be worth sharing
   // (a few dozen faces); otherwise one mesh after the other, each on every core. With
   // more than two cores, each mesh still re-triangulates on several.
+  // When each input's mesh is all that is asked for (no merged output, no
+  // snapping), the split writes it directly; otherwise into arrays first.
+  const bool directMeshes =
+      options.separate_meshes && !options.merged_output && options.snap_tolerance <= 0;
+  if (directMeshes) r.meshes.resize(meshes.size());
   std::atomic<std::size_t> nextMesh{0};
   std::vector<std::size_t> facesAdded(meshes.size(), 0);
   bool sideBySide = false;
@@ -1303,7 +1403,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     for (std::size_t m; (m = nextMesh++) < meshes.size();) {
       splitters[m].shareEdgePoints(table);
       splitters[m].retriangulateFaces(table, !sideBySide || workerCount() > 2);
-      splitters[m].build(table, outputs[m], r.curve_edges[m], exactNew[m], facesAdded[m]);
+      if (directMeshes)
+        splitters[m].build(table, MeshOutput(r.meshes[m]), r.curve_edges[m], exactNew[m],
+                           facesAdded[m]);
+      else
+        splitters[m].build(table, ArraysOutput(outputs[m]), r.curve_edges[m], exactNew[m],
+                           facesAdded[m]);
       splitters[m].releaseWorkingMemory();
     }
   };
@@ -1350,13 +1455,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // from them), so it needs them even when the merged mesh is not asked for.
   const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
-  // Without snapping, each input's output is final here: its vcglib mesh
-  // is built in parts (MeshBuilder: vertices, faces and their origins, new
-  // memory whose page faults cost more than the copy) that a second thread
-  // takes one after the other, the largest first, while this one makes the
-  // merged mesh or counts the curves, then takes the parts left. Once there
-  // are enough faces to be worth handing to a helper (a few thousand faces
-  // take a few hundred microseconds).
+  // Without snapping, each input's output is final here: unless the split
+  // wrote it directly, its vcglib mesh is built in parts (MeshBuilder: vertices, faces and their
+  // origins, new memory whose page faults cost more than the copy) that a second thread takes one
+  // after the other, the largest first, while this one makes the merged mesh or counts the curves,
+  // then takes the parts left. Once there are enough faces to be worth handing to a helper (a few
+  // thousand faces take a few hundred microseconds).
   std::size_t outputFaces = 0;
   for (const OutputArrays& out : outputs) outputFaces += out.triangles.size();
   std::vector<MeshBuilder> builders;
@@ -1373,7 +1477,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   };
   std::optional<TaskAlongside>
       separateBuilder;  // destroyed (waited for) also when the merged output throws
-  if (options.separate_meshes && options.snap_tolerance <= 0 && outputFaces >= 4096) {
+  if (!directMeshes && options.separate_meshes && options.snap_tolerance <= 0 &&
+      outputFaces >= 4096) {
     r.meshes.resize(meshes.size());
     builders.reserve(meshes.size());
     for (std::size_t m = 0; m < meshes.size(); ++m) {
@@ -1397,7 +1502,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       buildSomeParts();
       separateBuilder->wait();
       for (MeshBuilder& b : builders) b.link();
-    } else if (options.separate_meshes) {
+    } else if (options.separate_meshes && !directMeshes) {
       r.meshes.resize(meshes.size());
       for (std::size_t m = 0; m < meshes.size(); ++m) outputs[m].toMesh(r.meshes[m]);
     }
@@ -1415,9 +1520,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     std::size_t notAtCurvePoints = 0;  // curve vertices without an id: crossings made in a face
     std::vector<std::vector<int>> curveIndex(meshes.size());  // per mesh vertex: into curvePoints
     for (std::size_t m = 0; m < meshes.size(); ++m) {
-      const OutputArrays& mesh = outputs[m];
       std::vector<int>& index = curveIndex[m];
-      index.assign(mesh.positions.size(), -1);
+      index.assign(directMeshes ? r.meshes[m].vert.size() : outputs[m].positions.size(), -1);
       const auto& pointOfVertex = splitters[m].pointOfVertex();
       auto mark = [&](int v) {
         if (index[v] >= 0) return;
@@ -1435,7 +1539,8 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         index[v] = int(curvePoints.size());
         const std::size_t inputVertices = splitters[m].points().size();
         if (std::size_t(v) < inputVertices) {
-          inputCurvePoints.emplace_back(mesh.positions[v]);
+          inputCurvePoints.emplace_back(directMeshes ? r.meshes[m].vert[v].cP()
+                                                     : outputs[m].positions[v]);
           curvePoints.push_back(&inputCurvePoints.back());
         } else {
           curvePoints.push_back(&exactNew[m][v - inputVertices]);

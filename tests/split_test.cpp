@@ -96,33 +96,39 @@ TEST(Split, QualitySnappingRemovesSliversAndKeepsTheResultValid) {
 // Also for outputs large enough to be built in parts on two threads
 // (MeshBuilder: from 4,096 output faces).
 TEST(Split, FacesNotCrossedStayBitIdentical) {
-  for (const auto& [rings, segments] : {std::pair{16, 20}, std::pair{60, 80}}) {
-    SCOPED_TRACE(rings);
-    const Mesh a = uvSphere(rings, segments), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
-    const SplitResult r = splitAlongIntersections({&a, &b});
-    const Mesh& out = r.meshes[0];
-    // Input vertices keep their index, coordinates and origin.
-    VertexOriginHandle vo = vertexOrigins(const_cast<Mesh&>(out));
-    for (std::size_t v = 0; v < a.vert.size(); ++v) {
-      EXPECT_EQ(out.vert[v].cP(), a.vert[v].cP());
-      EXPECT_EQ(vo[v].vertex, int(v));
+  // Each output built from arrays (with the merged output), and written
+  // directly by the split (without it).
+  for (const bool merged : {true, false})
+    for (const auto& [rings, segments] : {std::pair{16, 20}, std::pair{60, 80}}) {
+      SCOPED_TRACE(rings);
+      SCOPED_TRACE(merged);
+      const Mesh a = uvSphere(rings, segments), b = uvSphere(16, 20, 1.0, {1.2, 0, 0});
+      SplitOptions options;
+      options.merged_output = merged;
+      const SplitResult r = splitAlongIntersections({&a, &b}, options);
+      const Mesh& out = r.meshes[0];
+      // Input vertices keep their index, coordinates and origin.
+      VertexOriginHandle vo = vertexOrigins(const_cast<Mesh&>(out));
+      for (std::size_t v = 0; v < a.vert.size(); ++v) {
+        EXPECT_EQ(out.vert[v].cP(), a.vert[v].cP());
+        EXPECT_EQ(vo[v].vertex, int(v));
+      }
+      EXPECT_EQ(out.vn, int(out.vert.size()));
+      EXPECT_EQ(out.fn, int(out.face.size()));
+      // Every face not split appears unchanged (same corner indices), and the
+      // split ones are covered by faces that record them as their birth face.
+      FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(out));
+      std::vector<int> children(a.face.size(), 0);
+      for (std::size_t f = 0; f < out.face.size(); ++f) ++children[fo[f].face];
+      const std::vector<Triangle> in = trianglesOf(a), result = trianglesOf(out);
+      std::size_t unchanged = 0;
+      for (std::size_t f = 0; f < out.face.size(); ++f)
+        if (children[fo[f].face] == 1 && result[f] == in[fo[f].face]) ++unchanged;
+      const std::size_t splitFaces =
+          std::size_t(std::count_if(children.begin(), children.end(), [](int c) { return c > 1; }));
+      EXPECT_EQ(unchanged + splitFaces, a.face.size());
+      EXPECT_GT(unchanged, a.face.size() / 2);
     }
-    EXPECT_EQ(out.vn, int(out.vert.size()));
-    EXPECT_EQ(out.fn, int(out.face.size()));
-    // Every face not split appears unchanged (same corner indices), and the
-    // split ones are covered by faces that record them as their birth face.
-    FaceOriginHandle fo = faceOrigins(const_cast<Mesh&>(out));
-    std::vector<int> children(a.face.size(), 0);
-    for (std::size_t f = 0; f < out.face.size(); ++f) ++children[fo[f].face];
-    const std::vector<Triangle> in = trianglesOf(a), result = trianglesOf(out);
-    std::size_t unchanged = 0;
-    for (std::size_t f = 0; f < out.face.size(); ++f)
-      if (children[fo[f].face] == 1 && result[f] == in[fo[f].face]) ++unchanged;
-    const std::size_t splitFaces =
-        std::size_t(std::count_if(children.begin(), children.end(), [](int c) { return c > 1; }));
-    EXPECT_EQ(unchanged + splitFaces, a.face.size());
-    EXPECT_GT(unchanged, a.face.size() / 2);
-  }
 }
 
 TEST(Split, CurveThroughAVertexAndAlongAnEdge) {
@@ -333,13 +339,26 @@ TEST(Split, WithoutTheMergedOutputEachMeshIsTheSame) {
     EXPECT_TRUE(r.merged_new_face.empty());
     ASSERT_EQ(r.meshes.size(), cases[i].size());
     for (std::size_t m = 0; m < r.meshes.size(); ++m) {
-      EXPECT_EQ(positionsOf(r.meshes[m]), positionsOf(full.meshes[m]));
-      EXPECT_EQ(trianglesOf(r.meshes[m]), trianglesOf(full.meshes[m]));
+      const Mesh& mesh = r.meshes[m];
+      EXPECT_EQ(positionsOf(mesh), positionsOf(full.meshes[m]));
+      EXPECT_EQ(trianglesOf(mesh), trianglesOf(full.meshes[m]));
+      EXPECT_EQ(mesh.vn, int(mesh.vert.size()));
+      EXPECT_EQ(mesh.fn, int(mesh.face.size()));
       EXPECT_EQ(r.curve_edges[m], full.curve_edges[m]);
+      VertexOriginHandle origin = vertexOrigins(r.meshes[m]);
+      VertexOriginHandle fullOrigin = vertexOrigins(const_cast<Mesh&>(full.meshes[m]));
+      for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
+        EXPECT_EQ(origin[v].layer, fullOrigin[v].layer);
+        EXPECT_EQ(origin[v].vertex, fullOrigin[v].vertex);
+        EXPECT_EQ(origin[v].face, fullOrigin[v].face);
+        EXPECT_EQ(origin[v].barycentric, fullOrigin[v].barycentric);
+      }
       FaceOriginHandle birth = faceOrigins(r.meshes[m]);
       FaceOriginHandle fullBirth = faceOrigins(const_cast<Mesh&>(full.meshes[m]));
-      for (std::size_t f = 0; f < r.meshes[m].face.size(); ++f)
+      for (std::size_t f = 0; f < mesh.face.size(); ++f) {
+        EXPECT_EQ(birth[f].layer, fullBirth[f].layer);
         EXPECT_EQ(birth[f].face, fullBirth[f].face);
+      }
     }
     EXPECT_GT(full.faces_split, 0u);
     EXPECT_EQ(r.curve_edges_welded, full.merged_curve_edges.size());
