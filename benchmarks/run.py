@@ -292,37 +292,59 @@ def split(repeat, rounds=3):
            "checked `PMP::corefine` refuses the pair (the dragon self-intersects; unchecked, "
            "its result is unspecified there), and CGAL's only "
            "alternative, `PMP::experimental::autorefine` of the two joined, runs under a "
-           "5-minute limit.",
+           "5-minute limit. *Page faults* are those of the median run (memory the allocator "
+           "handed back to the system after one run and took again in the next; about 11 µs "
+           "each on this virtual machine). The *warm* columns run the same rounds with "
+           "`--warm-allocator`: every method with glibc's malloc thresholds where its own "
+           "dynamic rule leaves them once a process has freed a 32 MiB block (a host that has "
+           "loaded and dropped a large mesh), so that no method's time includes memory faulted "
+           "in again; the bunny + dragon rows run without it.",
            "",
            "| pair | faces split (ours) | ours ms | ours + merged ms | ours peak MB | "
-           "CGAL ms | CGAL checked ms | CGAL peak MB | CGAL / ours |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+           "CGAL ms | CGAL checked ms | CGAL peak MB | CGAL / ours | page faults ours / CGAL | "
+           "warm: ours ms | warm: CGAL ms | warm: CGAL / ours |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
 
     def cell(m):
         if m is None:
             return "–"
         return fmt(m["median_ms"]) if m.get("ok") else m.get("error", "?").strip()
 
-    for name, a, b, extra in rows:
-        methods = split_rounds([str(BUILD / "benchmarks" / "bench_split"), "--repeat",
-                                str(repeat), *extra, str(a), str(b)], rounds)
+    def ours_and_best_peer(methods):
         o = methods.get("meshmend_split_refine") or methods["meshmend_split_sample"]
-        merged = methods.get("meshmend_split")
-        plain, checked = methods.get("cgal_corefine"), methods.get("cgal_corefine_checked")
-        peers = [c for c in (plain, checked) if c and c.get("ok")]
+        peers = [c for c in (methods.get("cgal_corefine"), methods.get("cgal_corefine_checked"))
+                 if c and c.get("ok")]
         best = min(peers, key=lambda c: c["median_ms"]) if peers else None
         ratio = f"{best['median_ms'] / o['median_ms']:.1f}×" if best and o.get("ok") else "–"
+        return o, best, ratio
+
+    def faults(m):
+        return f"{m['page_faults_per_run']:.0f}" if m and m.get("ok") else "–"
+
+    for name, a, b, extra in rows:
+        command = [str(BUILD / "benchmarks" / "bench_split"), "--repeat", str(repeat), *extra,
+                   str(a), str(b)]
+        methods = split_rounds(command, rounds)
+        o, best, ratio = ours_and_best_peer(methods)
+        merged = methods.get("meshmend_split")
+        plain, checked = methods.get("cgal_corefine"), methods.get("cgal_corefine_checked")
         peak = max((c.get("peak_rss_mb", 0) for c in (plain, checked) if c), default=0)
+        warm = ["–", "–", "–"]
+        if "--sample" not in extra:
+            wo, wbest, wratio = ours_and_best_peer(
+                split_rounds(command[:1] + ["--warm-allocator"] + command[1:], rounds))
+            warm = [cell(wo), cell(wbest), wratio]
         out.append(f"| {name} (corefine) | {o.get('result', '–')} | {cell(o)} | {cell(merged)} | "
                    f"{o.get('peak_rss_mb', 0):.0f} | {cell(plain)} | {cell(checked)} | "
-                   f"{peak:.0f} | {ratio} |")
+                   f"{peak:.0f} | {ratio} | {faults(o)} / {faults(best)} | {' | '.join(warm)} |")
         auto = methods.get("cgal_autorefine")
         if auto:
             ratio = (f"{auto['median_ms'] / o['median_ms']:.1f}×"
                      if auto.get("ok") and o.get("ok") else "–")
             out.append(f"| {name} (autorefine) | {o.get('result', '–')} | {cell(o)} | – | "
                        f"{o.get('peak_rss_mb', 0):.0f} | {cell(auto)} | – | "
-                       f"{auto.get('peak_rss_mb', 0):.0f} | {ratio} |")
+                       f"{auto.get('peak_rss_mb', 0):.0f} | {ratio} | {faults(o)} / "
+                       f"{faults(auto)} | – | – | – |")
     return "\n".join(out)
 
 
