@@ -221,6 +221,11 @@ struct OutputArrays {
   }
 };
 
+// The origin of the output vertex that is input vertex `vertex` of `layer`.
+VertexOrigin inputOrigin(int layer, int vertex) {
+  return {layer, vertex, -1, Point3(0, 0, 0)};  // (vcg leaves Point3{} unset)
+}
+
 // Where MeshSplitter::build writes a mesh's output: the input's vertices
 // (with their origins) and kept faces first, then the new vertices and
 // faces. ArraysOutput fills OutputArrays, which the merged output and
@@ -228,11 +233,6 @@ struct OutputArrays {
 // all that is asked for, so that the output is written once (a second copy
 // of it was a third of the memory a split touched, and on a virtual
 // machine memory first touched costs more than the copy).
-// The origin of the output vertex that is input vertex `vertex` of `layer`.
-VertexOrigin inputOrigin(int layer, int vertex) {
-  return {layer, vertex, -1, Point3(0, 0, 0)};  // (vcg leaves Point3{} unset)
-}
-
 class ArraysOutput {
  public:
   explicit ArraysOutput(OutputArrays& out) : out_(out) {}
