@@ -15,16 +15,18 @@ namespace meshmend::bench {
 
 namespace {
 
-double maxRssMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
+rusage usage() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u;
 }
 
+double maxRssMb() {
+  return double(usage().ru_maxrss) / 1024.0;
+}  // Linux: kilobytes
+
 long minorFaults() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_minflt;
+  return usage().ru_minflt;
 }
 
 }  // namespace

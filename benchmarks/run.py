@@ -258,6 +258,8 @@ def split_rounds(command, rounds):
         merged["median_ms"] = statistics.median(m["median_ms"] for m in ok)
         merged["round_medians_ms"] = [m["median_ms"] for m in ok]
         merged["peak_rss_mb"] = max(m.get("peak_rss_mb", 0) for m in ok)
+        merged["page_faults_per_run"] = statistics.median(m.get("page_faults_per_run", 0)
+                                                          for m in ok)
         methods[name] = merged
     return methods
 

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
-#include <limits>
 
 #include <gmpxx.h>
 
@@ -13,7 +12,7 @@ namespace meshmend {
 
 namespace {
 
-constexpr double kEpsilon = std::numeric_limits<double>::epsilon() / 2;  // 2^-53
+constexpr double kEpsilon = PlaneFilter::kEpsilon;  // 2^-53
 // Shewchuk's forward error bounds for the rounded determinants.
 constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 constexpr double kOrient3dBound = PlaneFilter::kOrient3dBound;
