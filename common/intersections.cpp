@@ -101,9 +101,7 @@ Candidates facesTouching(Soup& s, const Box& other) {
     hi[k] = std::nextafter(other.hi[k], INFINITY);
   }
   std::vector<std::uint8_t> beyond(s.points.size());
-  // In chunks, each keeping its own candidates, then joined in order: the
-  // two meshes' searches run side by side, and a large mesh's chunks go to
-  // the threads a small one's search leaves.
+  // In chunks, each keeping its own candidates, then joined in order.
   std::vector<Candidates> parts(workerCount());
   parallelChunks(
       s.points.size(),
@@ -269,15 +267,10 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
       for (std::size_t k = m + 1; k < n; ++k) {
         reportProgress(options.progress, 50, "Intersections between meshes");
         if (!overlap(soups[m].bounds, soups[k].bounds)) continue;
-        Candidates near[2];
-        parallelChunks(
-            2,
-            [&](std::size_t begin, std::size_t end, unsigned) {
-              for (std::size_t i = begin; i < end; ++i)
-                near[i] = i == 0 ? facesTouching(soups[m], soups[k].bounds)
-                                 : facesTouching(soups[k], soups[m].bounds);
-            },
-            1);
+        // One mesh after the other, each on every thread: side by side, the
+        // smaller one's thread idled while the larger one's did most of the work.
+        const Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
+                                    facesTouching(soups[k], soups[m].bounds)};
         // A tree over the smaller set of candidates, queried by the other's.
         const bool swap = near[0].faces.size() > near[1].faces.size();
         const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];

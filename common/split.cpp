@@ -40,6 +40,36 @@ struct ExactLess {
   }
 };
 
+// Sorts `pairs` (of values in [0, bound)) and removes the repeats, as
+// std::sort and std::unique would. A split's curve edges are a few hundred
+// to a hundred thousand pairs on as many vertices, and comparison sorting
+// them took a tenth of a small split: when `bound` is not much larger than
+// their number, a counting sort on the first value (each has the two or
+// three curve edges of one curve vertex, ordered in place) takes linear time.
+void sortUnique(std::vector<std::array<int, 2>>& pairs, std::size_t bound) {
+  if (bound > 16 * pairs.size() + 4096) {  // sparse: the counts would cost more
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    return;
+  }
+  std::vector<int> start(bound + 1, 0);
+  for (const auto& e : pairs) ++start[e[0] + 1];
+  for (std::size_t v = 0; v < bound; ++v) start[v + 1] += start[v];
+  std::vector<std::array<int, 2>> sorted(pairs.size());
+  {
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (const auto& e : pairs) sorted[next[e[0]]++] = e;
+  }
+  pairs.clear();
+  for (std::size_t v = 0; v < bound; ++v) {
+    const auto first = sorted.begin() + start[v], last = sorted.begin() + start[v + 1];
+    for (auto i = first; i != last; ++i)  // insertion sort: a few per value
+      for (auto j = i; j != first && (*j)[1] < (*(j - 1))[1]; --j) std::iter_swap(j, j - 1);
+    for (auto i = first; i != last; ++i)
+      if (i == first || (*i)[1] != (*(i - 1))[1]) pairs.push_back(*i);
+  }
+}
+
 // Barycentric coordinates of p in triangle (a, b, c), from the rounded values.
 Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Point3& c) {
   const Point3 n = (b - a) ^ (c - a);
@@ -624,8 +654,7 @@ class MeshSplitter {
         curves.push_back(
             {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
-    std::sort(curves.begin(), curves.end());
-    curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
+    sortUnique(curves, out.vertices());
     if (smallestSine < 2)  // one angle computed, not one per face
       smallestAngle_ = meshmend::smallestAngle(smallestFace[0], smallestFace[1], smallestFace[2]);
     // Later entries win, as each curve point is met again in every face it is in.
@@ -1573,8 +1602,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
           const int a = weldedTo[curveIndex[m][e[0]]], b = weldedTo[curveIndex[m][e[1]]];
           curves.push_back({std::min(a, b), std::max(a, b)});
         }
-      std::sort(curves.begin(), curves.end());
-      curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
+      sortUnique(curves, curvePoints.size());
       r.curve_edges_welded = curves.size();
       countCurves(curvePoints.size(), curves, r.curve_loops, r.open_curves);
       finishSeparate();
@@ -1624,8 +1652,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         curves.push_back(
             {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
-    std::sort(curves.begin(), curves.end());
-    curves.erase(std::unique(curves.begin(), curves.end()), curves.end());
+    sortUnique(curves, positions.size());
     // The quality of the new faces: their smallest angle, and the slivers.
     auto slivers = [&] {
       std::size_t n = 0;
