@@ -1,4 +1,5 @@
 #include "common/box_tree.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 
 #include <algorithm>
@@ -178,8 +179,8 @@ bool HashedBoxGrid::suits(const std::vector<Box>& queries) const {
   return wide * boxes_.size() <= 64 * queries.size();
 }
 
-BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
-    : boxes_(std::move(boxes)), order_(boxes_.size()) {
+BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes)) {
+  resizeInHugePages(order_, boxes_.size());
   std::iota(order_.begin(), order_.end(), 0u);
   if (boxes_.empty()) return;
   if (layout == Layout::kMorton) {
@@ -187,7 +188,7 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout)
     buildParallel(false);
     return;
   }
-  centres_.resize(boxes_.size());
+  resizeInHugePages(centres_, boxes_.size());
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
     const Box& b = boxes_[i];
     centres_[i] = {{b.lo[0] + b.hi[0], b.lo[1] + b.hi[1], b.lo[2] + b.hi[2]}, std::uint32_t(i)};
@@ -208,7 +209,10 @@ void BoxTree::buildParallel(bool splitByMedian) {
     else
       buildInOrder(b, e, out);
   };
+  // Leaves hold two to four boxes, so a tree over m boxes has fewer than m
+  // nodes: each part's room is made once.
   if (n < 20000) {
+    reserveInHugePages(nodes_, n);
     one(0, n, nodes_);
     return;
   }
@@ -232,10 +236,12 @@ void BoxTree::buildParallel(bool splitByMedian) {
         [axis](const Centre& x, const Centre& y) { return x.sum[axis] < y.sum[axis]; });
   }
   std::vector<Node> left, right;
+  reserveInHugePages(left, mid);
+  reserveInHugePages(right, n - mid);
   TaskAlongside worker([&] { one(0, mid, left); });
   one(mid, n, right);
   worker.wait();
-  nodes_.reserve(1 + left.size() + right.size());
+  reserveInHugePages(nodes_, 1 + left.size() + right.size());
   nodes_.push_back({all, 1, std::uint32_t(1 + left.size())});
   auto append = [&](const std::vector<Node>& part) {
     const std::uint32_t offset = std::uint32_t(nodes_.size());

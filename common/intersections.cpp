@@ -10,6 +10,7 @@
 
 #include "common/box_tree.h"
 #include "common/errors.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 #include "common/predicates.h"
 
@@ -34,8 +35,9 @@ struct Soup {
   std::vector<char> degenerate;
   bool degenerateKnown = false;
   Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
-  // Only for the search within the mesh (`withTree`): every face's box and
-  // the filter of its exact plane sides (side()).
+  // Only for the search within the mesh (`withTree`): every face's box
+  // (moved into the mesh's tree) and the filter of its exact plane sides
+  // (side()).
   std::vector<Box> boxes;
   std::vector<PlaneFilter> planes;
 
@@ -49,17 +51,18 @@ struct Soup {
         hi[k] = std::max(hi[k], p[k]);
       }
     if (!points.empty()) bounds = boxOf(lo, hi, hi);
-    degenerate.resize(triangles.size());
+    resizeInHugePages(degenerate, triangles.size());
     degenerateKnown = withTree;
     if (!withTree) return;
     // Each point rounded to float once (about six faces share it), then
     // each face's box from its corners'.
-    std::vector<Box> pointBoxes(points.size());
+    std::vector<Box> pointBoxes;
+    resizeInHugePages(pointBoxes, points.size());
     parallelChunks(points.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t v = begin; v < end; ++v) pointBoxes[v] = boxOf(points[v]);
     });
-    boxes.resize(triangles.size());
-    planes.resize(triangles.size());
+    resizeInHugePages(boxes, triangles.size());
+    resizeInHugePages(planes, triangles.size());
     parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
@@ -116,7 +119,12 @@ Candidates facesTouching(Soup& s, const Box& other) {
   parallelChunks(
       s.triangles.size(),
       [&](std::size_t begin, std::size_t end, unsigned worker) {
+        // Room for every face of the chunk (only what is written becomes
+        // memory); the first chunk's for all, as the others join it.
         Candidates& c = parts[worker];
+        const std::size_t room = worker == 0 ? s.triangles.size() : end - begin;
+        reserveInHugePages(c.faces, room);
+        reserveInHugePages(c.boxes, room);
         for (std::size_t f = begin; f < end; ++f) {
           const Triangle& t = s.triangles[f];
           if (beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) continue;
@@ -244,8 +252,9 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   if (options.self) {
     trees.reserve(n);
     for (std::size_t m = 0; m < n; ++m)
-      trees.emplace_back(soups[m].boxes, options.layout == 1 ? BoxTree::Layout::kMorton
-                                                             : BoxTree::Layout::kMedianSplit);
+      trees.emplace_back(std::move(soups[m].boxes), options.layout == 1
+                                                        ? BoxTree::Layout::kMorton
+                                                        : BoxTree::Layout::kMedianSplit);
   }
   r.build_ms = msSince(buildStart);
 

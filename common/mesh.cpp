@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "common/errors.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 
 namespace meshmend {
@@ -75,6 +76,8 @@ void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
   requireIndicesInRange(positions, triangles);
   mesh.Clear();
   mesh.ClearAttributes();
+  reserveInHugePages(mesh.vert, positions.size());
+  reserveInHugePages(mesh.face, triangles.size());
   auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i, ++vi) vi->P() = positions[i];
   auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
@@ -117,10 +120,16 @@ MeshBuilder::MeshBuilder(Mesh& mesh, const std::vector<Point3>& positions,
   requireIndicesInRange(positions, triangles);
   mesh.Clear();
   mesh.ClearAttributes();
+  // Room for every element first, in huge pages, so that the attributes
+  // (which reserve the elements' capacity) are made there too.
+  reserveInHugePages(mesh.vert, positions.size());
+  reserveInHugePages(mesh.face, triangles.size());
   // The attributes now, while the mesh is empty: adding one edits state
   // that vertex and face attributes share (vcglib's attribute counter).
   vo_ = vertexOrigins(mesh);
   fo_ = faceOrigins(mesh);
+  adviseHugePages(vo_._handle->data.data(), vo_._handle->data.capacity() * sizeof(VertexOrigin));
+  adviseHugePages(fo_._handle->data.data(), fo_._handle->data.capacity() * sizeof(FaceOrigin));
 }
 
 // vcglib's Allocator::AddVertices and AddFaces each resize the elements and
@@ -196,7 +205,8 @@ WeldedArrays weldCoincident(const MeshArrays& in) {
   std::size_t capacity = 16;
   while (capacity < 2 * points.size()) capacity *= 2;
   constexpr std::uint64_t kEmpty = ~std::uint64_t(0), kIndex = 0xFFFFFFFFu;
-  std::vector<std::uint64_t> table(capacity, kEmpty);  // (hash & ~kIndex) | vertex
+  std::vector<std::uint64_t> table;  // (hash & ~kIndex) | vertex
+  assignInHugePages(table, capacity, kEmpty);
   auto hash = [](const Point3& p) {
     std::uint64_t h = 0;
     for (int k = 0; k < 3; ++k) {
@@ -208,7 +218,8 @@ WeldedArrays weldCoincident(const MeshArrays& in) {
     }
     return h;
   };
-  std::vector<int> target(points.size());
+  std::vector<int> target;
+  resizeInHugePages(target, points.size());
   WeldedArrays w;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::uint64_t h = hash(points[i]), tag = h & ~kIndex;
@@ -227,12 +238,13 @@ WeldedArrays weldCoincident(const MeshArrays& in) {
       }
     }
   }
-  w.mesh.points.reserve(points.size() - w.vertices_merged);
-  w.vertex_origin.reserve(points.size() - w.vertices_merged);
-  w.mesh.triangles.reserve(in.triangles.size());
-  w.face_origin.reserve(in.triangles.size());
+  reserveInHugePages(w.mesh.points, points.size() - w.vertices_merged);
+  reserveInHugePages(w.vertex_origin, points.size() - w.vertices_merged);
+  reserveInHugePages(w.mesh.triangles, in.triangles.size());
+  reserveInHugePages(w.face_origin, in.triangles.size());
   // Keep every vertex that is not a merged duplicate; renumber.
-  std::vector<int> index(points.size(), -1);
+  std::vector<int> index;
+  assignInHugePages(index, points.size(), -1);
   for (std::size_t v = 0; v < points.size(); ++v)
     if (target[v] == int(v)) {
       index[v] = int(w.mesh.points.size());
@@ -277,7 +289,8 @@ Mesh appended(const Mesh& a, const Mesh& b) {
 // Both copy in chunks on the helper threads: a large mesh's copy is the
 // first stage of an operation, and would leave the other cores idle.
 std::vector<Point3> positionsOf(const Mesh& mesh) {
-  std::vector<Point3> out(mesh.vert.size());  // vcglib's Point3 leaves itself uninitialized
+  std::vector<Point3> out;
+  resizeInHugePages(out, mesh.vert.size());  // vcglib's Point3 leaves itself uninitialized
   parallelChunks(
       out.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
@@ -288,7 +301,8 @@ std::vector<Point3> positionsOf(const Mesh& mesh) {
 }
 
 std::vector<Triangle> trianglesOf(const Mesh& mesh) {
-  std::vector<Triangle> out(mesh.face.size());
+  std::vector<Triangle> out;
+  resizeInHugePages(out, mesh.face.size());
   const Vertex* first = mesh.vert.data();
   parallelChunks(
       out.size(),

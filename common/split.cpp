@@ -18,6 +18,7 @@
 #include "common/box_tree.h"
 #include "common/errors.h"
 #include "common/exact_point.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 #include "common/predicates.h"
 #include "common/retriangulate.h"
@@ -271,15 +272,15 @@ class ArraysOutput {
   // push_back each).
   void begin(const std::vector<Point3>& points, int layer, const std::vector<int>& pointOrigins,
              std::size_t keptFaces, std::size_t vertices, std::size_t faces) {
-    out_.positions.reserve(vertices);
+    reserveInHugePages(out_.positions, vertices);
     out_.positions.assign(points.begin(), points.end());
-    out_.vertex_origin.reserve(vertices);
+    reserveInHugePages(out_.vertex_origin, vertices);
     out_.vertex_origin.resize(points.size());
     for (std::size_t v = 0; v < points.size(); ++v)
       out_.vertex_origin[v] = inputOrigin(layer, pointOrigins[v]);
-    out_.triangles.reserve(faces);
+    reserveInHugePages(out_.triangles, faces);
     out_.triangles.resize(keptFaces);
-    out_.face_origin.reserve(faces);
+    reserveInHugePages(out_.face_origin, faces);
     out_.face_origin.resize(keptFaces);
   }
   void keptFace(std::size_t k, const Triangle& t, const FaceOrigin& origin) {
@@ -315,15 +316,15 @@ class MeshOutput {
     mesh_.ClearAttributes();
     vo_ = vertexOrigins(mesh_);
     fo_ = faceOrigins(mesh_);
-    mesh_.vert.reserve(vertices);
+    reserveInHugePages(mesh_.vert, vertices);
     mesh_.vert.resize(points.size());
     for (std::size_t v = 0; v < points.size(); ++v) mesh_.vert[v].P() = points[v];
-    vo_._handle->data.reserve(vertices);
+    reserveInHugePages(vo_._handle->data, vertices);
     vo_._handle->data.resize(points.size());
     for (std::size_t v = 0; v < points.size(); ++v) vo_[v] = inputOrigin(layer, pointOrigins[v]);
-    mesh_.face.reserve(faces);
+    reserveInHugePages(mesh_.face, faces);
     mesh_.face.resize(keptFaces);
-    fo_._handle->data.reserve(faces);
+    reserveInHugePages(fo_._handle->data, faces);
     fo_._handle->data.resize(keptFaces);
   }
   void keptFace(std::size_t k, const Triangle& t, const FaceOrigin& origin) {
@@ -1618,10 +1619,10 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       std::size_t vertices = 0, faces = 0;
       for (const OutputArrays& mesh : outputs)
         vertices += mesh.positions.size(), faces += mesh.triangles.size();
-      positions.reserve(vertices);
-      merged.vertex_origin.reserve(vertices);
-      merged.triangles.reserve(faces);
-      merged.face_origin.reserve(faces);
+      reserveInHugePages(positions, vertices);
+      reserveInHugePages(merged.vertex_origin, vertices);
+      reserveInHugePages(merged.triangles, faces);
+      reserveInHugePages(merged.face_origin, faces);
       r.merged_new_face.reserve(faces);
     }
     std::vector<std::array<int, 2>>& curves = r.merged_curve_edges;  // sorted, each once
