@@ -1,6 +1,7 @@
 #include "plugins/bridge/mesh_bridge.h"
 
 #include "common/errors.h"
+#include "common/huge_pages.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,9 +21,10 @@ Mesh toCore(const CMeshO& cm, const ToCoreOptions& options) {
 void toCore(const CMeshO& cm, Mesh& mesh, const ToCoreOptions& options) {
   std::vector<Point3> positions;
   std::vector<int> vertexSlot;  // core vertex -> index in cm.vert
-  std::vector<int> coreIndex(cm.vert.size(), -1);
-  positions.reserve(cm.vn);
-  vertexSlot.reserve(cm.vn);
+  std::vector<int> coreIndex;
+  assignInHugePages(coreIndex, cm.vert.size(), -1);
+  reserveInHugePages(positions, std::size_t(cm.vn));
+  reserveInHugePages(vertexSlot, std::size_t(cm.vn));
   const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
   for (std::size_t i = 0; i < cm.vert.size(); ++i) {
     if (cm.vert[i].IsD()) continue;
@@ -34,8 +36,8 @@ void toCore(const CMeshO& cm, Mesh& mesh, const ToCoreOptions& options) {
   }
   std::vector<Triangle> triangles;
   std::vector<int> faceSlot;
-  triangles.reserve(cm.fn);
-  faceSlot.reserve(cm.fn);
+  reserveInHugePages(triangles, std::size_t(cm.fn));
+  reserveInHugePages(faceSlot, std::size_t(cm.fn));
   for (std::size_t f = 0; f < cm.face.size(); ++f) {
     const CFaceO& face = cm.face[f];
     if (face.IsD()) continue;
@@ -71,12 +73,12 @@ LayerAttributes snapshot(const MeshModel& model) {
   a.face_quality = model.hasDataMask(MeshModel::MM_FACEQUALITY);
   a.wedge_texcoord = model.hasDataMask(MeshModel::MM_WEDGTEXCOORD);
   const std::size_t nv = cm.vert.size(), nf = cm.face.size();
-  a.positions.resize(nv);
-  a.vertex_normals.resize(nv);
+  resizeInHugePages(a.positions, nv);
+  resizeInHugePages(a.vertex_normals, nv);
   a.vertex_selected.resize(nv);
-  if (a.vertex_color) a.vertex_colors.resize(nv);
-  if (a.vertex_quality) a.vertex_qualities.resize(nv);
-  if (a.vertex_texcoord) a.vertex_texcoords.resize(nv);
+  if (a.vertex_color) resizeInHugePages(a.vertex_colors, nv);
+  if (a.vertex_quality) resizeInHugePages(a.vertex_qualities, nv);
+  if (a.vertex_texcoord) resizeInHugePages(a.vertex_texcoords, nv);
   for (std::size_t i = 0; i < nv; ++i) {
     const CVertexO& v = cm.vert[i];
     a.positions[i] = vcg::Point3d::Construct(v.cP());
@@ -86,11 +88,11 @@ LayerAttributes snapshot(const MeshModel& model) {
     if (a.vertex_quality) a.vertex_qualities[i] = v.cQ();
     if (a.vertex_texcoord) a.vertex_texcoords[i] = v.cT();
   }
-  a.faces.resize(nf);
+  resizeInHugePages(a.faces, nf);
   a.face_selected.resize(nf);
-  if (a.face_color) a.face_colors.resize(nf);
-  if (a.face_quality) a.face_qualities.resize(nf);
-  if (a.wedge_texcoord) a.wedge_texcoords.resize(nf);
+  if (a.face_color) resizeInHugePages(a.face_colors, nf);
+  if (a.face_quality) resizeInHugePages(a.face_qualities, nf);
+  if (a.wedge_texcoord) resizeInHugePages(a.wedge_texcoords, nf);
   for (std::size_t f = 0; f < nf; ++f) {
     const CFaceO& face = cm.face[f];
     if (face.IsD()) continue;
@@ -188,6 +190,11 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
     return layer >= 0 && layer < int(inputs.size()) ? &inputs[layer] : none;
   };
 
+  // The host's arrays too: its elements are large (a face is some hundred
+  // bytes), and a million of them new memory. Reserved on the empty mesh,
+  // where adding them moves nothing.
+  reserveInHugePages(cm.vert, core.vert.size());
+  reserveInHugePages(cm.face, core.face.size());
   auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(cm, core.vert.size());
   for (std::size_t i = 0; i < core.vert.size(); ++i, ++vi) {
     vi->P() = HostPoint::Construct(core.vert[i].cP());
