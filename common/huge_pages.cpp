@@ -9,7 +9,7 @@ namespace meshmend {
 void adviseHugePages(const void* begin, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
   constexpr std::uintptr_t kHugePage = std::uintptr_t(2) << 20;
-  if (bytes < 2 * kHugePage) return;
+  if (bytes < kLargeArrayBytes) return;
   const std::uintptr_t first = (std::uintptr_t(begin) + kHugePage - 1) & ~(kHugePage - 1);
   const std::uintptr_t last = (std::uintptr_t(begin) + bytes) & ~(kHugePage - 1);
   // A hint: a kernel without huge pages refuses it (EINVAL), and the memory

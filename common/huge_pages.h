@@ -19,6 +19,10 @@
 
 namespace meshmend {
 
+// The size from which an array is worth advising (two huge pages, so that
+// at least one lies wholly inside it).
+inline constexpr std::size_t kLargeArrayBytes = std::size_t(4) << 20;
+
 // Asks for huge pages for the 2 MiB pages that lie wholly inside [begin,
 // begin + bytes) (none under 4 MiB). Pages written already keep theirs.
 void adviseHugePages(const void* begin, std::size_t bytes);

@@ -119,12 +119,18 @@ Candidates facesTouching(Soup& s, const Box& other) {
   parallelChunks(
       s.triangles.size(),
       [&](std::size_t begin, std::size_t end, unsigned worker) {
-        // Room for every face of the chunk (only what is written becomes
-        // memory); the first chunk's for all, as the others join it.
+        // A large mesh's chunk makes room for every face at once (the first
+        // chunk's for all, as the others join it): mapped memory, of which
+        // only what is written becomes pages, where growing copied each
+        // array a few times. A small mesh's grow as they fill: room for all
+        // its faces, most of it unused, would take the heap's top, and a
+        // fresh process hands that back to the system after every run.
         Candidates& c = parts[worker];
         const std::size_t room = worker == 0 ? s.triangles.size() : end - begin;
-        reserveInHugePages(c.faces, room);
-        reserveInHugePages(c.boxes, room);
+        if (room * sizeof(Box) >= kLargeArrayBytes) {
+          reserveInHugePages(c.faces, room);
+          reserveInHugePages(c.boxes, room);
+        }
         for (std::size_t f = begin; f < end; ++f) {
           const Triangle& t = s.triangles[f];
           if (beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) continue;
