@@ -122,12 +122,13 @@ Candidates facesTouching(Soup& s, const Box& other) {
         // A large mesh's chunk makes room for every face at once (the first
         // chunk's for all, as the others join it): mapped memory, of which
         // only what is written becomes pages, where growing copied each
-        // array a few times. A small mesh's grow as they fill: room for all
-        // its faces, most of it unused, would take the heap's top, and a
-        // fresh process hands that back to the system after every run.
+        // array a few times into new memory. A small mesh's (under a few
+        // hundred KiB) grow as they fill: room for all its faces, most of it
+        // unused, would take the heap's top, which a fresh process hands
+        // back to the system after every run.
         Candidates& c = parts[worker];
         const std::size_t room = worker == 0 ? s.triangles.size() : end - begin;
-        if (room * sizeof(Box) >= kLargeArrayBytes) {
+        if (room * sizeof(Box) >= (std::size_t(256) << 10)) {
           reserveInHugePages(c.faces, room);
           reserveInHugePages(c.boxes, room);
         }
