@@ -70,31 +70,39 @@ void requireIndicesInRange(const std::vector<Point3>& positions,
                                 " vertices");
 }
 
-// The vertices and faces of buildMesh, without their origins.
-void buildGeometry(Mesh& mesh, const std::vector<Point3>& positions,
-                   const std::vector<Triangle>& triangles) {
-  requireIndicesInRange(positions, triangles);
+}  // namespace
+
+void startMesh(Mesh& mesh, std::size_t vertices, std::size_t faces, VertexOriginHandle& vo,
+               FaceOriginHandle& fo) {
   mesh.Clear();
   mesh.ClearAttributes();
-  reserveInHugePages(mesh.vert, positions.size());
-  reserveInHugePages(mesh.face, triangles.size());
-  auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
-  for (std::size_t i = 0; i < positions.size(); ++i, ++vi) vi->P() = positions[i];
-  auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
-  for (std::size_t f = 0; f < triangles.size(); ++f, ++fi)
-    for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[triangles[f][k]];
+  reserveInHugePages(mesh.vert, vertices);
+  reserveInHugePages(mesh.face, faces);
+  // The attributes once the room is made (each reserves its elements'
+  // capacity), and while the mesh is empty: adding one edits state that
+  // vertex and face attributes share (vcglib's attribute counter).
+  vo = vertexOrigins(mesh);
+  fo = faceOrigins(mesh);
+  adviseHugePages(vo._handle->data.data(), vo._handle->data.capacity() * sizeof(VertexOrigin));
+  adviseHugePages(fo._handle->data.data(), fo._handle->data.capacity() * sizeof(FaceOrigin));
 }
-
-}  // namespace
 
 void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<Triangle>& triangles, int layer) {
-  buildGeometry(mesh, positions, triangles);
-  VertexOriginHandle vo = vertexOrigins(mesh);
-  for (std::size_t i = 0; i < mesh.vert.size(); ++i)
+  requireIndicesInRange(positions, triangles);
+  VertexOriginHandle vo;
+  FaceOriginHandle fo;
+  startMesh(mesh, positions.size(), triangles.size(), vo, fo);
+  auto vi = vcg::tri::Allocator<Mesh>::AddVertices(mesh, positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i, ++vi) {
+    vi->P() = positions[i];
     vo[i] = VertexOrigin{layer, int(i), -1, {0, 0, 0}};
-  FaceOriginHandle fo = faceOrigins(mesh);
-  for (std::size_t f = 0; f < mesh.face.size(); ++f) fo[f] = FaceOrigin{layer, int(f)};
+  }
+  auto fi = vcg::tri::Allocator<Mesh>::AddFaces(mesh, triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f, ++fi) {
+    for (int k = 0; k < 3; ++k) fi->V(k) = &mesh.vert[triangles[f][k]];
+    fo[f] = FaceOrigin{layer, int(f)};
+  }
 }
 
 void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
@@ -118,18 +126,7 @@ MeshBuilder::MeshBuilder(Mesh& mesh, const std::vector<Point3>& positions,
   if (vertexOrigin.size() != positions.size() || faceOrigin.size() != triangles.size())
     throw std::invalid_argument("buildMesh: one origin per vertex and per face");
   requireIndicesInRange(positions, triangles);
-  mesh.Clear();
-  mesh.ClearAttributes();
-  // Room for every element first, in huge pages, so that the attributes
-  // (which reserve the elements' capacity) are made there too.
-  reserveInHugePages(mesh.vert, positions.size());
-  reserveInHugePages(mesh.face, triangles.size());
-  // The attributes now, while the mesh is empty: adding one edits state
-  // that vertex and face attributes share (vcglib's attribute counter).
-  vo_ = vertexOrigins(mesh);
-  fo_ = faceOrigins(mesh);
-  adviseHugePages(vo_._handle->data.data(), vo_._handle->data.capacity() * sizeof(VertexOrigin));
-  adviseHugePages(fo_._handle->data.data(), fo_._handle->data.capacity() * sizeof(FaceOrigin));
+  startMesh(mesh, positions.size(), triangles.size(), vo_, fo_);
 }
 
 // vcglib's Allocator::AddVertices and AddFaces each resize the elements and

@@ -92,6 +92,13 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<VertexOrigin>& vertexOrigin,
                const std::vector<FaceOrigin>& faceOrigin);
 
+// Clears `mesh`, makes room for `vertices` and `faces` (vcglib's arrays,
+// reserved: adding up to that many moves nothing) and gives it empty origin
+// attributes with the same room, all in huge pages (huge_pages.h): the
+// start of every mesh the core builds.
+void startMesh(Mesh& mesh, std::size_t vertices, std::size_t faces, VertexOriginHandle& vo,
+               FaceOriginHandle& fo);
+
 // That buildMesh in parts that may run on different threads at once. A
 // large mesh's arrays are new memory, whose first touch (a page fault per
 // 4 KiB) costs more than the copy into them: parts on two threads share

@@ -312,19 +312,12 @@ class MeshOutput {
   // array, which must not move.
   void begin(const std::vector<Point3>& points, int layer, const std::vector<int>& pointOrigins,
              std::size_t keptFaces, std::size_t vertices, std::size_t faces) {
-    mesh_.Clear();
-    mesh_.ClearAttributes();
-    vo_ = vertexOrigins(mesh_);
-    fo_ = faceOrigins(mesh_);
-    reserveInHugePages(mesh_.vert, vertices);
+    startMesh(mesh_, vertices, faces, vo_, fo_);
     mesh_.vert.resize(points.size());
     for (std::size_t v = 0; v < points.size(); ++v) mesh_.vert[v].P() = points[v];
-    reserveInHugePages(vo_._handle->data, vertices);
     vo_._handle->data.resize(points.size());
     for (std::size_t v = 0; v < points.size(); ++v) vo_[v] = inputOrigin(layer, pointOrigins[v]);
-    reserveInHugePages(mesh_.face, faces);
     mesh_.face.resize(keptFaces);
-    reserveInHugePages(fo_._handle->data, faces);
     fo_._handle->data.resize(keptFaces);
   }
   void keptFace(std::size_t k, const Triangle& t, const FaceOrigin& origin) {
