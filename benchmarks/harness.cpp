@@ -22,8 +22,8 @@ rusage usage() {
 }
 
 double maxRssMb() {
-  return double(usage().ru_maxrss) / 1024.0;
-}  // Linux: kilobytes
+  return double(usage().ru_maxrss) / 1024.0;  // Linux: kilobytes
+}
 
 long minorFaults() {
   return usage().ru_minflt;

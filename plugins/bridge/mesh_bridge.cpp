@@ -192,7 +192,8 @@ void writeMesh(const Mesh& core, const std::vector<LayerAttributes>& inputs, Mes
 
   // The host's arrays too: its elements are large (a face is some hundred
   // bytes), and a million of them new memory. Reserved on the empty mesh,
-  // where adding them moves nothing.
+  // where adding them moves nothing; the optional components' arrays
+  // (vector_ocf's own) are sized as the elements are added.
   reserveInHugePages(cm.vert, core.vert.size());
   reserveInHugePages(cm.face, core.face.size());
   auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(cm, core.vert.size());
