@@ -321,6 +321,35 @@ int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint
   return sgn(orient3dValue(a, b, c, d));
 }
 
+int inCircle(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+             const RationalPoint& d) {
+  // The planar in-circle determinant (rows b-a, c-a, d-a with their squared
+  // lengths) in an orthonormal frame of the plane, times |n| > 0 with
+  // n = (b-a) x (c-a): each 2-D cross product u x v there is (u x v) . n / |n|.
+  using V = std::array<mpq_class, 3>;
+  // (Explicit return types: gmpxx's expression templates would otherwise
+  // outlive the temporaries they refer to.)
+  auto minus = [](const RationalPoint& p, const RationalPoint& q) -> V {
+    return V{p.x[0] - q.x[0], p.x[1] - q.x[1], p.x[2] - q.x[2]};
+  };
+  auto cross = [](const V& u, const V& v) -> V {
+    return V{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  };
+  auto dot = [](const V& u, const V& v) -> mpq_class {
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  };
+  const V B = minus(b, a), C = minus(c, a), D = minus(d, a), n = cross(B, C);
+  const mpq_class v =
+      dot(B, B) * dot(cross(C, D), n) - dot(C, C) * dot(cross(B, D), n) + dot(D, D) * dot(n, n);
+  return -sgn(v);  // negative inside (a, b, c counter-clockwise about n)
+}
+
+int compareLexicographic(const ExactPoint& a, const ExactPoint& b) {
+  for (int k = 0; k < 3; ++k)
+    if (const int c = compareCoordinate(a, b, k)) return c;
+  return 0;
+}
+
 std::vector<int> coincidentGroups(const std::vector<const ExactPoint*>& points) {
   const std::size_t n = points.size();
   std::vector<int> parent(n);

@@ -127,6 +127,15 @@ RationalPoint along(const RationalPoint& p, const RationalPoint& q, const mpq_cl
 int orient3d(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
              const RationalPoint& d);
 
+// For coplanar a, b, c, d (a, b, c not collinear): +1 when d lies strictly
+// inside the circle through a, b and c, 0 on it, -1 outside. In the plane
+// itself, so independent of any projection and of the order of a, b, c.
+int inCircle(const RationalPoint& a, const RationalPoint& b, const RationalPoint& c,
+             const RationalPoint& d);
+
+// Sign of a - b in lexicographic order of the coordinates (x, then y, z).
+int compareLexicographic(const ExactPoint& a, const ExactPoint& b);
+
 // The double nearest to each coordinate.
 Point3 nearestDoubles(const RationalPoint& p);
 

@@ -16,6 +16,29 @@ Edge key(int a, int b) {
   return a < b ? Edge{a, b} : Edge{b, a};
 }
 
+// Compares two smallestAngleMeasures of triangles on the four points
+// `quad` (the two ways to split a quadrilateral): +1 when `after` is
+// certainly the larger, -1 when certainly the smaller, 0 when the rounded
+// positions cannot tell (the four points on one circle, or nearly: grids,
+// regular polygons, CAD faces). The measure's error is bounded from the
+// points' error boxes: moving a corner by d turns an angle by at most
+// d / (the shortest side), and the measure (a squared sine) by at most twice that.
+int compareMeasures(double before, double after, const std::array<const ExactPoint*, 4>& quad) {
+  const double difference = after - before, scale = std::max(after, before);
+  if (std::abs(difference) > 1e-3 * scale) return difference > 0 ? 1 : -1;  // far from a tie
+  double error = 0, reach = 0, shortest = INFINITY;
+  for (int i = 0; i < 4; ++i) {
+    const Point3& a = quad[i]->approx();
+    error = std::max(error, quad[i]->error());
+    reach = std::max({reach, std::abs(a[0]), std::abs(a[1]), std::abs(a[2])});
+    for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (quad[j]->approx() - a).Norm());
+  }
+  error += reach * 1e-15;  // the rounding of the differences the measure takes
+  const double bound = 1e-12 * scale + 16 * error / shortest;
+  if (std::abs(difference) > bound) return difference > 0 ? 1 : -1;
+  return 0;
+}
+
 // One re-triangulation at a time; its storage is kept for the next patch
 // (retriangulate() holds one per thread), so that a patch in steady state
 // allocates only its output.
@@ -510,12 +533,10 @@ class Retriangulator {
           const int p = T_[t][(i + 2) % 3], q = T_[other][(j + 2) % 3];
           // (u, w, p) and (w, u, q) are the triangles; the flip makes
           // (p, q, w) and (q, p, u), if their quadrilateral is strictly convex.
-          // Better when both new triangles are (the second is not needed
-          // when the first is not).
-          const double needed = std::min(quality_[t], quality_[other]) * (1 + 1e-9);
-          const double first = minAngle(p, q, w);
-          const double second = first > needed ? minAngle(q, p, u) : 0;
-          if (second > needed && orient(p, q, w) > 0 && orient(q, p, u) > 0) {
+          const double first = minAngle(p, q, w), second = minAngle(q, p, u);
+          if (flipImproves(u, w, p, q, std::min(quality_[t], quality_[other]),
+                           std::min(first, second)) &&
+              orient(p, q, w) > 0 && orient(q, p, u) > 0) {
             flip(t, i, other, j);
             quality_[t] = first;
             quality_[other] = second;
@@ -526,6 +547,25 @@ class Retriangulator {
         }
       if (!changed) return;
     }
+  }
+
+  // Does flipping edge (u, w) of triangles (u, w, p) and (w, u, q) to (p, q)
+  // raise their smallest angle (from `before` to `after`, as measured)? Where
+  // the measures cannot tell, the exact in-circle test does, and with the
+  // four points on one circle the diagonal through the lexicographically
+  // smallest of them is kept. Every answer is thus that of one triangulation
+  // (Delaunay, its ties broken by a fixed perturbation), whatever the
+  // triangulation the flips start from: faces of two meshes that overlap in
+  // a plane re-triangulate their overlap alike, into the same faces.
+  bool flipImproves(int u, int w, int p, int q, double before, double after) const {
+    if (const int c = compareMeasures(before, after, {&V_[u], &V_[w], &V_[p], &V_[q]}))
+      return c > 0;
+    if (const int in = inCircle(V_[u].exact(), V_[w].exact(), V_[p].exact(), V_[q].exact()))
+      return in > 0;
+    int smallest = u;
+    for (int x : {w, p, q})
+      if (compareLexicographic(V_[x], V_[smallest]) < 0) smallest = x;
+    return smallest == p || smallest == q;
   }
 
   // Flips the edge between side i of t1 and side j of t2 (see improve),
@@ -644,24 +684,25 @@ bool cutCorner(const PatchInput& in, Patch& out) {
   const int k = (e0 + 1) % 3 == e1 ? e0 : e1;
   const int p = k == e0 ? 3 : 4, q = 7 - p;
   const int a = k, c = (k + 1) % 3, b = (k + 2) % 3;
-  out.vertices = {in.corners[0], in.corners[1], in.corners[2], in.points[0], in.points[1]};
-  out.vertex_of_input = {0, 1, 2, 3, 4};
-  // The diagonal the general path ends with: inserting the points in their
-  // order makes p-b when p comes first (a-q otherwise), and a flip needs a
-  // gain of more than 1e-9 in the measure taken from the smallest index on.
+  auto at = [&](int i) -> const ExactPoint& { return i < 3 ? in.corners[i] : in.points[i - 3]; };
+  // The diagonal the general path's flips end with: the one with the larger
+  // smallest angle, where the measures tell (otherwise the general path
+  // decides, exactly).
   auto measure = [&](int x, int y, int z) {
     if (y < x && y < z)
       std::swap(x, y), std::swap(y, z);
     else if (z < x && z < y)
       std::swap(x, z), std::swap(y, z);
-    return smallestAngleMeasure(out.vertices[x].approx(), out.vertices[y].approx(),
-                                out.vertices[z].approx());
+    return smallestAngleMeasure(at(x).approx(), at(y).approx(), at(z).approx());
   };
   const double throughB = std::min(measure(a, p, b), measure(p, q, b));  // diagonal p-b
   const double throughA = std::min(measure(a, p, q), measure(a, q, b));  // diagonal a-q
-  const bool viaB = p == 3 ? !(throughA > throughB * (1 + 1e-9)) : throughB > throughA * (1 + 1e-9);
+  const int viaB = compareMeasures(throughA, throughB, {&at(a), &at(b), &at(p), &at(q)});
+  if (viaB == 0) return false;
+  out.vertices = {in.corners[0], in.corners[1], in.corners[2], in.points[0], in.points[1]};
+  out.vertex_of_input = {0, 1, 2, 3, 4};
   out.triangles = {{p, c, q}};
-  if (viaB)
+  if (viaB > 0)
     out.triangles.insert(out.triangles.end(), {{a, p, b}, {p, q, b}});
   else
     out.triangles.insert(out.triangles.end(), {{a, p, q}, {a, q, b}});

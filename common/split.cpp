@@ -252,6 +252,69 @@ struct OutputArrays {
   }
 };
 
+// Where meshes (or one mesh and itself) overlap in a plane, the contact
+// inserts the edges of each side into the other, so both re-triangulate the
+// overlap alike and, welded, their faces there coincide: the same three
+// vertices twice (either orientation). This keeps each such face once in
+// `merged` (the intersection paper's result is free of duplicate geometry)
+// and returns how many it removed. Only faces whose corners are all curve
+// vertices (`onCurve`) can have a twin: other vertices belong to one mesh.
+// A curve edge inside an overlap (all its faces were twins) is then an
+// ordinary edge of the one surface left there and leaves `curves` (sorted):
+// the overlap's outline stays.
+std::size_t keepOverlapsOnce(OutputArrays& merged, std::vector<char>& newFace,
+                             const std::vector<char>& onCurve,
+                             std::vector<std::array<int, 2>>& curves) {
+  std::vector<std::pair<Triangle, std::uint32_t>> corners;  // sorted corners, face
+  for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
+    Triangle t = merged.triangles[f];
+    if (!onCurve[t[0]] || !onCurve[t[1]] || !onCurve[t[2]]) continue;
+    std::sort(t.begin(), t.end());
+    corners.push_back({t, std::uint32_t(f)});
+  }
+  std::sort(corners.begin(), corners.end());
+  enum : char { kSingle, kTwinKept, kTwinRemoved };
+  std::vector<char> twin(merged.triangles.size(), kSingle);
+  std::size_t removed = 0;
+  for (std::size_t k = 1, first = 0; k < corners.size(); ++k) {
+    if (corners[k].first != corners[first].first) {
+      first = k;
+      continue;
+    }
+    twin[corners[first].second] = kTwinKept;
+    twin[corners[k].second] = kTwinRemoved;
+    ++removed;
+  }
+  if (removed == 0) return 0;
+  // Per curve edge: does a face that had no twin use it?
+  std::vector<char> outline(curves.size(), 0);
+  for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
+    const Triangle& t = merged.triangles[f];
+    if (twin[f] != kSingle || int(onCurve[t[0]]) + onCurve[t[1]] + onCurve[t[2]] < 2) continue;
+    for (int i = 0; i < 3; ++i) {
+      const std::array<int, 2> e = {std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])};
+      const auto at = std::lower_bound(curves.begin(), curves.end(), e);
+      if (at != curves.end() && *at == e) outline[at - curves.begin()] = 1;
+    }
+  }
+  std::size_t keptEdges = 0;
+  for (std::size_t k = 0; k < curves.size(); ++k)
+    if (outline[k]) curves[keptEdges++] = curves[k];
+  curves.resize(keptEdges);
+  std::size_t kept = 0;
+  for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
+    if (twin[f] == kTwinRemoved) continue;
+    merged.triangles[kept] = merged.triangles[f];
+    merged.face_origin[kept] = merged.face_origin[f];
+    newFace[kept] = newFace[f];
+    ++kept;
+  }
+  merged.triangles.resize(kept);
+  merged.face_origin.resize(kept);
+  newFace.resize(kept);
+  return removed;
+}
+
 // The origin of the output vertex that is input vertex `vertex` of `layer`.
 VertexOrigin inputOrigin(int layer, int vertex) {
   return {layer, vertex, -1, Point3(0, 0, 0)};  // (vcg leaves Point3{} unset)
@@ -1276,8 +1339,11 @@ std::size_t removeDuplicateFaces(WeldedArrays& in) {
 // Closed and open components of a curve graph.
 void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& edges,
                  std::size_t& loops, std::size_t& open) {
-  // Components of the curve graph (union-find with path halving); one is a
-  // loop when each of its vertices has even degree.
+  // Components of the curve graph (union-find with path halving); one is
+  // open when it has an end point (a vertex of one curve edge). Curves may
+  // branch without ending (three surfaces through one point, the outline of
+  // a planar overlap meeting a crossing): a component is closed when none
+  // of its vertices ends a curve.
   std::vector<int> parent(vertices), degree(vertices, 0);
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int x) {
@@ -1288,18 +1354,18 @@ void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& ed
     ++degree[e[0]], ++degree[e[1]];
     parent[find(e[0])] = find(e[1]);
   }
-  enum : std::uint8_t { kNone, kEven, kOdd };  // per component root: its vertices' degrees
+  enum : std::uint8_t { kNone, kClosed, kOpen };  // per component root
   std::vector<std::uint8_t> component(vertices, kNone);
   for (std::size_t v = 0; v < vertices; ++v) {
     if (degree[v] == 0) continue;
     std::uint8_t& c = component[find(int(v))];
-    if (degree[v] % 2)
-      c = kOdd;
+    if (degree[v] == 1)
+      c = kOpen;
     else if (c == kNone)
-      c = kEven;
+      c = kClosed;
   }
-  loops = std::size_t(std::count(component.begin(), component.end(), kEven));
-  open = std::size_t(std::count(component.begin(), component.end(), kOdd));
+  loops = std::size_t(std::count(component.begin(), component.end(), kClosed));
+  open = std::size_t(std::count(component.begin(), component.end(), kOpen));
 }
 
 }  // namespace
@@ -1619,6 +1685,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       r.merged_new_face.reserve(faces);
     }
     std::vector<std::array<int, 2>>& curves = r.merged_curve_edges;  // sorted, each once
+    std::vector<char> onCurve;                                       // per merged vertex
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const OutputArrays& mesh = outputs[m];
       std::vector<int>& global = r.merged_vertex.emplace_back(mesh.positions.size());
@@ -1635,6 +1702,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
         global[v] = int(positions.size());
         positions.push_back(mesh.positions[v]);
         merged.vertex_origin.push_back(mesh.vertex_origin[v]);
+        onCurve.push_back(c >= 0);
       }
       for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
         const Triangle& t = mesh.triangles[f];
@@ -1647,6 +1715,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
             {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
     sortUnique(curves, positions.size());
+    r.coincident_faces_removed = keepOverlapsOnce(merged, r.merged_new_face, onCurve, curves);
     // The quality of the new faces: their smallest angle, and the slivers.
     auto slivers = [&] {
       std::size_t n = 0;
@@ -1914,6 +1983,7 @@ JsonObject toJson(const SplitResult& r) {
       .set("degenerate_faces_kept", r.degenerate_faces_kept)
       .set("vertices_welded", r.vertices_welded)
       .set("duplicate_faces_removed", r.duplicate_faces_removed)
+      .set("coincident_faces_removed", r.coincident_faces_removed)
       .set("smallest_new_angle_deg", r.faces_split ? r.smallest_new_angle_deg : 0.0)
       .set("smallest_new_angle_deg_unsnapped",
            r.faces_split ? r.smallest_new_angle_deg_unsnapped : 0.0)

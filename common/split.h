@@ -73,6 +73,7 @@ struct SplitResult {
   std::size_t degenerate_faces_kept = 0;           // zero-area faces a curve touches, left unsplit
   std::size_t vertices_welded = 0;                 // duplicates merged first (weld_duplicates)
   std::size_t duplicate_faces_removed = 0;         // remove_duplicate_faces
+  std::size_t coincident_faces_removed = 0;        // merged: twins in planar overlaps, kept once
   double smallest_new_angle_deg = 180;             // smallest angle of a face the split made
   double smallest_new_angle_deg_unsnapped = 180;   // the same before quality snapping
   std::size_t new_faces_below_1deg = 0;            // slivers: new faces with an angle under 1°
@@ -80,7 +81,7 @@ struct SplitResult {
   std::size_t vertices_snapped = 0;                // new vertices merged into input vertices
   std::size_t edges_snapped = 0;                   // input edges split at a new vertex
   std::size_t curve_edges_welded = 0;              // curve edges, each once (as in `merged`)
-  std::size_t curve_loops = 0;                     // closed curve components (merged output)
+  std::size_t curve_loops = 0;                     // curve components without end points
   std::size_t open_curves = 0;                     // curve components with end points
   double time_ms = 0;
 };

@@ -108,6 +108,37 @@ TEST(ExactPoint, Orient2dMatchesRationalArithmetic) {
   }
 }
 
+TEST(ExactPoint, InCircleIsDecidedInThePlaneOfThePoints) {
+  // The unit circle about c in a tilted plane spanned by u and w (orthogonal,
+  // of equal length 3: circles stay circles), with points inside, on and
+  // outside, and the three on the circle given in both orders.
+  const mpq_class half(1, 2);
+  auto at = [](const mpq_class& s, const mpq_class& t) {
+    const mpq_class u[3] = {1, 2, 2}, w[3] = {2, 1, -2}, c[3] = {5, -1, 3};
+    RationalPoint p;
+    for (int k = 0; k < 3; ++k) p.x[k] = c[k] + s * u[k] + t * w[k];
+    return p;
+  };
+  const RationalPoint a = at(1, 0), b = at(0, 1), c = at(-1, 0);
+  EXPECT_EQ(inCircle(a, b, c, at(0, half)), 1);
+  EXPECT_EQ(inCircle(a, b, c, at(0, -1)), 0);
+  EXPECT_EQ(inCircle(a, b, c, at(mpq_class(3, 5), mpq_class(-4, 5))), 0);  // 3-4-5: on it
+  EXPECT_EQ(inCircle(a, b, c, at(1, 1)), -1);
+  EXPECT_EQ(inCircle(c, b, a, at(0, half)), 1);
+  EXPECT_EQ(inCircle(c, b, a, at(1, -1)), -1);
+}
+
+TEST(ExactPoint, LexicographicOrderComparesExactly) {
+  const ExactPoint a(Point3(0, 1, 2)), b(Point3(0, 1, 3)), c(Point3(-1, 5, 5));
+  EXPECT_LT(compareLexicographic(a, b), 0);
+  EXPECT_GT(compareLexicographic(a, c), 0);
+  EXPECT_EQ(compareLexicographic(b, ExactPoint(Point3(0, 1, 3))), 0);
+  // A constructed point that rounds to an input point but is not it.
+  const ExactPoint crossing = ExactPoint::edgePlane(
+      Point3(0, 0, -1), Point3(1e-30, 0, 1), Point3(0, 0, 0), Point3(1, 0, 0), Point3(0, 1, 0));
+  EXPECT_GT(compareLexicographic(crossing, ExactPoint(Point3(0, 0, 0))), 0);
+}
+
 TEST(ExactPoint, CoincidentGroupsMergeExactlyEqualPointsOnly) {
   // The same point three ways, a point one ulp away, and another.
   const ExactPoint a = ExactPoint::edgePlane({0, 0, 0}, {2, 2, 2}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1});

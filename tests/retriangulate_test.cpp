@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -285,6 +286,52 @@ TEST(Retriangulate, SegmentAcrossACornerGivesWhatTheFlipsGive) {
           EXPECT_EQ(triangleSet(fast), triangleSet(general))
               << "edge " << k << " at " << i << "/8 and " << j << "/8, order " << order;
         }
+}
+
+TEST(Retriangulate, PointsOnOneCircleGiveTheSameTrianglesInAnyOrder) {
+  // Twelve points on one circle (integer points at distance 5 about the
+  // origin of a tilted plane, its frame orthogonal and of equal lengths),
+  // their polygon as constraints: inside it every split is a tie. Listed in
+  // any order, the points give the same triangles, as two faces overlapping
+  // in a plane need (each re-triangulates the overlap on its own).
+  const Point3 c(5, -1, 3), u(1, 2, 2), w(2, 1, -2);
+  auto at = [&](double s, double t) { return c + u * s + w * t; };
+  const std::vector<std::array<int, 2>> ring = {{5, 0},   {4, 3},  {3, 4},  {0, 5},
+                                                {-3, 4},  {-4, 3}, {-5, 0}, {-4, -3},
+                                                {-3, -4}, {0, -5}, {3, -4}, {4, -3}};
+  std::vector<int> order(ring.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937 rng(3);
+  std::set<std::vector<std::array<double, 9>>> results;
+  for (int trial = 0; trial < 20; ++trial) {
+    std::shuffle(order.begin(), order.end(), rng);
+    PatchInput in;
+    in.corners = {ExactPoint(at(-20, -20)), ExactPoint(at(40, -20)), ExactPoint(at(-20, 40))};
+    std::vector<int> slot(ring.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      slot[order[i]] = 3 + int(i);
+      in.points.push_back(ExactPoint(at(ring[order[i]][0], ring[order[i]][1])));
+    }
+    for (std::size_t i = 0; i < ring.size(); ++i)
+      in.segments.push_back({slot[i], slot[(i + 1) % ring.size()]});
+    const Patch p = retriangulate(in);
+    std::vector<std::array<double, 9>> triangles;  // by coordinates, each from its smallest corner
+    for (std::array<int, 3> t : p.triangles) {
+      std::rotate(t.begin(),
+                  std::min_element(t.begin(), t.end(),
+                                   [&](int x, int y) {
+                                     return compareLexicographic(p.vertices[x], p.vertices[y]) < 0;
+                                   }),
+                  t.end());
+      std::array<double, 9> x;
+      for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) x[3 * k + d] = p.vertices[t[k]].approx()[d];
+      triangles.push_back(x);
+    }
+    std::sort(triangles.begin(), triangles.end());
+    results.insert(triangles);
+  }
+  EXPECT_EQ(results.size(), 1u);
 }
 
 TEST(Retriangulate, SegmentAcrossADegenerateTriangleIsRefused) {

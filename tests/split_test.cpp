@@ -10,6 +10,8 @@ namespace meshmend {
 namespace {
 
 using testing::box;
+using testing::gridCube;
+using testing::icosphere;
 using testing::moved;
 using testing::uvSphere;
 
@@ -245,7 +247,7 @@ TEST(Split, PointOnASharedEdgeSplitsBothFaces) {
 TEST(Split, CoplanarOverlappingTriangles) {
   // Two triangles of different meshes in one plane, overlapping in the
   // triangle (1,1) (3,1) (1,3): both are cut along its outline, and both
-  // then hold it as one face (the merged output welds the two copies).
+  // then hold it as one face; the merged output keeps it once.
   const Mesh a = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}});
   const Mesh b = makeMesh({{1, 1, 0}, {5, 1, 0}, {1, 5, 0}}, {{0, 1, 2}});
   const SplitResult r = splitAlongIntersections({&a, &b});
@@ -256,8 +258,75 @@ TEST(Split, CoplanarOverlappingTriangles) {
   EXPECT_EQ(r.merged_curve_edges.size(), 3u);  // the overlap's outline, shared by both
   EXPECT_EQ(r.curve_loops, 1u);
   EXPECT_EQ(r.open_curves, 0u);
+  EXPECT_EQ(r.coincident_faces_removed, 1u);
+  EXPECT_EQ(std::size_t(r.merged.fn), r.meshes[0].face.size() + r.meshes[1].face.size() - 1);
   const InspectResult merged = check(r.merged);
-  EXPECT_EQ(merged.duplicate_faces, 1u);  // the overlap, once from each mesh
+  EXPECT_EQ(merged.duplicate_faces, 0u);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.non_manifold_edges, 0u);  // on each outline edge: the overlap, one piece beside
+  EXPECT_EQ(remainingIntersections(r, true), 0u);
+}
+
+TEST(Split, TheSameSurfaceTwiceIsKeptOnce) {
+  // Two copies of one closed mesh overlap everywhere: merged, the surface
+  // is there once, and nothing of it is a curve.
+  const Mesh a = icosphere(2);
+  const SplitResult r = splitAlongIntersections({&a, &a});
+  EXPECT_EQ(std::size_t(r.merged.fn), a.face.size());
+  EXPECT_EQ(r.coincident_faces_removed, a.face.size());
+  EXPECT_TRUE(r.merged_curve_edges.empty());
+  const InspectResult merged = check(r.merged);
+  EXPECT_TRUE(merged.is_closed);
+  EXPECT_EQ(merged.non_manifold_edges, 0u);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  // Each separate output is still its own whole surface.
+  for (const Mesh& m : r.meshes) EXPECT_EQ(m.face.size(), a.face.size());
+}
+
+TEST(Split, BoxesOverlappingInPlanesMeetAlongTheOverlapsOutline) {
+  // A box and the same box moved by half its width: four of their sides
+  // overlap in a plane, and the end faces of each cross the other box.
+  // Merged, each overlap is there once; the curves are the outlines where
+  // the surfaces part (non-manifold edges), closed, without end points.
+  const Mesh a = gridCube(2), b = moved(gridCube(2), {0.5, 0, 0});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_GT(r.coincident_faces_removed, 0u);
+  EXPECT_GT(r.curve_loops, 0u);
+  EXPECT_EQ(r.open_curves, 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(merged.duplicate_faces, 0u);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
+  EXPECT_EQ(merged.border_edges, 0u);
+}
+
+TEST(Split, CurvesThatBranchWithoutEndingAreClosed) {
+  // A cube and the same cube turned 45° about z (and scaled by 1.4, so
+  // that its corners are exact doubles): their tops and bottoms overlap in
+  // octagons, their sides cross along eight vertical lines. The curves
+  // branch at the octagons' corners (three curve edges) and end nowhere:
+  // one closed network.
+  const Mesh a = moved(box(), {-0.5, -0.5, 0});
+  Mesh b = a;
+  for (Vertex& v : b.vert) {
+    const Point3 p = v.cP();
+    v.P() = Point3((p[0] - p[1]) * 0.7, (p[0] + p[1]) * 0.7, p[2]);
+  }
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(r.curve_loops, 1u);
+  EXPECT_EQ(r.open_curves, 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.duplicate_faces, 0u);
+  EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
+}
+
+TEST(Split, TwoBoxesSharingOnlyAnEdgeMeetAlongAnOpenCurve) {
+  const Mesh a = box(), b = moved(box(), {1, 1, 0});
+  const SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(r.merged_curve_edges.size(), 1u);
+  EXPECT_EQ(r.curve_loops, 0u);
+  EXPECT_EQ(r.open_curves, 1u);  // its two ends are end points
 }
 
 TEST(Split, TJunctionOfTwoCurvesInOneFace) {

@@ -139,7 +139,8 @@ void IntersectPlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
       ID(a) == INTERSECT_AND_SPLIT
           ? "When not empty, the result is also written to this path as one JSON object: "
             "curve_edges, curve_loops, open_curves, faces_split, faces_added, new_vertices, "
-            "remaining_intersecting_pairs and time_ms (compute time, file I/O excluded)."
+            "coincident_faces_removed, remaining_intersecting_pairs and time_ms (compute time, "
+            "file I/O excluded)."
           : "When not empty, the result is also written to this path as one JSON object: "
             "self_intersecting_pairs, self_intersecting_faces, cross_intersecting_pairs, per-layer "
             "counts, candidate_pairs and time_ms (detection time, file I/O excluded)."));
@@ -368,8 +369,12 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   }
   Log("MeshMend: %zu intersecting pairs split: %zu curve edges in %zu closed loops and %zu open "
       "curves; %zu faces re-triangulated into %zu more faces, %zu new vertices (%.0f ms)",
-      r.intersecting_pairs, r.merged_curve_edges.size(), r.curve_loops, r.open_curves,
-      r.faces_split, r.faces_added, r.new_vertices, r.time_ms);
+      r.intersecting_pairs, r.curve_edges_welded, r.curve_loops, r.open_curves, r.faces_split,
+      r.faces_added, r.new_vertices, r.time_ms);
+  if (r.coincident_faces_removed)
+    Log("  %zu faces where the surfaces overlap in a plane were there twice: the merged layer "
+        "keeps each once",
+        r.coincident_faces_removed);
   if (options.snap_tolerance > 0)
     Log("  smallest angle of a new face: %.3g degrees (%.3g without snapping); %zu faces under 1 "
         "degree (%zu without); %zu curve points "
