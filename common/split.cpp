@@ -71,6 +71,12 @@ void sortUnique(std::vector<std::array<int, 2>>& pairs, std::size_t bound) {
   }
 }
 
+// The step between floats where `p` lies (at its largest coordinate).
+double floatStep(const Point3& p) {
+  const float m = float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}));
+  return double(std::nextafter(m, INFINITY)) - double(m);
+}
+
 // Barycentric coordinates of p in triangle (a, b, c), from the rounded values.
 Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Point3& c) {
   const Point3 n = (b - a) ^ (c - a);
@@ -833,7 +839,7 @@ class FacesAroundVertices {
 class CurveSnapper {
  public:
   CurveSnapper(OutputArrays& mesh, std::set<std::array<int, 2>>& curves, std::vector<char>& newFace,
-               double tolerance)
+               double tolerance, double floatSteps)
       : P_(mesh.positions),
         T_(mesh.triangles),
         faceOrigin_(mesh.face_origin),
@@ -841,6 +847,7 @@ class CurveSnapper {
         curves_(curves),
         newFace_(newFace),
         tolerance_(tolerance),
+        floatSteps_(floatSteps),
         alive_(T_.size(), 1),
         snapped_(T_.size(), 0),
         around_(T_, P_.size()),
@@ -854,15 +861,17 @@ class CurveSnapper {
     // than the tolerance times their longest edge: only faces near the new
     // faces go into the tree. A query that reaches past them (covers())
     // puts every face in.
-    double longest = 0;
+    double longest = 0, farthest = 0;
     std::vector<Box> near;
     for (std::size_t f = 0; f < T_.size(); ++f)
       if (newFace_[f]) {
         near.push_back(boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]));
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 3; ++i) {
           longest = std::max(longest, Distance(P_[T_[f][i]], P_[T_[f][(i + 1) % 3]]));
+          farthest = std::max(farthest, floatReach(P_[T_[f][i]]));
+        }
       }
-    for (Box& b : near) b = grown(b, 2 * tolerance_ * longest);
+    for (Box& b : near) b = grown(b, 2 * std::max(tolerance_ * longest, farthest));
     grid_ = std::make_unique<BoxGrid>(near);
     std::vector<Box> boxes;
     for (std::size_t f = 0; f < T_.size(); ++f) {
@@ -893,7 +902,8 @@ class CurveSnapper {
           // Into an input vertex, or along the curve into another new vertex.
           if (w == int(v) || (vertexOrigin_[w].vertex < 0 && !isCurveEdge(int(v), w))) continue;
           const double d = Distance(P_[v], P_[w]);
-          if (d < tolerance_ * longest) candidates.push_back({d / longest, int(v), w});
+          if (d < tolerance_ * longest || d < floatReach(P_[v]))
+            candidates.push_back({d / longest, int(v), w});
         }
     }
     std::sort(candidates.begin(), candidates.end(),
@@ -921,7 +931,8 @@ class CurveSnapper {
         const double t = ((P_[v] - P_[a]) * ab) / ab.SquaredNorm();
         if (!(t > 0 && t < 1)) continue;
         const double distance = (P_[v] - (P_[a] + ab * t)).Norm();
-        if (distance < tolerance_ * ab.Norm() && splitEdgeAt(std::uint32_t(s), v, a, b)) {
+        if ((distance < tolerance_ * ab.Norm() || distance < floatReach(P_[v])) &&
+            splitEdgeAt(std::uint32_t(s), v, a, b)) {
           ++snapped;
           break;
         }
@@ -973,6 +984,12 @@ class CurveSnapper {
 
   bool isCurveEdge(int a, int b) const {
     return curves_.count({std::min(a, b), std::max(a, b)}) > 0;
+  }
+
+  // floatSteps_ float steps at `p`: closer than this, a float host can
+  // hardly tell points apart.
+  double floatReach(const Point3& p) const {
+    return floatSteps_ > 0 ? floatSteps_ * floatStep(p) : 0;
   }
 
   std::vector<std::uint32_t> facesAround(int v) const {
@@ -1232,6 +1249,7 @@ class CurveSnapper {
   std::set<std::array<int, 2>>& curves_;
   std::vector<char>& newFace_;
   double tolerance_;
+  double floatSteps_;  // SplitOptions::snap_float_steps
   std::vector<char> alive_;
   std::vector<char> snapped_;  // per face: reshaped or made by snapping
   FacesAroundVertices around_;
@@ -1368,6 +1386,11 @@ void countCurves(std::size_t vertices, const std::vector<std::array<int, 2>>& ed
   open = std::size_t(std::count(component.begin(), component.end(), kOpen));
 }
 
+// Does the split snap curve points (quality snapping, or within float steps)?
+bool snaps(const SplitOptions& o) {
+  return o.snap_tolerance > 0 || o.snap_float_steps > 0;
+}
+
 }  // namespace
 
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
@@ -1482,8 +1505,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   // more than two cores, each mesh still re-triangulates on several.
   // When each input's mesh is all that is asked for (no merged output, no
   // snapping), the split writes it directly; otherwise into arrays first.
-  const bool directMeshes =
-      options.separate_meshes && !options.merged_output && options.snap_tolerance <= 0;
+  const bool directMeshes = options.separate_meshes && !options.merged_output && !snaps(options);
   if (directMeshes) r.meshes.resize(meshes.size());
   std::atomic<std::size_t> nextMesh{0};
   std::vector<std::size_t> facesAdded(meshes.size(), 0);
@@ -1542,7 +1564,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   reportProgress(options.progress, 90, "Welding along the curves");
   // Snapping works on the merged arrays (and rebuilds each input's output
   // from them), so it needs them even when the merged mesh is not asked for.
-  const bool snapping = options.snap_tolerance > 0 && r.faces_split > 0;
+  const bool snapping = snaps(options) && r.faces_split > 0;
   const bool mergedArrays = options.merged_output || snapping;
   // Without snapping, each input's output is final here: unless the split
   // wrote it directly, its vcglib mesh is built in parts (MeshBuilder: vertices, faces and their
@@ -1566,8 +1588,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   };
   std::optional<TaskAlongside>
       separateBuilder;  // destroyed (waited for) also when the merged output throws
-  if (!directMeshes && options.separate_meshes && options.snap_tolerance <= 0 &&
-      outputFaces >= 4096) {
+  if (!directMeshes && options.separate_meshes && !snaps(options) && outputFaces >= 4096) {
     r.meshes.resize(meshes.size());
     builders.reserve(meshes.size());
     for (std::size_t m = 0; m < meshes.size(); ++m) {
@@ -1706,13 +1727,21 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       }
       for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
         const Triangle& t = mesh.triangles[f];
-        merged.triangles.push_back({global[t[0]], global[t[1]], global[t[2]]});
+        const Triangle g = {global[t[0]], global[t[1]], global[t[2]]};
+        // Two corners welded into one (they lie at one exact position, as
+        // rounded output split again can have them): no area left.
+        if (g[0] == g[1] || g[1] == g[2] || g[2] == g[0]) {
+          ++r.collapsed_faces_removed;
+          continue;
+        }
+        merged.triangles.push_back(g);
         merged.face_origin.push_back(mesh.face_origin[f]);
         r.merged_new_face.push_back(f >= splitters[m].keptFaces());
       }
       for (const auto& e : r.curve_edges[m])
-        curves.push_back(
-            {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
+        if (global[e[0]] != global[e[1]])
+          curves.push_back(
+              {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
     sortUnique(curves, positions.size());
     r.coincident_faces_removed = keepOverlapsOnce(merged, r.merged_new_face, onCurve, curves);
@@ -1727,11 +1756,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       return n;
     };
     r.new_faces_below_1deg = r.new_faces_below_1deg_unsnapped = slivers();
-    if (options.snap_tolerance > 0 && r.faces_split > 0) {
+    if (snapping) {
       reportProgress(options.progress, 95, "Snapping curve points");
       const std::size_t facesBefore = merged.triangles.size();              // edge snaps add faces
       std::set<std::array<int, 2>> curveSet(curves.begin(), curves.end());  // snapping edits it
-      CurveSnapper snapper(merged, curveSet, r.merged_new_face, options.snap_tolerance);
+      CurveSnapper snapper(merged, curveSet, r.merged_new_face, options.snap_tolerance,
+                           options.snap_float_steps);
       r.vertices_snapped = snapper.snapVertices();
       r.edges_snapped = snapper.snapEdges();
       const std::vector<int> snappedTo = snapper.snappedTo();
@@ -1788,6 +1818,20 @@ void requireMergedOutput(const SplitResult& result, const char* operation) {
 }
 
 }  // namespace
+
+std::size_t degenerateFaces(const SplitResult& result) {
+  std::size_t n = 0;
+  auto count = [&n](const Mesh& mesh) {
+    for (const Face& f : mesh.face)
+      n += f.cV(0) == f.cV(1) || f.cV(1) == f.cV(2) || f.cV(2) == f.cV(0) ||
+           collinear(f.cP(0), f.cP(1), f.cP(2));
+  };
+  if (result.merged.fn > 0)
+    count(result.merged);
+  else
+    for (const Mesh& mesh : result.meshes) count(mesh);
+  return n;
+}
 
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
   requireMergedOutput(result, "counting the intersections left");
@@ -1953,6 +1997,149 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   return remaining;
 }
 
+namespace {
+
+// The curve edge a-b of a merged output split again, in the new output:
+// the edge itself, or the path the split put on it (the shortest through
+// vertices that split made and that lie on the segment, within a float step
+// or so: they were rounded).
+void carryCurveEdge(int a, int b, const Mesh& mesh,
+                    const std::unordered_map<int, std::vector<int>>& changed,
+                    const std::vector<char>& isNew, std::vector<std::array<int, 2>>& curves) {
+  const auto around = changed.find(a);
+  if (around == changed.end() || changed.find(b) == changed.end() ||
+      std::find(around->second.begin(), around->second.end(), b) != around->second.end()) {
+    curves.push_back({std::min(a, b), std::max(a, b)});  // untouched, or still an edge
+    return;
+  }
+  const Point3 &pa = mesh.vert[a].cP(), &pb = mesh.vert[b].cP(), ab = pb - pa;
+  auto onSegment = [&](int v) {
+    const Point3 av = mesh.vert[v].cP() - pa;
+    const double t = (av * ab) / ab.SquaredNorm();
+    return t > 0 && t < 1 &&
+           (av - ab * t).Norm() <= 1e-5 * ab.Norm() + 4 * floatStep(mesh.vert[v].cP());
+  };
+  std::unordered_map<int, int> from{{a, -1}};
+  std::vector<int> layer{a};
+  for (int depth = 0; depth < 8 && !layer.empty() && !from.count(b); ++depth) {
+    std::vector<int> next;
+    for (int v : layer) {
+      const auto n = changed.find(v);
+      if (n == changed.end()) continue;
+      for (int w : n->second)
+        if ((w == b || (isNew[w] && onSegment(w))) && from.emplace(w, v).second) next.push_back(w);
+    }
+    layer = std::move(next);
+  }
+  if (!from.count(b)) return;  // gone (points merged by snapping)
+  for (int v = b; from.at(v) >= 0; v = from.at(v))
+    curves.push_back({std::min(v, from.at(v)), std::max(v, from.at(v))});
+}
+
+}  // namespace
+
+std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                              const SplitOptions& options, int rounds) {
+  requireMergedOutput(r, "splitting the rounded output again");
+  std::size_t left = std::numeric_limits<std::size_t>::max();  // not counted yet
+  for (int round = 0; round < rounds && left > 0 && r.merged.fn > 0; ++round) {
+    const auto start = std::chrono::steady_clock::now();
+    Mesh& old = r.merged;
+    SplitOptions again;
+    again.between_meshes = false;
+    again.self = true;
+    again.separate_meshes = false;
+    again.snap_float_steps = options.snap_float_steps;
+    again.progress = options.progress;
+    SplitResult next = splitAlongIntersections({&old}, again);
+    if (next.intersecting_pairs == 0) {
+      left = 0;
+      break;
+    }
+    const std::size_t stillCrossing = roundToFloat(next);
+    // Provenance through the old output to the inputs.
+    FaceOriginHandle oldFace = faceOrigins(old), newFace = faceOrigins(next.merged);
+    VertexOriginHandle oldVertex = vertexOrigins(old), newVertex = vertexOrigins(next.merged);
+    std::vector<char> isNew(next.merged.vert.size(), 0);
+    for (std::size_t v = 0; v < next.merged.vert.size(); ++v) {
+      const VertexOrigin o = newVertex[v];
+      if (o.vertex >= 0) {
+        newVertex[v] = oldVertex[o.vertex];
+        continue;
+      }
+      isNew[v] = 1;
+      const FaceOrigin birth = oldFace[o.face];
+      VertexOrigin carried{birth.layer, -1, birth.face, Point3(1, 0, 0)};
+      if (birth.layer >= 0 && std::size_t(birth.layer) < inputs.size() && birth.face >= 0 &&
+          std::size_t(birth.face) < inputs[birth.layer]->face.size()) {
+        const Face& f = inputs[birth.layer]->face[birth.face];
+        carried.barycentric = barycentric(next.merged.vert[v].cP(), f.cP(0), f.cP(1), f.cP(2));
+      }
+      newVertex[v] = carried;
+    }
+    std::vector<char> newFaces(next.merged.face.size()), snapped;
+    const bool anySnapped = !r.merged_snapped_face.empty() || !next.merged_snapped_face.empty();
+    if (anySnapped) snapped.resize(next.merged.face.size());
+    for (std::size_t f = 0; f < next.merged.face.size(); ++f) {
+      const int before = newFace[f].face;
+      newFaces[f] = next.merged_new_face[f] || r.merged_new_face[before];
+      if (anySnapped)
+        snapped[f] = (!r.merged_snapped_face.empty() && r.merged_snapped_face[before]) ||
+                     (!next.merged_snapped_face.empty() && next.merged_snapped_face[f]);
+      newFace[f] = oldFace[before];
+    }
+    // The curves: the old ones where they went, and the new ones.
+    const std::vector<int>& moved = next.merged_vertex[0];  // old vertex -> new
+    // Around each vertex of a new face, its neighbours (over every face).
+    std::unordered_map<int, std::vector<int>> changed;
+    auto corner = [&](const Face& face, int i) {
+      return int(vcg::tri::Index(next.merged, face.cV(i)));
+    };
+    for (std::size_t f = 0; f < next.merged.face.size(); ++f)
+      if (next.merged_new_face[f])
+        for (int i = 0; i < 3; ++i) changed[corner(next.merged.face[f], i)];
+    for (const Face& face : next.merged.face)
+      for (int i = 0; i < 3; ++i) {
+        const int a = corner(face, i), b = corner(face, (i + 1) % 3);
+        if (const auto n = changed.find(a); n != changed.end()) n->second.push_back(b);
+        if (const auto n = changed.find(b); n != changed.end()) n->second.push_back(a);
+      }
+    std::vector<std::array<int, 2>> curves = next.merged_curve_edges;
+    for (const auto& e : r.merged_curve_edges)
+      carryCurveEdge(moved[e[0]], moved[e[1]], next.merged, changed, isNew, curves);
+    // Only edges of the mesh (a face that collapsed takes its edges along).
+    curves.erase(std::remove_if(curves.begin(), curves.end(),
+                                [&](const std::array<int, 2>& e) {
+                                  const auto a = changed.find(e[0]);
+                                  return a != changed.end() &&
+                                         std::find(a->second.begin(), a->second.end(), e[1]) ==
+                                             a->second.end();
+                                }),
+                 curves.end());
+    sortUnique(curves, next.merged.vert.size());
+    for (std::vector<int>& global : r.merged_vertex)
+      for (int& g : global) g = moved[g];
+    r.merged_curve_edges = std::move(curves);
+    r.merged_new_face = std::move(newFaces);
+    r.merged_snapped_face = std::move(snapped);
+    r.faces_added += next.merged.face.size() - old.face.size();
+    r.new_vertices += next.new_vertices;
+    r.vertices_snapped += next.vertices_snapped;
+    r.edges_snapped += next.edges_snapped;
+    r.new_faces_below_1deg += next.new_faces_below_1deg;
+    r.smallest_new_angle_deg = std::min(r.smallest_new_angle_deg, next.smallest_new_angle_deg);
+    r.pairs_split_after_rounding += next.intersecting_pairs;
+    r.collapsed_faces_removed += next.collapsed_faces_removed;
+    r.merged = next.merged;
+    r.curve_edges_welded = r.merged_curve_edges.size();
+    countCurves(r.merged.vert.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
+    r.time_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    left = stillCrossing;
+  }
+  return left == std::numeric_limits<std::size_t>::max() ? remainingIntersections(r, true) : left;
+}
+
 std::vector<std::uint8_t> curveEdgeFlags(const Mesh& mesh,
                                          const std::vector<std::array<int, 2>>& curveEdges) {
   std::set<std::array<int, 2>> curves;
@@ -1984,6 +2171,8 @@ JsonObject toJson(const SplitResult& r) {
       .set("vertices_welded", r.vertices_welded)
       .set("duplicate_faces_removed", r.duplicate_faces_removed)
       .set("coincident_faces_removed", r.coincident_faces_removed)
+      .set("pairs_split_after_rounding", r.pairs_split_after_rounding)
+      .set("collapsed_faces_removed", r.collapsed_faces_removed)
       .set("smallest_new_angle_deg", r.faces_split ? r.smallest_new_angle_deg : 0.0)
       .set("smallest_new_angle_deg_unsnapped",
            r.faces_split ? r.smallest_new_angle_deg_unsnapped : 0.0)

@@ -42,6 +42,12 @@ struct SplitOptions {
   // most the tolerance near the curve, and may split input faces next to a
   // curve: those are no longer bit-identical to the input.
   double snap_tolerance = 0;
+  // Snapping by absolute distance as well, 0 = off: a new curve vertex
+  // closer than this many float steps (at its coordinates' magnitude) to a
+  // vertex or edge as above is merged or splits it, under the same checks.
+  // A float host (MeshLab 2020.09 stores float) cannot keep such points
+  // apart; rounding them to float may make faces cross or collapse.
+  double snap_float_steps = 0;
   Progress progress;  // called between stages
 };
 
@@ -74,6 +80,8 @@ struct SplitResult {
   std::size_t vertices_welded = 0;                 // duplicates merged first (weld_duplicates)
   std::size_t duplicate_faces_removed = 0;         // remove_duplicate_faces
   std::size_t coincident_faces_removed = 0;        // merged: twins in planar overlaps, kept once
+  std::size_t pairs_split_after_rounding = 0;      // splitRoundedAgain: pairs split again
+  std::size_t collapsed_faces_removed = 0;         // merged: faces whose corners welded into one
   double smallest_new_angle_deg = 180;             // smallest angle of a face the split made
   double smallest_new_angle_deg_unsnapped = 180;   // the same before quality snapping
   std::size_t new_faces_below_1deg = 0;            // slivers: new faces with an angle under 1°
@@ -108,11 +116,28 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 // intersecting pair of the rounded output.
 std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
+// Where roundToFloat left faces of the merged output crossing: splits the
+// merged output along its own intersections as rounded (exactly, on the
+// float values) and rounds again, up to `rounds` times while crossings are
+// left. Points that the float values put a step apart now meet where
+// they cross. Provenance goes through to `inputs` (the meshes split first,
+// for the barycentric coordinates of new vertices), and the merged output's
+// curve edges, new-face flags and merged_vertex follow; `meshes` (separate
+// outputs) do not change. Uses options.snap_float_steps. Returns the pairs
+// still crossing (as roundToFloat counts them).
+std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
+                              const SplitOptions& options, int rounds = 3);
+
 // Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not
 // count), with coordinates as stored in double or, with `asFloat`, rounded
 // to float as MeshLab stores them.
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
+
+// Faces of the output (the merged mesh, or else every separate mesh) whose
+// corners, as stored, coincide or are collinear (exactly): after rounding
+// to float, curve points a float step apart may collapse a face.
+std::size_t degenerateFaces(const SplitResult& result);
 
 // Per face of `mesh`: bit i set when its edge from corner i to corner i+1 is
 // one of `curveEdges` (pairs of vertex indices, either order), so that later

@@ -329,6 +329,89 @@ TEST(Split, TwoBoxesSharingOnlyAnEdgeMeetAlongAnOpenCurve) {
   EXPECT_EQ(r.open_curves, 1u);  // its two ends are end points
 }
 
+// `m` with its coordinates turned round (x, y, z) -> (z, x, y), `times`
+// times: a rotation, so orientation is kept.
+Mesh cycled(const Mesh& m, int times) {
+  Mesh out = m;
+  for (Vertex& v : out.vert)
+    for (int t = 0; t < times; ++t) {
+      const Point3 p = v.cP();
+      v.P() = Point3(p[2], p[0], p[1]);
+    }
+  return out;
+}
+
+TEST(Split, PointsAFloatStepApartAreMergedWhenAsked) {
+  // Two unit spheres far from the origin (1e5 on every axis: a float step
+  // is 1/128 there, an edge a seventh): rounded to float, curve points that
+  // close to a vertex or an edge make faces cross or collapse, unless they
+  // are merged first (snap_float_steps).
+  const Point3 far(1e5, 1e5, 1e5);
+  const Mesh a = moved(icosphere(3), far), b = moved(icosphere(3), far + Point3(0.7, 0.3, 0.2));
+  SplitResult plain = splitAlongIntersections({&a, &b});
+  const std::size_t plainLeft = roundToFloat(plain);
+  EXPECT_GT(plainLeft + degenerateFaces(plain), 0u);
+  SplitOptions o;
+  o.snap_float_steps = 8;
+  SplitResult r = splitAlongIntersections({&a, &b}, o);
+  EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
+  EXPECT_EQ(roundToFloat(r), 0u);
+  EXPECT_EQ(degenerateFaces(r), 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.degenerate_faces, 0u);
+  EXPECT_EQ(r.curve_loops, 1u);
+  EXPECT_EQ(r.open_curves, 0u);
+}
+
+TEST(Split, CrossingsLeftByRoundingAreSplitAgain) {
+  // Two capped tubes of one radius crossing at right angles touch where
+  // their top lines cross: curve points there lie far closer than a float
+  // step, and rounded to float some faces cross. Split again on the float
+  // values, none is left and none collapses; provenance still leads to the
+  // inputs, and the curves are the non-manifold edges.
+  const Mesh tube = testing::cappedCylinder(24, 4, 0.5, 0.5, -1, 2);
+  const Mesh a = cycled(tube, 1), b = cycled(tube, 2);
+  SplitOptions o;
+  o.snap_float_steps = 8;
+  SplitResult r = splitAlongIntersections({&a, &b}, o);
+  EXPECT_GT(roundToFloat(r), 0u);  // the case this is about
+  EXPECT_EQ(splitRoundedAgain(r, {&a, &b}, o), 0u);
+  EXPECT_GT(r.pairs_split_after_rounding, 0u);
+  EXPECT_EQ(remainingIntersections(r, true), 0u);
+  EXPECT_EQ(degenerateFaces(r), 0u);
+  const InspectResult merged = check(r.merged);
+  EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
+  EXPECT_EQ(merged.degenerate_faces, 0u);
+  EXPECT_EQ(merged.border_edges, 0u);
+  EXPECT_EQ(merged.non_manifold_edges, r.merged_curve_edges.size());
+  const Mesh* inputs[2] = {&a, &b};
+  FaceOriginHandle fo = faceOrigins(r.merged);
+  for (std::size_t f = 0; f < r.merged.face.size(); ++f) {
+    ASSERT_TRUE(fo[f].layer == 0 || fo[f].layer == 1);
+    ASSERT_LT(std::size_t(fo[f].face), inputs[fo[f].layer]->face.size());
+  }
+  VertexOriginHandle vo = vertexOrigins(r.merged);
+  for (std::size_t v = 0; v < r.merged.vert.size(); ++v) {
+    const VertexOrigin o = vo[v];
+    ASSERT_TRUE(o.layer == 0 || o.layer == 1);
+    const Mesh& in = *inputs[o.layer];
+    Point3 expected;
+    if (o.vertex >= 0) {
+      expected = in.vert[o.vertex].cP();
+    } else {
+      const Face& f = in.face[o.face];
+      expected =
+          f.cP(0) * o.barycentric[0] + f.cP(1) * o.barycentric[1] + f.cP(2) * o.barycentric[2];
+    }
+    EXPECT_LT(Distance(r.merged.vert[v].cP(), expected), 1e-6) << "vertex " << v;
+  }
+  // Each input vertex's place in the merged output is where it is.
+  for (int m = 0; m < 2; ++m)
+    for (std::size_t v = 0; v < inputs[m]->vert.size(); ++v)
+      EXPECT_LT(Distance(r.merged.vert[r.merged_vertex[m][v]].cP(), inputs[m]->vert[v].cP()), 1e-6);
+}
+
 TEST(Split, TJunctionOfTwoCurvesInOneFace) {
   // Two thin plates cross a big triangle and each other: the curves meet at
   // a point inside the triangle (a curve ending on another).
@@ -440,6 +523,7 @@ TEST(Split, WithoutTheMergedOutputEachMeshIsTheSame) {
     // Rounding and the check need the merged output.
     EXPECT_THROW(roundToFloat(r), InvalidInputError);
     EXPECT_THROW(remainingIntersections(r, true), InvalidInputError);
+    EXPECT_THROW(splitRoundedAgain(r, {&a, &b}, SplitOptions{}), InvalidInputError);
   }
   SplitOptions none;
   none.separate_meshes = none.merged_output = false;
