@@ -313,11 +313,17 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh) {
 
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what) {
   if (mesh.fn == 0) throw InvalidInputError(what + " has no faces: load or select a triangle mesh");
-  for (std::size_t i = 0; i < mesh.vert.size(); ++i)
-    if (!mesh.vert[i].IsD() && !isFinite(mesh.vert[i].cP()))
-      throw InvalidInputError(what + ": vertex " + std::to_string(i) +
-                              " has a non-finite coordinate (NaN or infinity); run "
-                              "\"Remove Unreferenced Vertices\" or repair the file first");
+  for (std::size_t i = 0; i < mesh.vert.size(); ++i) {
+    if (mesh.vert[i].IsD() || isFinite(mesh.vert[i].cP())) continue;
+    const std::string bad =
+        what + ": vertex " + std::to_string(i) + " has a non-finite coordinate (NaN or infinity)";
+    for (std::size_t f = 0; f < mesh.face.size(); ++f)
+      for (int k = 0; k < 3; ++k)
+        if (!mesh.face[f].IsD() && mesh.face[f].cV(k) == &mesh.vert[i])
+          throw InvalidInputError(bad + " and face " + std::to_string(f) +
+                                  " uses it: repair the file, or delete the faces that use it");
+    throw InvalidInputError(bad + "; no face uses it: run \"Remove Unreferenced Vertices\" first");
+  }
 }
 
 }  // namespace meshmend

@@ -1425,6 +1425,12 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       },
       1);
   for (std::size_t m = 0; m < meshes.size(); ++m) {
+    if (inputs[m].mesh.triangles.empty())
+      throw InvalidInputError(
+          "mesh " + std::to_string(m) +
+          " has no face left once its coincident vertices are welded: every face had two "
+          "corners at one position (as where coordinates are very large for the mesh's size, "
+          "stored in float); move the mesh near the origin first, or do not weld");
     r.vertices_welded += inputs[m].vertices_merged;
     r.duplicate_faces_removed += duplicateFaces[m];
   }

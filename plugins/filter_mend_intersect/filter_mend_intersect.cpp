@@ -303,7 +303,10 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   const bool merge = parameters.getEnum("output") == 1;
   options.separate_meshes = !merge;
   SplitResult r = splitAlongIntersections(in.meshes, options);
-  if (r.intersecting_pairs == 0)
+  // Welding and removing duplicate faces may be all there was to do (a
+  // layer that met itself only through duplicate faces): that result is
+  // kept; otherwise nothing changed and nothing is written.
+  if (r.intersecting_pairs == 0 && r.vertices_welded == 0 && r.duplicate_faces_removed == 0)
     throw InvalidInputError(mode == kWithinCurrent
                                 ? layerName(*layers[0]) +
                                       " does not intersect itself: nothing to split"
@@ -412,6 +415,9 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
       "curves; %zu faces re-triangulated into %zu more faces, %zu new vertices (%.0f ms)",
       r.intersecting_pairs, r.curve_edges_welded, r.curve_loops, r.open_curves, r.faces_split,
       r.faces_added, r.new_vertices, r.time_ms);
+  if (r.vertices_welded || r.duplicate_faces_removed)
+    Log("  first %zu duplicate vertices were welded and %zu duplicate faces removed",
+        r.vertices_welded, r.duplicate_faces_removed);
   if (r.coincident_faces_removed)
     Log("  %zu faces where the surfaces overlap in a plane were there twice: the merged layer "
         "keeps each once",

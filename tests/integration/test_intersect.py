@@ -1,4 +1,6 @@
 """MeshMend: Select Intersecting Faces, through the real meshlabserver."""
+import math
+
 import pytest
 
 from conftest import MESHCHECK, ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
@@ -178,6 +180,94 @@ def test_split_with_snapping_on_two_cubes(tmp_path):
     assert snapped["smallest_new_angle_deg_unsnapped"] == plain["smallest_new_angle_deg"]
     assert snapped["smallest_new_angle_deg"] > 10 * plain["smallest_new_angle_deg"]
     assert snapped["new_faces_below_1deg"] < plain["new_faces_below_1deg"]
+
+
+def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
+    """The same cube in two layers overlaps itself everywhere: merged, it is
+    there once, closed, with nothing crossing and no duplicate face."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", V, F)
+    out = tmp_path / "merged.ply"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    assert run.report["coincident_faces_removed"] == 12
+    assert run.report["remaining_intersecting_pairs"] == 0
+    assert "keeps each once" in run.log
+    check = meshcheck_if_available(out)
+    if check:
+        assert check["faces"] == 12 and check["duplicate_faces"] == 0
+        assert check["self_intersecting_pairs"] == 0 and check["border_edges"] == 0
+
+
+def tube(axis, n=24, rings=4, r=0.5, h=2.0):
+    """A capped cylinder along `axis`, centred at the origin (as CAD exports one)."""
+    V = [(r * math.cos(2 * math.pi * j / n), r * math.sin(2 * math.pi * j / n), -h / 2 + h * k / rings)
+         for k in range(rings + 1) for j in range(n)]
+    F = []
+    for k in range(rings):
+        for j in range(n):
+            a, b = k * n + j, k * n + (j + 1) % n
+            F += [(a, b, b + n), (a, b + n, a + n)]
+    V += [(0, 0, -h / 2), (0, 0, h / 2)]
+    for j in range(n):
+        F += [(len(V) - 2, (j + 1) % n, j), (len(V) - 1, rings * n + j, rings * n + (j + 1) % n)]
+    turn = {0: (2, 0, 1), 1: (1, 2, 0), 2: (0, 1, 2)}[axis]  # cyclic: orientation kept
+    return [(v[turn[0]], v[turn[1]], v[turn[2]]) for v in V], F
+
+
+def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
+    """Two tubes of one radius crossing at right angles touch tangentially:
+    curve points there lie far closer than a float step. The float result
+    is repaired (points merged, what still crosses split again): nothing
+    crosses, nothing collapses."""
+    a = write_off(tmp_path / "a.off", *tube(0))
+    b = write_off(tmp_path / "b.off", *tube(1))
+    out = tmp_path / "merged.ply"
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_faces"] == 0
+    assert r["snapped_for_float"] or r["pairs_split_after_rounding"] > 0
+    check = meshcheck_if_available(out)
+    if check:
+        assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
+        assert check["border_edges"] == 0
+
+
+def test_split_of_a_layer_that_meets_itself_only_through_duplicates(tmp_path):
+    """A cube listed twice in one layer (its own vertices each time): welded,
+    the second copy is duplicate faces; removing them is the whole repair,
+    and the result is written."""
+    V, F = cube()
+    path = write_off(tmp_path / "twice.off", V + V, F + [(a + 8, b + 8, c + 8) for a, b, c in F])
+    out = tmp_path / "out.ply"
+    script = mlx((SPLIT, {"mode": 0, "first_layer": 0, "second_layer": 0, "output": 1,
+                          "weld_duplicate_vertices": True, "remove_duplicate_faces": True,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [path], script, outputs=[out])
+    assert run.returncode == 0, run.log
+    assert run.report["vertices_welded"] == 8 and run.report["duplicate_faces_removed"] == 12
+    check = meshcheck_if_available(out)
+    if check:
+        assert check["faces"] == 12 and check["self_intersecting_pairs"] == 0
+
+
+def test_split_refuses_a_layer_that_collapses_when_welded(tmp_path):
+    """A unit cube at 1e8, where a float step is 8: as MeshLab stores it, all
+    its corners are one point."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", [(x + 1e8, y + 1e8, z + 1e8) for x, y, z in V], F)
+    b = write_off(tmp_path / "b.off", [(x + 1e8 + 0.5, y + 1e8, z + 1e8) for x, y, z in V], F)
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
+                          "weld_duplicate_vertices": True, "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script)
+    assert run.returncode != 0 and not run.reports
+    assert "no face left" in run.log and "near the origin" in run.log
 
 
 def test_split_sample_runs(tmp_path):
