@@ -1825,17 +1825,15 @@ void requireMergedOutput(const SplitResult& result, const char* operation) {
 
 }  // namespace
 
-std::size_t degenerateFaces(const SplitResult& result) {
+std::size_t degenerateNewFaces(const SplitResult& result) {
+  requireMergedOutput(result, "counting degenerate faces");
   std::size_t n = 0;
-  auto count = [&n](const Mesh& mesh) {
-    for (const Face& f : mesh.face)
-      n += f.cV(0) == f.cV(1) || f.cV(1) == f.cV(2) || f.cV(2) == f.cV(0) ||
-           collinear(f.cP(0), f.cP(1), f.cP(2));
-  };
-  if (result.merged.fn > 0)
-    count(result.merged);
-  else
-    for (const Mesh& mesh : result.meshes) count(mesh);
+  for (std::size_t f = 0; f < result.merged.face.size(); ++f) {
+    if (!result.merged_new_face[f]) continue;
+    const Face& face = result.merged.face[f];
+    n += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) || face.cV(2) == face.cV(0) ||
+         collinear(face.cP(0), face.cP(1), face.cP(2));
+  }
   return n;
 }
 

@@ -134,10 +134,11 @@ std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*
 // to float as MeshLab stores them.
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
 
-// Faces of the output (the merged mesh, or else every separate mesh) whose
-// corners, as stored, coincide or are collinear (exactly): after rounding
-// to float, curve points a float step apart may collapse a face.
-std::size_t degenerateFaces(const SplitResult& result);
+// New faces of the merged output (required, as above) whose corners, as
+// stored, coincide or are collinear (exactly): after rounding to float,
+// curve points a float step apart may collapse a face. (Faces kept from
+// the inputs are as the inputs had them.)
+std::size_t degenerateNewFaces(const SplitResult& result);
 
 // Per face of `mesh`: bit i set when its edge from corner i to corner i+1 is
 // one of `curveEdges` (pairs of vertex indices, either order), so that later

@@ -350,13 +350,13 @@ TEST(Split, PointsAFloatStepApartAreMergedWhenAsked) {
   const Mesh a = moved(icosphere(3), far), b = moved(icosphere(3), far + Point3(0.7, 0.3, 0.2));
   SplitResult plain = splitAlongIntersections({&a, &b});
   const std::size_t plainLeft = roundToFloat(plain);
-  EXPECT_GT(plainLeft + degenerateFaces(plain), 0u);
+  EXPECT_GT(plainLeft + degenerateNewFaces(plain), 0u);
   SplitOptions o;
   o.snap_float_steps = 8;
   SplitResult r = splitAlongIntersections({&a, &b}, o);
   EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
   EXPECT_EQ(roundToFloat(r), 0u);
-  EXPECT_EQ(degenerateFaces(r), 0u);
+  EXPECT_EQ(degenerateNewFaces(r), 0u);
   const InspectResult merged = check(r.merged);
   EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
   EXPECT_EQ(merged.degenerate_faces, 0u);
@@ -379,7 +379,7 @@ TEST(Split, CrossingsLeftByRoundingAreSplitAgain) {
   EXPECT_EQ(splitRoundedAgain(r, {&a, &b}, o), 0u);
   EXPECT_GT(r.pairs_split_after_rounding, 0u);
   EXPECT_EQ(remainingIntersections(r, true), 0u);
-  EXPECT_EQ(degenerateFaces(r), 0u);
+  EXPECT_EQ(degenerateNewFaces(r), 0u);
   const InspectResult merged = check(r.merged);
   EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
   EXPECT_EQ(merged.degenerate_faces, 0u);

@@ -325,13 +325,13 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     // edge, no rounding keeps every face apart (or whole): split again with
     // such points merged as quality snapping merges them, and keep that
     // result if it leaves fewer crossings and collapsed faces.
-    if (options.snap_float_steps <= 0 && (remaining > 0 || degenerateFaces(r) > 0)) {
+    if (options.snap_float_steps <= 0 && (remaining > 0 || degenerateNewFaces(r) > 0)) {
       reportProgress(progressFrom(cb), 96, "Splitting again, merging points a float apart");
       SplitOptions again = options;
       again.snap_float_steps = kFloatSnapSteps;
       SplitResult second = splitAlongIntersections(in.meshes, again);
       const std::size_t left = roundToFloat(second);
-      if (left + degenerateFaces(second) < remaining + degenerateFaces(r)) {
+      if (left + degenerateNewFaces(second) < remaining + degenerateNewFaces(r)) {
         second.time_ms += r.time_ms;
         r = std::move(second);
         remaining = left;
@@ -367,15 +367,15 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     Log("  curve points within %d float steps of a vertex or edge were merged into it (%zu "
         "vertices, %zu edges), as the float result could not keep them apart",
         kFloatSnapSteps, r.vertices_snapped, r.edges_snapped);
-  const std::size_t collapsed = degenerateFaces(r);
+  const std::size_t collapsed = degenerateNewFaces(r);
   if (collapsed > 0)
-    Log("  warning: %zu faces are degenerate (collinear corners) as stored", collapsed);
+    Log("  warning: %zu new faces are degenerate (collinear corners) as stored", collapsed);
   if (verify && remaining > 0 && kHostStoresFloat && options.snap_tolerance <= 0)
     Log("  warning: where curve points lie a few float steps apart (surfaces meeting at a very "
         "small angle), no float rounding keeps every face apart: run again with a quality "
         "snapping tolerance of 0.05, which merges such points");
   JsonObject report = toJson(r);
-  report.set("degenerate_faces", collapsed).set("snapped_for_float", snappedForFloat);
+  report.set("degenerate_new_faces", collapsed).set("snapped_for_float", snappedForFloat);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));

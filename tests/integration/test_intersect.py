@@ -231,7 +231,7 @@ def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
     run = run_server(tmp_path, [a, b], script, outputs=[out])
     assert run.returncode == 0, run.log
     r = run.report
-    assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_faces"] == 0
+    assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_new_faces"] == 0
     assert r["snapped_for_float"] or r["pairs_split_after_rounding"] > 0
     check = meshcheck_if_available(out)
     if check:
