@@ -1856,8 +1856,10 @@ float above(double x) {
 }  // namespace
 
 // How many floats away from its exact value roundToFloat may put a
-// coordinate of a new vertex (the nearest below or above is one away).
-constexpr int kFarthestRounding = 4;
+// coordinate of a new vertex (the nearest below or above is one away). The
+// choices grow as its cube; what two floats each way cannot keep apart is
+// for snapping and splitRoundedAgain.
+constexpr int kFarthestRounding = 2;
 
 std::size_t roundToFloat(SplitResult& r, int passes) {
   requireMergedOutput(r, "rounding to float");

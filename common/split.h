@@ -101,19 +101,18 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 
 // Prepares the output for float storage (MeshLab's), which needs the merged
 // output (SplitOptions::merged_output; throws InvalidInputError without
-// it): every coordinate is
-// rounded to float, and where that makes faces that met only along a curve
-// cross, the new vertices of those faces are rounded the other way (each
-// coordinate to the float just below or above its exact value, or where
-// neither keeps surfaces meeting at a very small angle apart, up to four
-// floats away), choosing the rounding under which the faces around the
-// vertex cross nothing. Curve points a few float steps apart may leave
-// crossings no rounding removes: quality snapping (snap_tolerance) merges
-// them. Applied to
-// `merged` and to `meshes` alike. Returns the pairs still crossing among
-// those with a new face or a face that rounding moved (faces kept exactly
-// as they were cannot cross anything new); with `complete`, that is every
-// intersecting pair of the rounded output.
+// it): every coordinate is rounded to float, and where that makes faces that
+// met only along a curve cross, the new vertices of those faces are rounded
+// the other way (each coordinate to the float just below or above its exact
+// value, or where neither keeps surfaces meeting at a very small angle
+// apart, the next float out), choosing the rounding under which the faces
+// around the vertex cross nothing. Curve points a few float steps apart may
+// leave crossings no rounding removes: snapping (snap_float_steps or
+// snap_tolerance) merges them, and splitRoundedAgain splits what is left.
+// Applied to `merged` and to `meshes` alike. Returns the pairs still
+// crossing among those with a new face or a face that rounding moved (faces
+// kept exactly as they were cannot cross anything new); with `complete`,
+// that is every intersecting pair of the rounded output.
 std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
 // Where roundToFloat left faces of the merged output crossing: splits the
