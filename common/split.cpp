@@ -270,7 +270,7 @@ struct OutputArrays {
 // the overlap's outline stays.
 std::size_t keepOverlapsOnce(OutputArrays& merged, std::vector<char>& newFace,
                              const std::vector<char>& onCurve,
-                             std::vector<std::array<int, 2>>& curves) {
+                             std::vector<std::array<int, 2>>& curves, bool remove = true) {
   std::vector<std::pair<Triangle, std::uint32_t>> corners;  // sorted corners, face
   for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
     Triangle t = merged.triangles[f];
@@ -291,7 +291,7 @@ std::size_t keepOverlapsOnce(OutputArrays& merged, std::vector<char>& newFace,
     twin[corners[k].second] = kTwinRemoved;
     ++removed;
   }
-  if (removed == 0) return 0;
+  if (removed == 0 || !remove) return removed;  // (only counted)
   // Per curve edge: does a face that had no twin use it?
   std::vector<char> outline(curves.size(), 0);
   for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
@@ -1750,7 +1750,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
               {std::min(global[e[0]], global[e[1]]), std::max(global[e[0]], global[e[1]])});
     }
     sortUnique(curves, positions.size());
-    r.coincident_faces_removed = keepOverlapsOnce(merged, r.merged_new_face, onCurve, curves);
+    r.coincident_faces =
+        keepOverlapsOnce(merged, r.merged_new_face, onCurve, curves, options.overlaps_once);
+    if (options.overlaps_once) r.coincident_faces_removed = r.coincident_faces;
     // The quality of the new faces: their smallest angle, and the slivers.
     auto slivers = [&] {
       std::size_t n = 0;
@@ -2056,6 +2058,7 @@ std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& in
     again.self = true;
     again.separate_meshes = false;
     again.snap_float_steps = options.snap_float_steps;
+    again.overlaps_once = options.overlaps_once;
     again.progress = options.progress;
     SplitResult next = splitAlongIntersections({&old}, again);
     if (next.intersecting_pairs == 0) {
@@ -2176,6 +2179,7 @@ JsonObject toJson(const SplitResult& r) {
       .set("degenerate_faces_kept", r.degenerate_faces_kept)
       .set("vertices_welded", r.vertices_welded)
       .set("duplicate_faces_removed", r.duplicate_faces_removed)
+      .set("coincident_faces", r.coincident_faces)
       .set("coincident_faces_removed", r.coincident_faces_removed)
       .set("pairs_split_after_rounding", r.pairs_split_after_rounding)
       .set("collapsed_faces_removed", r.collapsed_faces_removed)

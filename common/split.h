@@ -23,6 +23,13 @@ struct SplitOptions {
   // mesh (after welding): the same surface twice, intersecting itself
   // everywhere (decimated scans have them). The first of each group stays.
   bool remove_duplicate_faces = false;
+  // Where surfaces overlap in a plane, both sides' faces there coincide
+  // (same three vertices): keep each such face once in `merged` (the
+  // intersection paper's result is free of duplicate geometry), and the
+  // curve edges inside the overlap become ordinary edges. Off, `merged`
+  // keeps both: each input part stays a whole surface there, as the patch
+  // classification of booleans needs (patches.h).
+  bool overlaps_once = false;
   bool separate_meshes = true;  // build `meshes` (one output per input)
   // Build `merged` (all meshes in one, welded along the curves) with
   // merged_curve_edges, merged_vertex and merged_new_face. Without it the
@@ -79,7 +86,8 @@ struct SplitResult {
   std::size_t degenerate_faces_kept = 0;           // zero-area faces a curve touches, left unsplit
   std::size_t vertices_welded = 0;                 // duplicates merged first (weld_duplicates)
   std::size_t duplicate_faces_removed = 0;         // remove_duplicate_faces
-  std::size_t coincident_faces_removed = 0;        // merged: twins in planar overlaps, kept once
+  std::size_t coincident_faces = 0;                // merged: twins in planar overlaps
+  std::size_t coincident_faces_removed = 0;        // the same, kept once (overlaps_once)
   std::size_t pairs_split_after_rounding = 0;      // splitRoundedAgain: pairs split again
   std::size_t collapsed_faces_removed = 0;         // merged: faces whose corners welded into one
   double smallest_new_angle_deg = 180;             // smallest angle of a face the split made

@@ -146,6 +146,27 @@ TEST(Patches, BooleanResultsOfTwoCrossingSpheres) {
   EXPECT_LT(volumes[1], std::min(pair.volumeA, pair.volumeB));
 }
 
+TEST(Patches, UnionOfBoxesSharingASideIsOneClosedBox) {
+  // Two boxes side by side, their shared side triangulated alike: split
+  // (each keeps its copy of the side, the default), the union drops the
+  // side and is one closed box of twice the volume.
+  const Mesh a = testing::gridCube(2), b = testing::moved(a, {1, 0, 0});
+  SplitResult r = splitAlongIntersections({&a, &b});
+  EXPECT_GT(r.coincident_faces, 0u);
+  const FaceLabels labels = labelsOf(r);
+  Patches p = paintPatches(r.merged, labels);
+  classifyPatches(r.merged, labels, p);
+  EXPECT_TRUE(p.part_closed[0] && p.part_closed[1]);
+  const PatchChoice choice = choosePatches(p, BooleanOperation::kUnion);
+  const InspectResult i = check(extractPatches(r.merged, p, choice.keep, choice.flip));
+  EXPECT_TRUE(i.is_closed);
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(i.duplicate_faces, 0u);
+  EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+  ASSERT_TRUE(i.volume.has_value());
+  EXPECT_NEAR(*i.volume, 2, 1e-12);
+}
+
 TEST(Patches, ClassificationWithHolesInTheOtherPart) {
   // A small sphere inside a big one with a hole cut at its top: the small
   // one is still inside, well above the ½ threshold.

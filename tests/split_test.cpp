@@ -250,7 +250,14 @@ TEST(Split, CoplanarOverlappingTriangles) {
   // then hold it as one face; the merged output keeps it once.
   const Mesh a = makeMesh({{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}});
   const Mesh b = makeMesh({{1, 1, 0}, {5, 1, 0}, {1, 5, 0}}, {{0, 1, 2}});
-  const SplitResult r = splitAlongIntersections({&a, &b});
+  // By default each mesh keeps its copy (a whole surface each, for booleans).
+  const SplitResult both = splitAlongIntersections({&a, &b});
+  EXPECT_EQ(both.coincident_faces, 1u);
+  EXPECT_EQ(both.coincident_faces_removed, 0u);
+  EXPECT_EQ(check(both.merged).duplicate_faces, 1u);
+  SplitOptions once;
+  once.overlaps_once = true;
+  const SplitResult r = splitAlongIntersections({&a, &b}, once);
   EXPECT_EQ(r.intersecting_pairs, 1u);
   EXPECT_EQ(r.faces_split, 2u);
   EXPECT_GT(r.meshes[0].fn, 1);
@@ -271,7 +278,9 @@ TEST(Split, TheSameSurfaceTwiceIsKeptOnce) {
   // Two copies of one closed mesh overlap everywhere: merged, the surface
   // is there once, and nothing of it is a curve.
   const Mesh a = icosphere(2);
-  const SplitResult r = splitAlongIntersections({&a, &a});
+  SplitOptions once;
+  once.overlaps_once = true;
+  const SplitResult r = splitAlongIntersections({&a, &a}, once);
   EXPECT_EQ(std::size_t(r.merged.fn), a.face.size());
   EXPECT_EQ(r.coincident_faces_removed, a.face.size());
   EXPECT_TRUE(r.merged_curve_edges.empty());
@@ -289,7 +298,9 @@ TEST(Split, BoxesOverlappingInPlanesMeetAlongTheOverlapsOutline) {
   // Merged, each overlap is there once; the curves are the outlines where
   // the surfaces part (non-manifold edges), closed, without end points.
   const Mesh a = gridCube(2), b = moved(gridCube(2), {0.5, 0, 0});
-  const SplitResult r = splitAlongIntersections({&a, &b});
+  SplitOptions once;
+  once.overlaps_once = true;
+  const SplitResult r = splitAlongIntersections({&a, &b}, once);
   EXPECT_GT(r.coincident_faces_removed, 0u);
   EXPECT_GT(r.curve_loops, 0u);
   EXPECT_EQ(r.open_curves, 0u);
@@ -312,7 +323,9 @@ TEST(Split, CurvesThatBranchWithoutEndingAreClosed) {
     const Point3 p = v.cP();
     v.P() = Point3((p[0] - p[1]) * 0.7, (p[0] + p[1]) * 0.7, p[2]);
   }
-  const SplitResult r = splitAlongIntersections({&a, &b});
+  SplitOptions once;
+  once.overlaps_once = true;
+  const SplitResult r = splitAlongIntersections({&a, &b}, once);
   EXPECT_EQ(r.curve_loops, 1u);
   EXPECT_EQ(r.open_curves, 0u);
   const InspectResult merged = check(r.merged);

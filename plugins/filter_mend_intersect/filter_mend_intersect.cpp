@@ -105,6 +105,13 @@ void IntersectPlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
         "(after welding): the same surface twice, which intersects itself everywhere and "
         "cannot be split apart (decimated scans have hundreds). The first of each group "
         "stays."));
+    parameters.addParam(RichBool(
+        "overlaps_once", false, "Planar overlaps once",
+        "Where layers (or a layer and itself) overlap in a plane, their faces there coincide "
+        "after the split. On, the merged layer keeps each such face once, so that it is free "
+        "of duplicate faces (a repaired result). Off, it keeps both, so that each input layer "
+        "stays a whole surface there, as the boolean filters (Keep Outer Surface, Difference, "
+        "...) need."));
     parameters.addParam(RichFloat(
         "snap_tolerance", 0, "Quality snapping (0 = off)",
         "Scale-free tolerance, as a fraction of the local edge length (0.05 is a good value). "
@@ -296,6 +303,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
   options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.remove_duplicate_faces = parameters.getBool("remove_duplicate_faces");
+  options.overlaps_once = parameters.getBool("overlaps_once");
   options.snap_tolerance = parameters.getFloat("snap_tolerance");
   if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
     throw InvalidInputError("the snapping tolerance must be at least 0 (off) and below 0.5");
@@ -425,6 +433,11 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     Log("  %zu faces where the surfaces overlap in a plane were there twice: the merged layer "
         "keeps each once",
         r.coincident_faces_removed);
+  else if (r.coincident_faces && merge)
+    Log("  %zu faces lie twice where the surfaces overlap in a plane, each layer's own (for the "
+        "boolean filters; the check counts them as crossing pairs): 'Planar overlaps once' "
+        "keeps each once",
+        r.coincident_faces);
   if (options.snap_tolerance > 0)
     Log("  smallest angle of a new face: %.3g degrees (%.3g without snapping); %zu faces under 1 "
         "degree (%zu without); %zu curve points "

@@ -190,7 +190,7 @@ def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
     b = write_off(tmp_path / "b.off", V, F)
     out = tmp_path / "merged.ply"
     script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
-                          "report_file": "{report0}"}))
+                          "overlaps_once": True, "report_file": "{report0}"}))
     run = run_server(tmp_path, [a, b], script, outputs=[out])
     assert run.returncode == 0, run.log
     assert run.report["coincident_faces_removed"] == 12
