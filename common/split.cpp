@@ -1839,6 +1839,37 @@ std::size_t degenerateNewFaces(const SplitResult& result) {
   return n;
 }
 
+FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                              const SplitOptions& options, bool repairMerged) {
+  FloatOutput out;
+  out.crossing = roundToFloat(r);
+  SplitOptions used = options;
+  // Where curve points lie a few float steps from each other or from an
+  // edge, no rounding keeps every face apart (or whole): split again with
+  // such points merged as quality snapping merges them.
+  if (options.snap_float_steps <= 0 && (out.crossing > 0 || degenerateNewFaces(r) > 0)) {
+    reportProgress(options.progress, 96, "Splitting again, merging points a float apart");
+    used.snap_float_steps = kFloatSnapSteps;
+    SplitResult second = splitAlongIntersections(inputs, used);
+    const std::size_t left = roundToFloat(second);
+    if (left + degenerateNewFaces(second) < out.crossing + degenerateNewFaces(r)) {
+      second.time_ms += r.time_ms;
+      r = std::move(second);
+      out.crossing = left;
+      out.snapped_for_float = true;
+    } else {
+      used.snap_float_steps = options.snap_float_steps;
+    }
+  }
+  // What is left crosses as rounded: the merged output is split again along
+  // those crossings, on its float values, and rounded again.
+  if (out.crossing > 0 && repairMerged) {
+    reportProgress(options.progress, 97, "Splitting the rounded result where it crosses");
+    out.crossing = splitRoundedAgain(r, inputs, used);
+  }
+  return out;
+}
+
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
   requireMergedOutput(result, "counting the intersections left");
   return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat);

@@ -135,6 +135,25 @@ std::size_t roundToFloat(SplitResult& result, int passes = 4);
 std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options, int rounds = 3);
 
+// How close (in float steps) roundForFloatHost merges curve points: far
+// below any feature a float mesh can hold, and enough to take the points
+// rounding confuses.
+inline constexpr int kFloatSnapSteps = 8;
+
+struct FloatOutput {
+  std::size_t crossing = 0;        // pairs still crossing, as roundToFloat counts them
+  bool snapped_for_float = false;  // the result is the second split (snap_float_steps)
+};
+
+// The result as a float host (MeshLab 2020.09) stores it: rounded
+// (roundToFloat); where that left crossings or collapsed new faces and
+// options.snap_float_steps was 0, the split of `inputs` again with
+// snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then,
+// with `repairMerged`, what still crosses in the merged output split again
+// (splitRoundedAgain).
+FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
+                              const SplitOptions& options, bool repairMerged);
+
 // Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not
 // count), with coordinates as stored in double or, with `asFloat`, rounded

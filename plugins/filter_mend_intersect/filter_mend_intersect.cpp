@@ -17,11 +17,6 @@ namespace {
 
 enum Mode { kWithinCurrent, kBetweenTwo, kAllVisible };
 
-// How close (in float steps) curve points are merged when the float result
-// of a split still has crossings or collapsed faces: far below any feature
-// a float mesh can hold, and enough to take the points rounding confuses.
-constexpr int kFloatSnapSteps = 8;
-
 }  // namespace
 
 IntersectPlugin::IntersectPlugin() {
@@ -325,34 +320,11 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   const auto roundStart = std::chrono::steady_clock::now();
   std::size_t remaining = 0;
   const bool checkWhole = !kHostStoresFloat || !r.complete;
-  bool snappedForFloat = false;
+  FloatOutput stored;
   if (kHostStoresFloat) {
     reportProgress(progressFrom(cb), 95, "Rounding to float");
-    remaining = roundToFloat(r);
-    // Where curve points lie a few float steps from each other or from an
-    // edge, no rounding keeps every face apart (or whole): split again with
-    // such points merged as quality snapping merges them, and keep that
-    // result if it leaves fewer crossings and collapsed faces.
-    if (options.snap_float_steps <= 0 && (remaining > 0 || degenerateNewFaces(r) > 0)) {
-      reportProgress(progressFrom(cb), 96, "Splitting again, merging points a float apart");
-      SplitOptions again = options;
-      again.snap_float_steps = kFloatSnapSteps;
-      SplitResult second = splitAlongIntersections(in.meshes, again);
-      const std::size_t left = roundToFloat(second);
-      if (left + degenerateNewFaces(second) < remaining + degenerateNewFaces(r)) {
-        second.time_ms += r.time_ms;
-        r = std::move(second);
-        remaining = left;
-        snappedForFloat = true;
-        options.snap_float_steps = kFloatSnapSteps;
-      }
-    }
-    // What is left crosses as rounded: the merged layer is split again
-    // along those crossings, on its float values, and rounded again.
-    if (remaining > 0 && merge) {
-      reportProgress(progressFrom(cb), 97, "Splitting the rounded result where it crosses");
-      remaining = splitRoundedAgain(r, in.meshes, options);
-    }
+    stored = roundForFloatHost(r, in.meshes, options, merge);
+    remaining = stored.crossing;
   }
   const bool verify = parameters.getBool("verify");
   if (verify && checkWhole) {  // rounding did not count every pair: check everything
@@ -371,7 +343,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   if (r.pairs_split_after_rounding > 0)
     Log("  %zu pairs of faces that crossed once rounded to float were split again",
         r.pairs_split_after_rounding);
-  if (snappedForFloat)
+  if (stored.snapped_for_float)
     Log("  curve points within %d float steps of a vertex or edge were merged into it (%zu "
         "vertices, %zu edges), as the float result could not keep them apart",
         kFloatSnapSteps, r.vertices_snapped, r.edges_snapped);
@@ -386,7 +358,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
         "small angle), no float rounding keeps every face apart: run again with a quality "
         "snapping tolerance of 0.05, which merges such points");
   JsonObject report = toJson(r);
-  report.set("degenerate_new_faces", collapsed).set("snapped_for_float", snappedForFloat);
+  report.set("degenerate_new_faces", collapsed).set("snapped_for_float", stored.snapped_for_float);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));

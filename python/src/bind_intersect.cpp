@@ -132,8 +132,9 @@ OptionTable<SplitCall> splitTable() {
   t.add(
       "round_to_float", [](SplitCall& c) -> bool& { return c.round_to_float; },
       "round the output to float (as MeshLab and STL, float PLY or OBJ files store it), "
-      "re-rounding curve points where rounding to nearest would make faces cross; the check "
-      "then counts the float output");
+      "re-rounding curve points where rounding to nearest would make faces cross, merging curve "
+      "points a few float steps apart and splitting the merged output again where it still "
+      "crosses, as the MeshLab filter does; the check then counts the float output");
   t.add(
       "verify", [](SplitCall& c) -> bool& { return c.verify; },
       "count the intersecting pairs left in the merged output (remaining_intersecting_pairs)");
@@ -154,12 +155,16 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   SplitResult r = call([&] { return splitAlongIntersections(pointers, c.core); });
   std::size_t remaining = 0;
   const auto start = std::chrono::steady_clock::now();
-  if (c.round_to_float) call([&] { return roundToFloat(r); });
+  FloatOutput stored;  // as the MeshLab filter stores it
+  if (c.round_to_float)
+    stored = call([&] { return roundForFloatHost(r, pointers, c.core, !c.core.separate_meshes); });
   if (c.verify)  // the whole merged output as returned, by the self-intersection rule
     remaining = call([&] { return remainingIntersections(r, c.round_to_float); });
   r.time_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   JsonObject report = toJson(r);
+  report.set("degenerate_new_faces", degenerateNewFaces(r))
+      .set("snapped_for_float", stored.snapped_for_float);
   if (c.verify) report.set("remaining_intersecting_pairs", remaining);
   report.set("output", c.core.separate_meshes ? "separate" : "merged");
 

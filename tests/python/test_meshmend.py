@@ -310,14 +310,17 @@ def test_split_rounded_to_float_keeps_faces_apart(tmp_path):
         assert len(V) == len(W)
 
 
-def test_split_rounded_to_float_counts_what_only_snapping_removes(tmp_path):
-    # Here curve points lie a few float steps apart: no rounding keeps every
-    # face apart, and the report says how many pairs cross.
+def test_split_rounded_to_float_repairs_points_a_float_step_apart(tmp_path):
+    # Here curve points lie a few float steps apart: no rounding alone keeps
+    # every face apart. Rounding for a float host merges such points (or
+    # splits again what still crosses): nothing crosses, nothing collapses.
     (A, F), (B, G) = nearly_coincident_pair(3)
-    out = mm.intersect_and_split(A, F, B, G, round_to_float=True)
-    left = out.report["remaining_intersecting_pairs"]
-    assert left > 0
-    assert meshcheck(write_off(tmp_path / "rounded.off", *out.merged))["self_intersecting_pairs"] == left
+    out = mm.intersect_and_split(A, F, B, G, round_to_float=True, separate_meshes=False)
+    assert out.report["snapped_for_float"] or out.report["pairs_split_after_rounding"] > 0
+    assert out.report["remaining_intersecting_pairs"] == 0
+    assert out.report["degenerate_new_faces"] == 0
+    check = meshcheck(write_off(tmp_path / "rounded.off", *out.merged))
+    assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
     snapped = mm.intersect_and_split(A, F, B, G, round_to_float=True, snap_tolerance=0.05)
     assert snapped.report["vertices_snapped"] + snapped.report["edges_snapped"] > 0
     assert snapped.report["remaining_intersecting_pairs"] == 0
