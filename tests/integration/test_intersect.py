@@ -97,15 +97,22 @@ def test_nan_coordinates_are_refused(tmp_path):
 SPLIT = "MeshMend: Intersect and Split Layers"
 
 
-def test_split_two_cubes_merged_is_free_of_intersections(tmp_path):
-    V, F = cube()
-    a = write_off(tmp_path / "a.off", V, F)
-    b = write_off(tmp_path / "b.off", shifted(V, 0.5), F)
-    out = tmp_path / "merged.off"
+def split_merged(tmp_path, first, second, **params):
+    """Two meshes (V, F) split into one merged layer; the run and the
+    written layer's path."""
+    a = write_off(tmp_path / "a.off", *first)
+    b = write_off(tmp_path / "b.off", *second)
+    out = tmp_path / "merged.ply"  # binary float, as MeshLab holds it
     script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
-                          "report_file": "{report0}"}))
+                          "report_file": "{report0}", **params}))
     run = run_server(tmp_path, [a, b], script, outputs=[out])
     assert run.returncode == 0, run.log
+    return run, out
+
+
+def test_split_two_cubes_merged_is_free_of_intersections(tmp_path):
+    V, F = cube()
+    run, out = split_merged(tmp_path, (V, F), (shifted(V, 0.5), F))
     r = run.report
     assert r["remaining_intersecting_pairs"] == 0
     assert r["curve_loops"] >= 1 and r["open_curves"] == 0
@@ -185,14 +192,7 @@ def test_split_with_snapping_on_two_cubes(tmp_path):
 def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
     """The same cube in two layers overlaps itself everywhere: merged, it is
     there once, closed, with nothing crossing and no duplicate face."""
-    V, F = cube()
-    a = write_off(tmp_path / "a.off", V, F)
-    b = write_off(tmp_path / "b.off", V, F)
-    out = tmp_path / "merged.ply"
-    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
-                          "overlaps_once": True, "report_file": "{report0}"}))
-    run = run_server(tmp_path, [a, b], script, outputs=[out])
-    assert run.returncode == 0, run.log
+    run, out = split_merged(tmp_path, cube(), cube(), overlaps_once=True)
     assert run.report["coincident_faces_removed"] == 12
     assert run.report["remaining_intersecting_pairs"] == 0
     assert "keeps each once" in run.log
@@ -223,13 +223,7 @@ def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
     curve points there lie far closer than a float step. The float result
     is repaired (points merged, what still crosses split again): nothing
     crosses, nothing collapses."""
-    a = write_off(tmp_path / "a.off", *tube(0))
-    b = write_off(tmp_path / "b.off", *tube(1))
-    out = tmp_path / "merged.ply"
-    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 1,
-                          "report_file": "{report0}"}))
-    run = run_server(tmp_path, [a, b], script, outputs=[out])
-    assert run.returncode == 0, run.log
+    run, out = split_merged(tmp_path, tube(0), tube(1))
     r = run.report
     assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_new_faces"] == 0
     assert r["snapped_for_float"] or r["pairs_split_after_rounding"] > 0
