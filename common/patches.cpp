@@ -229,6 +229,66 @@ Patches patchesFromIds(const Mesh& mesh, const FaceLabels& labels, const std::ve
   return result;
 }
 
+namespace {
+
+// A face's twins in other parts (faces with the same three corners).
+struct FaceTwins {
+  struct Twin {
+    int face = -1;   // in that part, or -1
+    int facing = 0;  // +1 the same way, -1 the other way, 0 no twin
+  };
+  std::vector<std::pair<int, Twin>> twins;  // (part, twin)
+  Twin in(int part) const {
+    for (const auto& [p, twin] : twins)
+      if (p == part) return twin;
+    return {};
+  }
+};
+
+// The twins of the sample faces (those that have any), by face.
+template <class PartOf>
+std::unordered_map<int, FaceTwins> twinsOf(const std::vector<Point3>& P,
+                                           const std::vector<Triangle>& T,
+                                           const std::vector<std::vector<int>>& samples,
+                                           PartOf partOf, int parts) {
+  std::unordered_map<int, FaceTwins> result;
+  if (parts < 2) return result;
+  using Key = std::array<double, 9>;  // the corners' coordinates, corners in lexicographic order
+  auto keyOf = [&](int f) {
+    std::array<Point3, 3> c = {P[T[f][0]], P[T[f][1]], P[T[f][2]]};
+    std::sort(c.begin(), c.end());
+    return Key{c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2]};
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::size_t h = 0;
+      for (double x : k) h = h * 1000003u ^ std::hash<double>()(x);
+      return h;
+    }
+  };
+  std::unordered_map<Key, std::vector<int>, KeyHash> sampleFaces;
+  for (const std::vector<int>& faces : samples)
+    for (int f : faces) sampleFaces[keyOf(f)].push_back(f);
+  for (std::size_t g = 0; g < T.size(); ++g) {
+    const auto it = sampleFaces.find(keyOf(int(g)));
+    if (it == sampleFaces.end()) continue;
+    for (int f : it->second) {
+      const int part = partOf(g);
+      if (part == partOf(f)) continue;
+      const auto known = result.find(f);
+      if (known != result.end() && known->second.in(part).face >= 0) continue;
+      // The same way round when g's corner after f's first corner is f's second.
+      int k = 0;
+      while (k < 3 && !(P[T[g][k]] == P[T[f][0]])) ++k;
+      const bool same = k < 3 && P[T[g][(k + 1) % 3]] == P[T[f][1]];
+      result[f].twins.push_back({part, {int(g), same ? 1 : -1}});
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
 void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patches) {
   const std::vector<Triangle> T = trianglesOf(mesh);
   const std::vector<Point3> P = positionsOf(mesh);
@@ -277,24 +337,37 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
       if (samples[id].empty()) samples[id].push_back(patches.patches[id].first_face);
     }
   }
+  // Where parts overlap in a plane, each keeps its copy of the overlap: a
+  // sample face's twin in another part (the same corners) is that part's
+  // surface at the sample, whose own solid angle there is left out like
+  // the sample's, and whose orientation tells on which side that part lies.
+  const std::unordered_map<int, FaceTwins> twins = twinsOf(P, T, samples, partOf, patches.parts);
   parallelChunks(
       patches.patches.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t id = begin; id < end; ++id) {
           Patch& patch = patches.patches[id];
           patch.winding.assign(patches.parts, 0);
+          patch.coincident.assign(patches.parts, 0);
+          patch.coincident[patch.part] = 1;
           for (int p = 0; p < patches.parts; ++p) {
             std::vector<double> values;
+            int facing[3] = {0, 0,
+                             0};  // samples with a twin facing the other way, none, the same way
             for (int f : samples[id]) {
               const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
-              values.push_back(trees[p].at(c, f));
+              const auto it = twins.find(f);
+              const FaceTwins::Twin twin = it == twins.end() ? FaceTwins::Twin{} : it->second.in(p);
+              values.push_back(trees[p].at(c, twin.face >= 0 ? twin.face : f));
+              if (p != patch.part) ++facing[twin.facing + 1];
             }
             std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
             patch.winding[p] = values[values.size() / 2];  // the median: one odd sample is outvoted
+            if (p != patch.part)
+              patch.coincident[p] = std::int8_t(std::max_element(facing, facing + 3) - facing -
+                                                1);  // the samples' majority
           }
-          const double total = std::accumulate(patch.winding.begin(), patch.winding.end(), 0.0);
-          patch.winding_outside = total - 0.5;
-          patch.winding_inside = total + 0.5;
+          patch.setSideWindings();
         }
       },
       4);
@@ -399,9 +472,7 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
   for (const auto& [root, id] : idOfRoot) {
     Patch& patch = patches.patches[id];
     for (double& w : patch.winding) w /= double(patch.faces);
-    const double total = std::accumulate(patch.winding.begin(), patch.winding.end(), 0.0);
-    patch.winding_outside = total - 0.5;
-    patch.winding_inside = total + 0.5;
+    patch.setSideWindings();
   }
   patches.patches_split_at_open_parts = std::count(mixed.begin(), mixed.end(), 1);
 }
@@ -425,24 +496,38 @@ PatchChoice choosePatches(const Patches& patches, BooleanOperation op) {
   choice.flip.assign(n, 0);
   for (std::size_t id = 0; id < n; ++id) {
     const Patch& patch = patches.patches[id];
-    if (patch.winding.size() != std::size_t(patches.parts))
+    if (patch.winding.size() != std::size_t(patches.parts) ||
+        patch.coincident.size() != std::size_t(patches.parts))
       throw InvalidInputError("the patches are not classified yet");
-    switch (op) {
-      case BooleanOperation::kUnion:
-        choice.keep[id] = patch.onUnionSurface();
-        break;
-      case BooleanOperation::kIntersection:
-        choice.keep[id] = patch.insideAllOthers(true);
-        break;
-      case BooleanOperation::kDifference:
-        if (patch.part == 0) {
-          choice.keep[id] = patch.insideAllOthers(false);
-        } else {
-          choice.keep[id] = patch.inside(0) && patch.insideAllOthers(false, 0);
-          choice.flip[id] = choice.keep[id];
-        }
-        break;
-    }
+    // Is the result's region just in front of the patch (along its normal),
+    // or just behind it? The patch bounds the result where they differ, and
+    // faces the result's outside: turned over when the region is in front.
+    auto inResult = [&](bool front) {
+      auto insidePart = [&](int p) {
+        return (front ? patch.windingInFront(p) : patch.windingBehind(p)) > 0.5;
+      };
+      switch (op) {
+        case BooleanOperation::kUnion:  // inside all parts together (an open part: fractions add
+                                        // up)
+          return (front ? patch.winding_outside : patch.winding_inside) > 0.5;
+        case BooleanOperation::kIntersection:
+          for (int p = 0; p < patches.parts; ++p)
+            if (!insidePart(p)) return false;
+          return true;
+        case BooleanOperation::kDifference:
+          if (!insidePart(0)) return false;
+          for (int p = 1; p < patches.parts; ++p)
+            if (insidePart(p)) return false;
+          return true;
+      }
+      return false;
+    };
+    const bool behind = inResult(false), inFront = inResult(true);
+    // A planar overlap bounds the result once: by the copy of its first part.
+    bool copyOfEarlierPart = false;
+    for (int p = 0; p < patch.part; ++p) copyOfEarlierPart |= patch.coincident[p] != 0;
+    choice.keep[id] = behind != inFront && !copyOfEarlierPart;
+    choice.flip[id] = choice.keep[id] && inFront;
   }
   return choice;
 }
@@ -506,12 +591,15 @@ std::array<std::uint8_t, 3> patchColour(int id) {
 
 std::string statusOf(const Patch& patch, int parts) {
   if (patch.winding.empty()) return "not classified";
-  std::string inside;
-  for (int p = 0; p < parts; ++p)
-    if (p != patch.part && patch.inside(p))
-      inside += (inside.empty() ? "" : ",") + std::to_string(p);
+  std::string inside, on;
+  for (int p = 0; p < parts; ++p) {
+    if (p == patch.part) continue;
+    if (patch.inside(p)) inside += (inside.empty() ? "" : ",") + std::to_string(p);
+    if (patch.coincident[p] != 0) on += (on.empty() ? "" : ",") + std::to_string(p);
+  }
   std::string status = patch.onUnionSurface() ? "outer surface" : "interior";
   if (parts > 1) status += inside.empty() ? "; outside the other parts" : "; inside part " + inside;
+  if (!on.empty()) status += "; on the surface of part " + on;
   return status;
 }
 
@@ -528,7 +616,8 @@ JsonObject toJson(const Patches& patches) {
     if (!p.winding.empty())
       j.set("winding", p.winding)
           .set("winding_outside", p.winding_outside)
-          .set("winding_inside", p.winding_inside);
+          .set("winding_inside", p.winding_inside)
+          .set("coincident", std::vector<double>(p.coincident.begin(), p.coincident.end()));
     list.push_back(j);
   }
   JsonObject j;

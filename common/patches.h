@@ -42,8 +42,26 @@ struct Patch {
   // less than on either side), and of all parts together just outside
   // (along the face normals) and just inside the patch.
   std::vector<double> winding;
-  double winding_outside = 0, winding_inside = 0;
-  bool inside(int otherPart) const { return winding[otherPart] > 0.5; }
+  // Per part: +1 where the patch lies on that part's surface facing the same
+  // way (its own part; another part's copy of a planar overlap), -1 facing
+  // the other way (two parts touching), 0 off it. On such a part's surface
+  // the winding number is ½ more behind the patch (against its normal) than
+  // on it, and ½ less in front, or the reverse when facing the other way.
+  std::vector<std::int8_t> coincident;
+  double windingInFront(int part) const { return winding[part] - 0.5 * coincident[part]; }
+  double windingBehind(int part) const { return winding[part] + 0.5 * coincident[part]; }
+  double winding_outside = 0, winding_inside = 0;  // all parts' together, in front and behind
+  void setSideWindings() {
+    winding_outside = winding_inside = 0;
+    for (int p = 0; p < int(winding.size()); ++p) {
+      winding_outside += windingInFront(p);
+      winding_inside += windingBehind(p);
+    }
+  }
+  // Inside another part on both sides (not on its surface).
+  bool inside(int otherPart) const {
+    return windingInFront(otherPart) > 0.5 && windingBehind(otherPart) > 0.5;
+  }
   // Inside (or, with inside = false, outside) every part but its own and `except`.
   bool insideAllOthers(bool inside, int except = -1) const {
     for (int p = 0; p < int(winding.size()); ++p)

@@ -167,6 +167,53 @@ TEST(Patches, UnionOfBoxesSharingASideIsOneClosedBox) {
   EXPECT_NEAR(*i.volume, 2, 1e-12);
 }
 
+// The boolean results of two unit boxes (2x2 grids on each side) where
+// they overlap in planes: each result's faces once, closed, of the expected
+// volume (0: nothing left).
+struct BoxCase {
+  const char* name;
+  Point3 offset;  // of the second box
+  double union_volume, intersection_volume, difference_volume;
+};
+
+TEST(Patches, BooleansOfBoxesOverlappingInPlanes) {
+  const BoxCase cases[] = {
+      {"the same box", {0, 0, 0}, 1, 1, 0},
+      {"half overlapping", {0.5, 0, 0}, 1.5, 0.5, 0.5},
+      {"half overlapping, sides shifted", {0.5, 0.5, 0}, 1.75, 0.25, 0.75},
+      {"touching along a side", {1, 0, 0}, 2, 0, 1},
+      {"touching along half a side", {1, 0.5, 0}, 2, 0, 1},
+  };
+  const Mesh a = testing::gridCube(2);
+  for (const BoxCase& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Mesh b = testing::moved(a, c.offset);
+    SplitResult r = splitAlongIntersections({&a, &b});
+    const FaceLabels labels = labelsOf(r);
+    Patches p = paintPatches(r.merged, labels);
+    classifyPatches(r.merged, labels, p);
+    const double expected[] = {c.union_volume, c.intersection_volume, c.difference_volume};
+    for (BooleanOperation op : {BooleanOperation::kUnion, BooleanOperation::kIntersection,
+                                BooleanOperation::kDifference}) {
+      SCOPED_TRACE(toString(op));
+      const PatchChoice choice = choosePatches(p, op);
+      const Mesh result = extractPatches(r.merged, p, choice.keep, choice.flip);
+      if (expected[int(op)] == 0) {
+        EXPECT_EQ(result.face.size(), 0u);
+        continue;
+      }
+      const InspectResult i = check(result);
+      EXPECT_TRUE(i.is_closed);
+      EXPECT_EQ(i.non_manifold_edges, 0u);
+      EXPECT_EQ(i.duplicate_faces, 0u);
+      EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+      EXPECT_TRUE(i.consistently_oriented);
+      ASSERT_TRUE(i.volume.has_value());
+      EXPECT_NEAR(*i.volume, expected[int(op)], 1e-12);
+    }
+  }
+}
+
 TEST(Patches, ClassificationWithHolesInTheOtherPart) {
   // A small sphere inside a big one with a hole cut at its top: the small
   // one is still inside, well above the ½ threshold.

@@ -496,8 +496,10 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
   for (char k : choice.keep) kept += k;
   if (kept == 0)
     throw InvalidInputError(
-        "nothing would be left: every patch would be removed (are the "
-        "layers intersected and split first?)");
+        "nothing would be left: every patch would be removed. The result is empty "
+        "when the parts' interiors do not overlap (an intersection), or the first "
+        "part lies inside the others (a difference); if the layers cross, run "
+        "'Intersect and Split Layers' first");
   reportProgress(progressFrom(cb), 60, "Extracting the kept patches");
   const Mesh result = extractPatches(a.mesh, p, choice.keep, choice.flip);
   std::vector<char> removedPatches(choice.keep.size());

@@ -279,8 +279,9 @@ py::dict removeArrays(py::handle vertices, py::handle faces, py::kwargs kwargs) 
   for (char k : choice.keep) kept += k != 0;
   if (kept == 0)
     throw InvalidInputError(
-        "nothing would be left: every patch would be removed (are the meshes intersected and "
-        "split first?)");
+        "nothing would be left: every patch would be removed. The result is empty when the "
+        "parts' interiors do not overlap (an intersection), or the first part lies inside the "
+        "others (a difference); if the meshes cross, intersect_and_split them first");
   const Mesh result = call([&] { return extractPatches(mesh, p, choice.keep, choice.flip); });
 
   JsonObject report;

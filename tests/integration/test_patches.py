@@ -114,6 +114,33 @@ def test_select_and_remove_by_hand(tmp_path):
     assert "layer 'removed patches'" in run.log
 
 
+@pytest.mark.parametrize("offset,volumes", [
+    ((0, 0, 0), {"union": 1, "intersection": 1, "difference": 0}),           # the same cube
+    ((0.5, 0, 0), {"union": 1.5, "intersection": 0.5, "difference": 0.5}),   # half overlapping
+    ((0.5, 0.5, 0), {"union": 1.75, "intersection": 0.25, "difference": 0.75}),
+    ((1, 0, 0), {"union": 2, "intersection": 0, "difference": 1}),           # touching
+    ((1, 0.5, 0), {"union": 2, "intersection": 0, "difference": 1}),         # along half a side
+])
+def test_booleans_of_cubes_overlapping_in_planes(tmp_path, offset, volumes):
+    """CAD parts often share planes: each overlap bounds a result once (or
+    not at all), and an empty result is refused with a message that says why."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", [tuple(x + d for x, d in zip(v, offset)) for v in V], F)
+    for operation, volume in volumes.items():
+        out = tmp_path / f"{operation}.ply"
+        run = run_server(tmp_path, [a, b], sample(SAMPLES[operation]), outputs=[out])
+        if volume == 0:
+            assert run.returncode != 0 and "The result is empty when" in run.log, run.log[-2000:]
+            continue
+        assert run.returncode == 0, run.log[-3000:]
+        check = meshcheck(out)
+        assert check["is_closed"] and check["border_edges"] == 0, (operation, check)
+        assert check["non_manifold_edges"] == 0 and check["duplicate_faces"] == 0, (operation, check)
+        assert check["self_intersecting_pairs"] == 0 and check["consistently_oriented"], operation
+        assert check["volume"] == pytest.approx(volume, abs=1e-6), (operation, check["volume"])
+
+
 def test_bad_input(tmp_path):
     V, F = cube()
     a = write_off(tmp_path / "a.off", V, F)
