@@ -1840,7 +1840,7 @@ std::size_t degenerateNewFaces(const SplitResult& result) {
 }
 
 FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options, bool repairMerged) {
+                              const SplitOptions& options) {
   FloatOutput out;
   out.crossing = roundToFloat(r);
   SplitOptions used = options;
@@ -1862,8 +1862,9 @@ FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& in
     }
   }
   // What is left crosses as rounded: the merged output is split again along
-  // those crossings, on its float values, and rounded again.
-  if (out.crossing > 0 && repairMerged) {
+  // those crossings, on its float values, and rounded again (the separate
+  // outputs follow).
+  if (out.crossing > 0) {
     reportProgress(options.progress, 97, "Splitting the rounded result where it crosses");
     out.crossing = splitRoundedAgain(r, inputs, used);
   }
@@ -2077,9 +2078,67 @@ void carryCurveEdge(int a, int b, const Mesh& mesh,
 
 }  // namespace
 
+namespace {
+
+// Each input's own output again from the merged output (after
+// splitRoundedAgain changed it): its vertices in their order, each at its
+// merged vertex (two that became one, once), then the new vertices its faces
+// use; its faces as the merged output has them; its curve edges, those of
+// the merged output along its faces.
+void separateFromMerged(SplitResult& r) {
+  Mesh& merged = r.merged;
+  FaceOriginHandle mergedFace = faceOrigins(merged);
+  VertexOriginHandle mergedVertex = vertexOrigins(merged);
+  std::set<std::array<int, 2>> curves(r.merged_curve_edges.begin(), r.merged_curve_edges.end());
+  for (std::size_t m = 0; m < r.meshes.size(); ++m) {
+    VertexOriginHandle oldVertex = vertexOrigins(r.meshes[m]);
+    const std::vector<int>& globalOf = r.merged_vertex[m];
+    OutputArrays out;
+    std::vector<int> newGlobalOf;
+    std::unordered_map<int, int> localOf;  // merged vertex -> its vertex here
+    for (std::size_t u = 0; u < globalOf.size(); ++u) {
+      const int g = globalOf[u];
+      if (g >= 0 && localOf.count(g)) continue;
+      if (g >= 0) localOf.emplace(g, int(out.positions.size()));
+      out.positions.push_back(g >= 0 ? merged.vert[g].cP() : r.meshes[m].vert[u].cP());
+      out.vertex_origin.push_back(oldVertex[u]);
+      newGlobalOf.push_back(g);
+    }
+    std::set<std::array<int, 2>> meshCurves;
+    for (std::size_t f = 0; f < merged.face.size(); ++f) {
+      if (mergedFace[f].layer != int(m)) continue;
+      Triangle global, local;
+      for (int k = 0; k < 3; ++k) {
+        global[k] = int(vcg::tri::Index(merged, merged.face[f].cV(k)));
+        auto [it, added] = localOf.emplace(global[k], int(out.positions.size()));
+        if (added) {
+          out.positions.push_back(merged.vert[global[k]].cP());
+          out.vertex_origin.push_back(mergedVertex[global[k]]);
+          newGlobalOf.push_back(global[k]);
+        }
+        local[k] = it->second;
+      }
+      out.triangles.push_back(local);
+      out.face_origin.push_back(mergedFace[f]);
+      for (int k = 0; k < 3; ++k) {
+        const int a = global[k], b = global[(k + 1) % 3];
+        if (curves.count({std::min(a, b), std::max(a, b)}))
+          meshCurves.insert(
+              {std::min(local[k], local[(k + 1) % 3]), std::max(local[k], local[(k + 1) % 3])});
+      }
+    }
+    out.toMesh(r.meshes[m]);
+    r.merged_vertex[m] = std::move(newGlobalOf);
+    r.curve_edges[m].assign(meshCurves.begin(), meshCurves.end());
+  }
+}
+
+}  // namespace
+
 std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options, int rounds) {
   requireMergedOutput(r, "splitting the rounded output again");
+  const std::size_t splitBefore = r.pairs_split_after_rounding;
   std::size_t left = std::numeric_limits<std::size_t>::max();  // not counted yet
   for (int round = 0; round < rounds && left > 0 && r.merged.fn > 0; ++round) {
     const auto start = std::chrono::steady_clock::now();
@@ -2177,6 +2236,7 @@ std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& in
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     left = stillCrossing;
   }
+  if (r.pairs_split_after_rounding > splitBefore && !r.meshes.empty()) separateFromMerged(r);
   return left == std::numeric_limits<std::size_t>::max() ? remainingIntersections(r, true) : left;
 }
 

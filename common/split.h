@@ -129,9 +129,11 @@ std::size_t roundToFloat(SplitResult& result, int passes = 4);
 // left. Points that the float values put a step apart now meet where
 // they cross. Provenance goes through to `inputs` (the meshes split first,
 // for the barycentric coordinates of new vertices), and the merged output's
-// curve edges, new-face flags and merged_vertex follow; `meshes` (separate
-// outputs) do not change. Uses options.snap_float_steps. Returns the pairs
-// still crossing (as roundToFloat counts them).
+// curve edges, new-face flags and merged_vertex follow, and `meshes`
+// (separate outputs), when there are any, are made again from the merged
+// output (each input's vertices in their order, then the new ones). Uses
+// options.snap_float_steps. Returns the pairs still crossing (as
+// roundToFloat counts them).
 std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options, int rounds = 3);
 
@@ -148,11 +150,11 @@ struct FloatOutput {
 // The result as a float host (MeshLab 2020.09) stores it: rounded
 // (roundToFloat); where that left crossings or collapsed new faces and
 // options.snap_float_steps was 0, the split of `inputs` again with
-// snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then,
-// with `repairMerged`, what still crosses in the merged output split again
-// (splitRoundedAgain).
+// snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then
+// what still crosses split again (splitRoundedAgain; the separate outputs
+// follow the merged one).
 FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options, bool repairMerged);
+                              const SplitOptions& options);
 
 // Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not

@@ -1,5 +1,7 @@
 #include "common/split.h"
 
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include "common/errors.h"
@@ -423,6 +425,51 @@ TEST(Split, CrossingsLeftByRoundingAreSplitAgain) {
   for (int m = 0; m < 2; ++m)
     for (std::size_t v = 0; v < inputs[m]->vert.size(); ++v)
       EXPECT_LT(Distance(r.merged.vert[r.merged_vertex[m][v]].cP(), inputs[m]->vert[v].cP()), 1e-6);
+}
+
+TEST(Split, SeparateOutputsFollowTheSplitAfterRounding) {
+  // The tubes above, kept as separate outputs: what the float host stores
+  // is each input's own mesh, so the repair of the merged output must reach
+  // them. Each is the merged output's faces of its input, vertex for vertex,
+  // its input vertices first in their places, and crosses nothing itself.
+  const Mesh tube = testing::cappedCylinder(24, 4, 0.5, 0.5, -1, 2);
+  const Mesh a = cycled(tube, 1), b = cycled(tube, 2);
+  SplitOptions o;
+  o.separate_meshes = true;
+  SplitResult r = splitAlongIntersections({&a, &b}, o);
+  const FloatOutput stored = roundForFloatHost(r, {&a, &b}, o);
+  EXPECT_GT(r.pairs_split_after_rounding, 0u);  // the repair ran
+  EXPECT_EQ(stored.crossing, 0u);
+  ASSERT_EQ(r.meshes.size(), 2u);
+  FaceOriginHandle fo = faceOrigins(r.merged);
+  const Mesh* inputs[2] = {&a, &b};
+  for (int m = 0; m < 2; ++m) {
+    SCOPED_TRACE(m);
+    const Mesh& mesh = r.meshes[m];
+    ASSERT_EQ(r.merged_vertex[m].size(), mesh.vert.size());
+    for (std::size_t v = 0; v < inputs[m]->vert.size(); ++v)
+      EXPECT_LT(Distance(mesh.vert[v].cP(), inputs[m]->vert[v].cP()), 1e-6);
+    std::multiset<std::array<int, 3>> here, there;
+    for (const Face& f : mesh.face) {
+      std::array<int, 3> t;
+      for (int k = 0; k < 3; ++k) {
+        const int v = int(vcg::tri::Index(mesh, f.cV(k)));
+        t[k] = r.merged_vertex[m][v];
+        EXPECT_EQ(mesh.vert[v].cP(), r.merged.vert[t[k]].cP());
+      }
+      here.insert(t);
+    }
+    for (std::size_t f = 0; f < r.merged.face.size(); ++f)
+      if (fo[f].layer == m)
+        there.insert({int(vcg::tri::Index(r.merged, r.merged.face[f].cV(0))),
+                      int(vcg::tri::Index(r.merged, r.merged.face[f].cV(1))),
+                      int(vcg::tri::Index(r.merged, r.merged.face[f].cV(2)))});
+    EXPECT_EQ(here, there);
+    const InspectResult i = check(mesh);
+    EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+    EXPECT_TRUE(i.is_closed);
+    EXPECT_FALSE(r.curve_edges[m].empty());
+  }
 }
 
 TEST(Split, TJunctionOfTwoCurvesInOneFace) {

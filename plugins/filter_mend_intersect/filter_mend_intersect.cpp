@@ -323,7 +323,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   FloatOutput stored;
   if (kHostStoresFloat) {
     reportProgress(progressFrom(cb), 95, "Rounding to float");
-    stored = roundForFloatHost(r, in.meshes, options, merge);
+    stored = roundForFloatHost(r, in.meshes, options);
     remaining = stored.crossing;
   }
   const bool verify = parameters.getBool("verify");
@@ -350,10 +350,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   const std::size_t collapsed = degenerateNewFaces(r);
   if (collapsed > 0)
     Log("  warning: %zu new faces are degenerate (collinear corners) as stored", collapsed);
-  if (verify && remaining > 0 && kHostStoresFloat && r.complete && !merge)
-    Log("  warning: as rounded to float, faces of the layers still cross where they meet at a "
-        "very small angle: the merged output ('Merge into one welded layer') splits them again");
-  else if (verify && remaining > 0 && kHostStoresFloat && r.complete && options.snap_tolerance <= 0)
+  if (verify && remaining > 0 && kHostStoresFloat && r.complete && options.snap_tolerance <= 0)
     Log("  warning: where curve points lie a few float steps apart (surfaces meeting at a very "
         "small angle), no float rounding keeps every face apart: run again with a quality "
         "snapping tolerance of 0.05, which merges such points");

@@ -156,8 +156,7 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   std::size_t remaining = 0;
   const auto start = std::chrono::steady_clock::now();
   FloatOutput stored;  // as the MeshLab filter stores it
-  if (c.round_to_float)
-    stored = call([&] { return roundForFloatHost(r, pointers, c.core, !c.core.separate_meshes); });
+  if (c.round_to_float) stored = call([&] { return roundForFloatHost(r, pointers, c.core); });
   if (c.verify)  // the whole merged output as returned, by the self-intersection rule
     remaining = call([&] { return remainingIntersections(r, c.round_to_float); });
   r.time_ms +=

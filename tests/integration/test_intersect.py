@@ -233,6 +233,20 @@ def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
         assert check["border_edges"] == 0
 
 
+def test_separate_layers_of_tangent_tubes_are_repaired_as_float(tmp_path):
+    """The same tubes kept as separate layers: the repair of the float
+    result reaches each layer (what MeshLab stores), not only a merged one."""
+    a = write_off(tmp_path / "a.off", *tube(0))
+    b = write_off(tmp_path / "b.off", *tube(1))
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 0,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script)
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["output"] == "separate" and r["pairs_split_after_rounding"] > 0
+    assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_new_faces"] == 0
+
+
 def test_split_of_a_layer_that_meets_itself_only_through_duplicates(tmp_path):
     """A cube listed twice in one layer (its own vertices each time): welded,
     the second copy is duplicate faces; removing them is the whole repair,

@@ -310,6 +310,38 @@ def test_split_rounded_to_float_keeps_faces_apart(tmp_path):
         assert len(V) == len(W)
 
 
+def tube(axis, n=24, rings=4, r=0.5, h=2.0):
+    """A capped cylinder along `axis`, centred at the origin."""
+    V = [(r * np.cos(2 * np.pi * j / n), r * np.sin(2 * np.pi * j / n), -h / 2 + h * k / rings)
+         for k in range(rings + 1) for j in range(n)]
+    F = []
+    for k in range(rings):
+        for j in range(n):
+            a, b = k * n + j, k * n + (j + 1) % n
+            F += [(a, b, b + n), (a, b + n, a + n)]
+    V += [(0, 0, -h / 2), (0, 0, h / 2)]
+    for j in range(n):
+        F += [(len(V) - 2, (j + 1) % n, j), (len(V) - 1, rings * n + j, rings * n + (j + 1) % n)]
+    turn = {0: [2, 0, 1], 1: [1, 2, 0], 2: [0, 1, 2]}[axis]  # cyclic: orientation kept
+    return np.array(V)[:, turn], np.array(F, dtype=np.int64)
+
+
+def test_separate_meshes_rounded_to_float_are_repaired_too(tmp_path):
+    # Tubes of one radius crossing at right angles touch tangentially; as
+    # floats some faces cross, and the merged result is split again there.
+    # The separate meshes follow: welded where they meet, nothing crosses.
+    (A, F), (B, G) = tube(0), tube(1)
+    out = mm.intersect_and_split(A, F, B, G, round_to_float=True)
+    assert out.report["pairs_split_after_rounding"] > 0
+    (V0, F0), (V1, F1) = out.meshes
+    V, inverse = np.unique(np.vstack([V0, V1]), axis=0, return_inverse=True)
+    faces = inverse.reshape(-1)[np.vstack([F0, F1 + len(V0)])]
+    check = meshcheck(write_off(tmp_path / "welded.off", V, faces))
+    assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
+    assert check["border_edges"] == 0
+    assert len(faces) == len(out.merged[1])
+
+
 def test_split_rounded_to_float_repairs_points_a_float_step_apart(tmp_path):
     # Here curve points lie a few float steps apart: no rounding alone keeps
     # every face apart. Rounding for a float host merges such points (or
