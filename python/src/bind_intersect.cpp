@@ -134,7 +134,8 @@ OptionTable<SplitCall> splitTable() {
       "round the output to float (as MeshLab and STL, float PLY or OBJ files store it), "
       "re-rounding curve points where rounding to nearest would make faces cross, merging curve "
       "points a few float steps apart and splitting the merged output again where it still "
-      "crosses, as the MeshLab filter does; the check then counts the float output");
+      "crosses (the separate meshes follow it), as the MeshLab filter does; the check then "
+      "counts the float output");
   t.add(
       "verify", [](SplitCall& c) -> bool& { return c.verify; },
       "count the intersecting pairs left in the merged output (remaining_intersecting_pairs)");
