@@ -377,30 +377,57 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
   // patch (a closed mesh passing through a scan's hole). Faces spread over
   // each patch reveal it; such a patch is split by classifying every face,
   // along the level set where the other part's winding number crosses ½.
-  auto statusOf = [&](const std::vector<double>& winding) {
-    std::uint64_t status = 0;
-    double total = 0;
+  // Per part: inside it or not, and whether on the union's surface; a part
+  // whose surface the patch lies on (a planar overlap) counts on each side,
+  // as its winding number there is ½ off either way.
+  auto statusOf = [&](const std::vector<double>& winding, const Patch& patch) {
+    std::vector<std::uint8_t> status(patches.parts + 1, 0);
+    double front = 0, behind = 0;
     for (int p = 0; p < patches.parts; ++p) {
-      total += winding[p];
-      if (winding[p] > 0.5 && p < 63) status |= std::uint64_t(1) << p;
+      const int c = p == patch.part ? 1 : patch.coincident[p];
+      front += winding[p] - 0.5 * c;
+      behind += winding[p] + 0.5 * c;
+      if (p == patch.part || c == 0)
+        status[p] = winding[p] > 0.5 ? 3 : 0;
+      else
+        status[p] = std::uint8_t((winding[p] - 0.5 * c > 0.5) | (winding[p] + 0.5 * c > 0.5) << 1);
     }
-    if (total - 0.5 < 0.5 && total + 0.5 > 0.5) status |= std::uint64_t(1) << 63;
+    status[patches.parts] = front < 0.5 && behind > 0.5;
     return status;
   };
   // A closed part's winding number is the same all over a patch that does
   // not cross it: only the open parts' change from face to face.
   if (std::all_of(patches.part_closed.begin(), patches.part_closed.end(), [](bool c) { return c; }))
     return;
-  auto windingAt = [&](int f) {
-    std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
-    const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
-    for (int p = 0; p < patches.parts; ++p)
-      if (!patches.part_closed[p]) w[p] = trees[p].at(c, f);
-    return w;
-  };
   std::vector<std::vector<int>> facesOfPatch(patches.patches.size());
   for (std::size_t f = 0; f < T.size(); ++f)
     facesOfPatch[patches.patch_of_face[f]].push_back(int(f));
+  // On an open part's surface (a planar overlap), each face's own twin is
+  // left out, as for the samples.
+  std::vector<std::vector<int>> onOtherParts(1);
+  for (std::size_t id = 0; id < patches.patches.size(); ++id) {
+    const Patch& patch = patches.patches[id];
+    for (int p = 0; p < patches.parts; ++p)
+      if (p != patch.part && patch.coincident[p] != 0 && !patches.part_closed[p]) {
+        onOtherParts[0].insert(onOtherParts[0].end(), facesOfPatch[id].begin(),
+                               facesOfPatch[id].end());
+        break;
+      }
+  }
+  const std::unordered_map<int, FaceTwins> faceTwins =
+      onOtherParts[0].empty() ? std::unordered_map<int, FaceTwins>()
+                              : twinsOf(P, T, onOtherParts, partOf, patches.parts);
+  auto windingAt = [&](int f) {
+    std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
+    const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
+    const auto twins = faceTwins.find(f);
+    for (int p = 0; p < patches.parts; ++p) {
+      if (patches.part_closed[p]) continue;
+      const int twin = twins == faceTwins.end() ? -1 : twins->second.in(p).face;
+      w[p] = trees[p].at(c, twin >= 0 ? twin : f);
+    }
+    return w;
+  };
   constexpr std::size_t kProbes = 32;
   std::vector<char> mixed(patches.patches.size(), 0);
   parallelChunks(
@@ -408,10 +435,11 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t id = begin; id < end; ++id) {
           const std::vector<int>& faces = facesOfPatch[id];
-          const std::uint64_t status = statusOf(patches.patches[id].winding);
+          const Patch& patch = patches.patches[id];
+          const std::vector<std::uint8_t> status = statusOf(patch.winding, patch);
           const std::size_t step = std::max<std::size_t>(1, faces.size() / kProbes);
           for (std::size_t k = step / 2; k < faces.size() && !mixed[id]; k += step)
-            mixed[id] = statusOf(windingAt(faces[k])) != status;
+            mixed[id] = statusOf(windingAt(faces[k]), patch) != status;
         }
       },
       1);
@@ -435,7 +463,8 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
       const int f = uses[i].face, g = uses[i + 1].face;
       const int id = patches.patch_of_face[f];
       if (id == patches.patch_of_face[g] && mixed[id] &&
-          statusOf(faceWinding[f]) == statusOf(faceWinding[g])) {
+          statusOf(faceWinding[f], patches.patches[id]) ==
+              statusOf(faceWinding[g], patches.patches[id])) {
         const int a = find(parent, f), b = find(parent, g);
         if (a != b) parent[std::max(a, b)] = std::min(a, b);
       }

@@ -214,6 +214,49 @@ TEST(Patches, BooleansOfBoxesOverlappingInPlanes) {
   }
 }
 
+TEST(Patches, APlanarOverlapWithAnOpenPartIsKeptOnce) {
+  // A closed box and the same box without its bottom (open), at coordinates
+  // no float makes exact (face centres lie a rounding off their planes):
+  // the five shared sides bound the intersection once, by the first part's
+  // copy, unbroken by the open part's own faces there.
+  const Mesh unit = testing::gridCube(2, 0.1);
+  const std::vector<Point3> grid = positionsOf(unit);
+  const std::vector<Triangle> all = trianglesOf(unit);
+  std::vector<Triangle> open;
+  for (const Triangle& t : all)
+    if (!(grid[t[0]][2] == 0 && grid[t[1]][2] == 0 && grid[t[2]][2] == 0)) open.push_back(t);
+  // Turned about an oblique axis and moved: no side is axis-aligned.
+  std::vector<Point3> points;
+  const double c = std::cos(0.7), s = std::sin(0.7), c2 = std::cos(0.3), s2 = std::sin(0.3);
+  for (const Point3& q : grid) {
+    const Point3 r(c * q[0] - s * q[1], s * q[0] + c * q[1], q[2]);
+    points.emplace_back(r[0] + 0.1 / 3, c2 * r[1] - s2 * r[2] + 0.2 / 3, s2 * r[1] + c2 * r[2]);
+  }
+  const Mesh a = makeMesh(points, all), b = makeMesh(points, open);
+  ASSERT_EQ(open.size() + 8, all.size());
+  SplitResult r = splitAlongIntersections({&a, &b});
+  const FaceLabels labels = labelsOf(r);
+  Patches p = paintPatches(r.merged, labels);
+  classifyPatches(r.merged, labels, p);
+  EXPECT_TRUE(p.part_closed[0]);
+  EXPECT_FALSE(p.part_closed[1]);
+  const PatchChoice choice = choosePatches(p, BooleanOperation::kIntersection);
+  // Faces of the shared sides: the first part's kept, the second's not.
+  std::size_t keptShared = 0, keptOfSecond = 0;
+  for (std::size_t f = 0; f < r.merged.face.size(); ++f) {
+    const int birth = faceOrigins(r.merged)[f].face;
+    const bool bottom = labels.part[f] == 0 && grid[all[birth][0]][2] == 0 &&
+                        grid[all[birth][1]][2] == 0 && grid[all[birth][2]][2] == 0;
+    if (bottom || !choice.keep[p.patch_of_face[f]]) continue;
+    if (labels.part[f] == 0)
+      ++keptShared;
+    else
+      ++keptOfSecond;
+  }
+  EXPECT_EQ(keptShared, open.size());
+  EXPECT_EQ(keptOfSecond, 0u);
+}
+
 TEST(Patches, ClassificationWithHolesInTheOtherPart) {
   // A small sphere inside a big one with a hole cut at its top: the small
   // one is still inside, well above the ½ threshold.
