@@ -2082,9 +2082,9 @@ namespace {
 
 // Each input's own output again from the merged output (after
 // splitRoundedAgain changed it): its vertices in their order, each at its
-// merged vertex (two that became one, once), then the new vertices its faces
-// use; its faces as the merged output has them; its curve edges, those of
-// the merged output along its faces.
+// merged vertex (of two that became one, the first is used by the faces),
+// then the new vertices its faces use; its faces as the merged output has them; its curve edges,
+// those of the merged output along its faces.
 void separateFromMerged(SplitResult& r) {
   Mesh& merged = r.merged;
   FaceOriginHandle mergedFace = faceOrigins(merged);
@@ -2095,11 +2095,10 @@ void separateFromMerged(SplitResult& r) {
     const std::vector<int>& globalOf = r.merged_vertex[m];
     OutputArrays out;
     std::vector<int> newGlobalOf;
-    std::unordered_map<int, int> localOf;  // merged vertex -> its vertex here
-    for (std::size_t u = 0; u < globalOf.size(); ++u) {
+    std::unordered_map<int, int> localOf;                // merged vertex -> its vertex here
+    for (std::size_t u = 0; u < globalOf.size(); ++u) {  // each in its place, also two that met
       const int g = globalOf[u];
-      if (g >= 0 && localOf.count(g)) continue;
-      if (g >= 0) localOf.emplace(g, int(out.positions.size()));
+      if (g >= 0) localOf.emplace(g, int(u));  // the first of them takes the faces
       out.positions.push_back(g >= 0 ? merged.vert[g].cP() : r.meshes[m].vert[u].cP());
       out.vertex_origin.push_back(oldVertex[u]);
       newGlobalOf.push_back(g);
@@ -2236,7 +2235,11 @@ std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& in
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     left = stillCrossing;
   }
-  if (r.pairs_split_after_rounding > splitBefore && !r.meshes.empty()) separateFromMerged(r);
+  // (Where planar overlaps were kept once, the merged output no longer
+  // holds each input whole: the separate outputs stay as they were.)
+  if (r.pairs_split_after_rounding > splitBefore && !r.meshes.empty() &&
+      r.coincident_faces_removed == 0)
+    separateFromMerged(r);
   return left == std::numeric_limits<std::size_t>::max() ? remainingIntersections(r, true) : left;
 }
 

@@ -131,7 +131,8 @@ std::size_t roundToFloat(SplitResult& result, int passes = 4);
 // for the barycentric coordinates of new vertices), and the merged output's
 // curve edges, new-face flags and merged_vertex follow, and `meshes`
 // (separate outputs), when there are any, are made again from the merged
-// output (each input's vertices in their order, then the new ones). Uses
+// output (each input's vertices in their order, then the new ones), unless
+// planar overlaps were kept once there (overlaps_once: then they stay). Uses
 // options.snap_float_steps. Returns the pairs still crossing (as
 // roundToFloat counts them).
 std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,

@@ -298,7 +298,8 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.self = mode == kWithinCurrent || parameters.getBool("split_self_intersections");
   options.weld_duplicates = parameters.getBool("weld_duplicate_vertices");
   options.remove_duplicate_faces = parameters.getBool("remove_duplicate_faces");
-  options.overlaps_once = parameters.getBool("overlaps_once");
+  // Only the merged layer keeps planar overlaps once: separate layers stay whole.
+  options.overlaps_once = parameters.getEnum("output") == 1 && parameters.getBool("overlaps_once");
   options.snap_tolerance = parameters.getFloat("snap_tolerance");
   if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
     throw InvalidInputError("the snapping tolerance must be at least 0 (off) and below 0.5");
