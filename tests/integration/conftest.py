@@ -5,6 +5,7 @@ independent checker `meshcheck` from ../shared/tools."""
 import json
 import os
 import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from xml.sax.saxutils import escape
 from pathlib import Path
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.append(str(ROOT / "tests"))  # shapes.py, shared with the Python module's tests
 BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
 SHARED = Path(os.environ.get("MESHMEND_SHARED_DIR", ROOT.parent / "shared"))
 DATA = SHARED / "data"

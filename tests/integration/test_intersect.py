@@ -1,9 +1,9 @@
 """MeshMend: Select Intersecting Faces, through the real meshlabserver."""
-import math
 
 import pytest
 
 from conftest import MESHCHECK, ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
+from shapes import tube
 
 SELECT = "MeshMend: Select Intersecting Faces"
 
@@ -200,22 +200,6 @@ def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
     if check:
         assert check["faces"] == 12 and check["duplicate_faces"] == 0
         assert check["self_intersecting_pairs"] == 0 and check["border_edges"] == 0
-
-
-def tube(axis, n=24, rings=4, r=0.5, h=2.0):
-    """A capped cylinder along `axis`, centred at the origin (as CAD exports one)."""
-    V = [(r * math.cos(2 * math.pi * j / n), r * math.sin(2 * math.pi * j / n), -h / 2 + h * k / rings)
-         for k in range(rings + 1) for j in range(n)]
-    F = []
-    for k in range(rings):
-        for j in range(n):
-            a, b = k * n + j, k * n + (j + 1) % n
-            F += [(a, b, b + n), (a, b + n, a + n)]
-    V += [(0, 0, -h / 2), (0, 0, h / 2)]
-    for j in range(n):
-        F += [(len(V) - 2, (j + 1) % n, j), (len(V) - 1, rings * n + j, rings * n + (j + 1) % n)]
-    turn = {0: (2, 0, 1), 1: (1, 2, 0), 2: (0, 1, 2)}[axis]  # cyclic: orientation kept
-    return [(v[turn[0]], v[turn[1]], v[turn[2]]) for v in V], F
 
 
 def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):

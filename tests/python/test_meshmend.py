@@ -24,8 +24,10 @@ ROOT = Path(__file__).resolve().parents[2]
 BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
 MESHCHECK = Path(os.environ.get("MESHMEND_MESHCHECK", BUILD / "shared-tools" / "meshcheck"))
 sys.path.insert(0, str(BUILD / "python"))
+sys.path.append(str(ROOT / "tests"))  # shapes.py, shared with the meshlabserver tests
 
 import meshmend as mm  # noqa: E402
+from shapes import tube  # noqa: E402
 
 
 def test_the_module_under_test_is_the_build_s():
@@ -308,22 +310,6 @@ def test_split_rounded_to_float_keeps_faces_apart(tmp_path):
     assert meshcheck(write_off(tmp_path / "rounded.off", RV, RF))["self_intersecting_pairs"] == 0
     for (V, _), (W, _) in zip(out.meshes, exact.meshes):
         assert len(V) == len(W)
-
-
-def tube(axis, n=24, rings=4, r=0.5, h=2.0):
-    """A capped cylinder along `axis`, centred at the origin."""
-    V = [(r * np.cos(2 * np.pi * j / n), r * np.sin(2 * np.pi * j / n), -h / 2 + h * k / rings)
-         for k in range(rings + 1) for j in range(n)]
-    F = []
-    for k in range(rings):
-        for j in range(n):
-            a, b = k * n + j, k * n + (j + 1) % n
-            F += [(a, b, b + n), (a, b + n, a + n)]
-    V += [(0, 0, -h / 2), (0, 0, h / 2)]
-    for j in range(n):
-        F += [(len(V) - 2, (j + 1) % n, j), (len(V) - 1, rings * n + j, rings * n + (j + 1) % n)]
-    turn = {0: [2, 0, 1], 1: [1, 2, 0], 2: [0, 1, 2]}[axis]  # cyclic: orientation kept
-    return np.array(V)[:, turn], np.array(F, dtype=np.int64)
 
 
 def test_separate_meshes_rounded_to_float_are_repaired_too(tmp_path):
