@@ -377,22 +377,16 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
   // patch (a closed mesh passing through a scan's hole). Faces spread over
   // each patch reveal it; such a patch is split by classifying every face,
   // along the level set where the other part's winding number crosses ½.
-  // Per part: inside it or not, and whether on the union's surface; a part
-  // whose surface the patch lies on (a planar overlap) counts on each side,
-  // as its winding number there is ½ off either way.
+  // Per part: inside it in front of the patch and behind it (on a part's
+  // surface, one side only), and whether the patch is on the union's surface.
   auto statusOf = [&](const std::vector<double>& winding, const Patch& patch) {
+    Patch at = patch;
+    at.winding = winding;
+    at.setSideWindings();
     std::vector<std::uint8_t> status(patches.parts + 1, 0);
-    double front = 0, behind = 0;
-    for (int p = 0; p < patches.parts; ++p) {
-      const int c = p == patch.part ? 1 : patch.coincident[p];
-      front += winding[p] - 0.5 * c;
-      behind += winding[p] + 0.5 * c;
-      if (p == patch.part || c == 0)
-        status[p] = winding[p] > 0.5 ? 3 : 0;
-      else
-        status[p] = std::uint8_t((winding[p] - 0.5 * c > 0.5) | (winding[p] + 0.5 * c > 0.5) << 1);
-    }
-    status[patches.parts] = front < 0.5 && behind > 0.5;
+    for (int p = 0; p < patches.parts; ++p)
+      status[p] = std::uint8_t((at.windingInFront(p) > 0.5) | (at.windingBehind(p) > 0.5) << 1);
+    status[patches.parts] = at.onUnionSurface();
     return status;
   };
   // A closed part's winding number is the same all over a patch that does
@@ -448,10 +442,15 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
     if (mixed[id]) refine.insert(refine.end(), facesOfPatch[id].begin(), facesOfPatch[id].end());
   if (refine.empty()) return;
   std::vector<std::vector<double>> faceWinding(T.size());
+  std::vector<std::vector<std::uint8_t>> faceStatus(T.size());
   parallelChunks(
       refine.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t i = begin; i < end; ++i) faceWinding[refine[i]] = windingAt(refine[i]);
+        for (std::size_t i = begin; i < end; ++i) {
+          const int f = refine[i];
+          faceWinding[f] = windingAt(f);
+          faceStatus[f] = statusOf(faceWinding[f], patches.patches[patches.patch_of_face[f]]);
+        }
       },
       256);
   std::vector<int> parent(T.size());
@@ -462,9 +461,7 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
     if (j - i == 2) {
       const int f = uses[i].face, g = uses[i + 1].face;
       const int id = patches.patch_of_face[f];
-      if (id == patches.patch_of_face[g] && mixed[id] &&
-          statusOf(faceWinding[f], patches.patches[id]) ==
-              statusOf(faceWinding[g], patches.patches[id])) {
+      if (id == patches.patch_of_face[g] && mixed[id] && faceStatus[f] == faceStatus[g]) {
         const int a = find(parent, f), b = find(parent, g);
         if (a != b) parent[std::max(a, b)] = std::min(a, b);
       }
