@@ -204,12 +204,13 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
   return findIntersectionsInArrays(pointers, options);
 }
 
-std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat) {
+std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat, bool sameVertices) {
   MeshArrays arrays = arraysOf(mesh);
   if (asFloat)
     for (Point3& p : arrays.points) p = roundedToFloat(p);
   FindIntersectionsOptions o;
   o.cross = false;
+  o.same_vertices = sameVertices;
   return findIntersectionsInArrays({&arrays}, o).self_pairs[0];
 }
 
@@ -273,7 +274,8 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
       trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
         if (s.degenerate[f] || s.degenerate[g]) return;
         ++found[worker].candidates;
-        if (selfIntersect(s, f, g))
+        if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
+            selfIntersect(s, f, g))
           found[worker].pairs.push_back(
               {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
       });

@@ -20,8 +20,14 @@ struct FindIntersectionsOptions {
   bool self = true;       // pairs of faces of the same mesh
   bool cross = true;      // pairs of faces of different meshes
   bool contacts = false;  // classify every pair and keep its exact contact points
-  int layout = 0;         // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
-  Progress progress;      // called between stages
+  // Two faces of one mesh with the same three vertices (the same face twice:
+  // duplicate faces, or a planar overlap kept in each part of a welded
+  // merged mesh) are a pair. They coincide everywhere, so splitting finds
+  // nothing in them and no rounding moves them apart: the split and its
+  // checks of the float result leave them out.
+  bool same_vertices = true;
+  int layout = 0;     // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
+  Progress progress;  // called between stages
 };
 
 // A face of one of the input meshes.
@@ -64,8 +70,9 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
 
 // Self-intersecting pairs of one mesh (the self-intersection rule), with its
 // coordinates as stored or, with `asFloat`, rounded to float as MeshLab
-// stores them.
-std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false);
+// stores them; faces with the same three vertices count unless
+// `sameVertices` is false (FindIntersectionsOptions::same_vertices).
+std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false, bool sameVertices = true);
 
 // Candidate pairs (box overlap) of faces of (points, triangles) where at
 // least one face is `changed`: after a local edit only those pairs can

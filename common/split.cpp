@@ -1440,6 +1440,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   find.self = options.self;
   find.cross = options.between_meshes;
   find.contacts = true;
+  find.same_vertices = false;
   find.progress = [&](int percent, const char* stage) {
     return !options.progress || options.progress(percent * 4 / 10, stage);
   };
@@ -1873,7 +1874,7 @@ FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& in
 
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
   requireMergedOutput(result, "counting the intersections left");
-  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat);
+  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat, false);
 }
 
 namespace {
@@ -1921,8 +1922,13 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   if (changed.empty()) return 0;
   // Candidates: boxes widened by more float steps than re-rounding moves a
   // vertex (at most kFarthestRounding from its exact position).
-  const std::vector<std::array<std::uint32_t, 2>> pairs =
+  // Faces with the same three vertices (a planar overlap kept in each part)
+  // coincide however their vertices are rounded: never a crossing here.
+  std::vector<std::array<std::uint32_t, 2>> pairs =
       pairsWithChangedFaces(P, T, isChanged, kFarthestRounding + 2);
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [&](const auto& p) { return sameVertices(T[p[0]], T[p[1]]); }),
+              pairs.end());
   // Candidates of each changed face, both ways (compressed rows).
   std::vector<std::uint32_t> offsets(changed.size() + 1, 0), others;
   for (const auto& [f, g] : pairs) {

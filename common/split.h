@@ -119,8 +119,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
 // snap_tolerance) merges them, and splitRoundedAgain splits what is left.
 // Applied to `merged` and to `meshes` alike. Returns the pairs still
 // crossing among those with a new face or a face that rounding moved (faces
-// kept exactly as they were cannot cross anything new); with `complete`,
-// that is every intersecting pair of the rounded output.
+// kept exactly as they were cannot cross anything new; faces with the same
+// three vertices are never a crossing, see remainingIntersections); with
+// `complete`, that is every intersecting pair of the rounded output.
 std::size_t roundToFloat(SplitResult& result, int passes = 4);
 
 // Where roundToFloat left faces of the merged output crossing: splits the
@@ -160,7 +161,11 @@ FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*
 // Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not
 // count), with coordinates as stored in double or, with `asFloat`, rounded
-// to float as MeshLab stores them.
+// to float as MeshLab stores them. Faces with the same three vertices do not
+// count either: a planar overlap kept in each part (overlaps_once off;
+// coincident_faces counts them) or duplicate faces of an input, which no
+// split or rounding changes (a checker that takes them for intersecting
+// pairs, as meshcheck does, counts one pair each).
 std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
 
 // New faces of the merged output (required, as above) whose corners, as

@@ -50,6 +50,10 @@ struct SharedCorners {
   int ia = -1, ib = -1;
 };
 SharedCorners sharedCorners(const Triangle& a, const Triangle& b);
+// Do a and b have the same three vertices (the same face twice)?
+inline bool sameVertices(const Triangle& a, const Triangle& b) {
+  return sharedCorners(a, b).count == 3;
+}
 
 // How two triangles meet.
 enum class ContactKind {

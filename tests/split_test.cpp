@@ -313,6 +313,30 @@ TEST(Split, BoxesOverlappingInPlanesMeetAlongTheOverlapsOutline) {
   EXPECT_EQ(merged.border_edges, 0u);
 }
 
+TEST(Split, PlanarOverlapsKeptInEachPartAreNoCrossingsForTheFloatRepair) {
+  // With each part keeping its copy of a planar overlap (overlaps_once off:
+  // the separate outputs, the boolean filters), the merged output holds
+  // faces with the same three vertices. They coincide however rounding
+  // goes, so the float repair leaves them alone: no second split, nothing
+  // split again, the same curves.
+  const Mesh a = gridCube(2);
+  for (const Mesh& b : {gridCube(2), moved(gridCube(2), {0.5, 0, 0})}) {
+    SplitResult r = splitAlongIntersections({&a, &b});
+    ASSERT_GT(r.coincident_faces, 0u);
+    EXPECT_EQ(selfIntersectingPairs(r.merged), r.coincident_faces);  // as a checker counts them
+    EXPECT_EQ(remainingIntersections(r, true), 0u);
+    const std::size_t faces = r.merged.face.size(), curves = r.merged_curve_edges.size();
+    const FloatOutput stored = roundForFloatHost(r, {&a, &b}, SplitOptions{});
+    EXPECT_EQ(stored.crossing, 0u);
+    EXPECT_FALSE(stored.snapped_for_float);
+    EXPECT_EQ(r.pairs_split_after_rounding, 0u);
+    EXPECT_EQ(r.merged.face.size(), faces);
+    EXPECT_EQ(r.merged_curve_edges.size(), curves);
+    EXPECT_EQ(selfIntersectingPairs(r.merged), r.coincident_faces);
+    for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(*check(r.meshes[i]).self_intersecting_pairs, 0u);
+  }
+}
+
 TEST(Split, CurvesThatBranchWithoutEndingAreClosed) {
   // A cube and the same cube turned 45° about z (and scaled by 1.4, so
   // that its corners are exact doubles): their tops and bottoms overlap in
@@ -490,7 +514,10 @@ TEST(Split, DuplicateFacesAreRemovedFirst) {
   const Mesh plate = makeMesh({{1, 1, -1}, {1, 1, 1}, {3, 0.5, 0}}, {{0, 1, 2}});
   SplitOptions keep;
   const SplitResult kept = splitAlongIntersections({&sheet, &plate}, keep);
-  EXPECT_GT(remainingIntersections(kept, false), 0u);  // the duplicate intersects its twin
+  // The duplicate intersects its twin (a self-intersection checker counts
+  // the pair); no split or rounding changes that, so it is no crossing left.
+  EXPECT_GT(selfIntersectingPairs(kept.merged), 0u);
+  EXPECT_EQ(remainingIntersections(kept, false), 0u);
   SplitOptions remove;
   remove.remove_duplicate_faces = true;
   SplitResult r = splitAlongIntersections({&sheet, &plate}, remove);

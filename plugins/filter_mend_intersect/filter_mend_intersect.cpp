@@ -330,9 +330,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   const bool verify = parameters.getBool("verify");
   if (verify && checkWhole) {  // rounding did not count every pair: check everything
     reportProgress(progressFrom(cb), 97, "Checking the result");
-    FindIntersectionsOptions o;  // on all layers together, welded along the curves
-    o.cross = false;
-    remaining = findIntersections({&r.merged}, o).pairs.size();
+    remaining = remainingIntersections(r, false);  // all layers together, welded along the curves
   }
   r.time_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - roundStart)
@@ -405,9 +403,11 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
         r.coincident_faces_removed);
   else if (r.coincident_faces && merge)
     Log("  %zu faces lie twice where the surfaces overlap in a plane, each layer's own (for the "
-        "boolean filters; the check counts them as crossing pairs): 'Planar overlaps once' "
-        "keeps each once",
+        "boolean filters; the check above leaves them out, a checker of self-intersections "
+        "counts each as an intersecting pair): 'Planar overlaps once' keeps each once",
         r.coincident_faces);
+  else if (r.coincident_faces)
+    Log("  %zu faces lie in two layers where the surfaces overlap in a plane", r.coincident_faces);
   if (options.snap_tolerance > 0)
     Log("  smallest angle of a new face: %.3g degrees (%.3g without snapping); %zu faces under 1 "
         "degree (%zu without); %zu curve points "
