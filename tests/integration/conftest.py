@@ -96,8 +96,9 @@ def run_server(tmp_path, inputs, script_text, outputs=(), timeout=600):
     cmd = [str(ROOT / "scripts" / "meshlabserver")]
     for i in inputs:
         cmd += ["-i", str(i)]
-    for o in outputs:
-        cmd += ["-o", str(o)]
+    for o in outputs:  # a path (the current layer), or (path, layer index)
+        path, layer = o if isinstance(o, tuple) else (o, None)
+        cmd += ["-o", str(path)] + (["-l", str(layer)] if layer is not None else [])
     cmd += ["-s", str(script)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     return Run(proc, [json.loads(p.read_text()) for p in reports if p.exists()])

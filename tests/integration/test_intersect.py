@@ -202,6 +202,31 @@ def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
         assert check["self_intersecting_pairs"] == 0 and check["border_edges"] == 0
 
 
+def test_separate_layers_overlapping_in_planes_keep_their_faces_uncounted(tmp_path):
+    """A cube and the same cube moved by half its width, kept as separate
+    layers: where their sides overlap in a plane each layer keeps its own
+    faces. Those coincide (the same three vertices once welded) and are no
+    crossing: the check reports none and the float result is not split
+    again; each layer is its own closed surface."""
+    V, F = cube()
+    a = write_off(tmp_path / "a.off", V, F)
+    b = write_off(tmp_path / "b.off", [(x + 0.5, y, z) for x, y, z in V], F)
+    layers = [tmp_path / "a_out.ply", tmp_path / "b_out.ply"]
+    script = mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1, "output": 0,
+                          "report_file": "{report0}"}))
+    run = run_server(tmp_path, [a, b], script, outputs=[(layers[0], 0), (layers[1], 1)])
+    assert run.returncode == 0, run.log
+    r = run.report
+    assert r["coincident_faces"] > 0 and "lie in two layers" in run.log
+    assert r["remaining_intersecting_pairs"] == 0 and r["pairs_split_after_rounding"] == 0
+    assert not r["snapped_for_float"] and "snapping tolerance" not in run.log
+    for layer in layers:
+        check = meshcheck_if_available(layer)
+        if check:
+            assert check["self_intersecting_pairs"] == 0 and check["is_closed"]
+            assert check["non_manifold_edges"] == 0 and check["duplicate_faces"] == 0
+
+
 def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
     """Two tubes of one radius crossing at right angles touch tangentially:
     curve points there lie far closer than a float step. The float result
