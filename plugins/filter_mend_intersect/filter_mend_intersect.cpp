@@ -306,19 +306,24 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.progress = progressFrom(cb);
   const bool merge = parameters.getEnum("output") == 1;
   options.separate_meshes = !merge;
+  const auto start = std::chrono::steady_clock::now();
   SplitResult r = splitAlongIntersections(in.meshes, options);
   // Welding and removing duplicate faces may be all there was to do (a
   // layer that met itself only through duplicate faces): that result is
-  // kept; otherwise nothing changed and nothing is written.
-  if (r.intersecting_pairs == 0 && r.vertices_welded == 0 && r.duplicate_faces_removed == 0)
-    throw InvalidInputError(mode == kWithinCurrent
-                                ? layerName(*layers[0]) +
-                                      " does not intersect itself: nothing to split"
-                                : "the chosen layers do not intersect: nothing to split");
+  // kept. Layers that do not meet are still merged when asked (the boolean
+  // filters take nested or separate parts from the merged layer);
+  // otherwise nothing changed and nothing is written.
+  const bool nothingMet =
+      r.intersecting_pairs == 0 && r.vertices_welded == 0 && r.duplicate_faces_removed == 0;
+  if (nothingMet && mode == kWithinCurrent)
+    throw InvalidInputError(layerName(*layers[0]) + " does not intersect itself: nothing to split");
+  if (nothingMet && !merge)
+    throw InvalidInputError(
+        "the chosen layers do not intersect: nothing to split (to combine parts that do not "
+        "meet, nested or apart, for the boolean filters, choose the merged output)");
   // A float host (2020.09) gets the result rounded here, re-rounding curve
   // points where that keeps faces that meet along a curve from crossing; a
   // double host (2022.02) stores it as computed and is checked whole.
-  const auto roundStart = std::chrono::steady_clock::now();
   std::size_t remaining = 0;
   const bool checkWhole = !kHostStoresFloat || !r.complete;
   FloatOutput stored;
@@ -332,9 +337,10 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     reportProgress(progressFrom(cb), 97, "Checking the result");
     remaining = remainingIntersections(r, false);  // all layers together, welded along the curves
   }
-  r.time_ms +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - roundStart)
-          .count();
+  // The whole computation once (the core's time_ms adds up the splits it ran).
+  r.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (nothingMet) Log("  the layers do not intersect: the merged layer holds them as they are");
   if (verify)
     Log("  check of the %s result: %zu intersecting pairs remain%s",
         kHostStoresFloat ? "float" : "double", remaining,
@@ -408,13 +414,13 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
         r.coincident_faces);
   else if (r.coincident_faces)
     Log("  %zu faces lie in two layers where the surfaces overlap in a plane", r.coincident_faces);
-  if (options.snap_tolerance > 0)
+  if (r.faces_split > 0 && options.snap_tolerance > 0)
     Log("  smallest angle of a new face: %.3g degrees (%.3g without snapping); %zu faces under 1 "
         "degree (%zu without); %zu curve points "
         "merged into vertices, %zu edges split at curve points",
         r.smallest_new_angle_deg, r.smallest_new_angle_deg_unsnapped, r.new_faces_below_1deg,
         r.new_faces_below_1deg_unsnapped, r.vertices_snapped, r.edges_snapped);
-  else
+  else if (r.faces_split > 0)
     Log("  smallest angle of a new face: %.3g degrees; %zu faces under 1 degree",
         r.smallest_new_angle_deg, r.new_faces_below_1deg);
   if (r.degenerate_faces_kept)

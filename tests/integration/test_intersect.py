@@ -140,13 +140,27 @@ def test_split_keeps_layers_separate_and_closed(tmp_path):
 
 
 def test_split_refuses_layers_that_do_not_intersect(tmp_path):
+    """Kept separate, layers that do not meet have nothing to split: refused,
+    unchanged. Merged, the merged layer holds them as they are (the boolean
+    filters take nested or separate parts from it)."""
     V, F = cube()
     a = write_off(tmp_path / "a.off", V, F)
     b = write_off(tmp_path / "b.off", shifted(V, 5.0), F)
     run = run_server(tmp_path, [a, b], mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
-                                                    "report_file": "{report0}"})))
+                                                    "output": 0, "report_file": "{report0}"})))
     assert run.returncode != 0
-    assert "do not intersect" in run.log and not run.reports
+    assert "do not intersect" in run.log and "merged output" in run.log and not run.reports
+    out = tmp_path / "merged.ply"
+    run = run_server(tmp_path, [a, b], mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
+                                                    "output": 1, "report_file": "{report0}"})),
+                     outputs=[out])
+    assert run.returncode == 0, run.log
+    assert "do not intersect" in run.log and "smallest angle" not in run.log
+    assert run.report["intersecting_pairs"] == 0 and run.report["faces_split"] == 0
+    check = meshcheck_if_available(out)
+    if check:
+        assert check["faces"] == 24 and check["connected_components"] == 2
+        assert check["is_closed"] and check["self_intersecting_pairs"] == 0
 
 
 def test_split_refuses_a_bad_snapping_tolerance(tmp_path):
