@@ -371,6 +371,22 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
         }
       },
       4);
+  // A closed part whose faces point inward has winding number -1 inside:
+  // taken turned, its winding numbers and the sides its surface faces
+  // change sign.
+  patches.part_inside_out.assign(patches.parts, false);
+  std::vector<double> volume(patches.parts, 0);
+  for (std::size_t f = 0; f < T.size(); ++f)
+    volume[partOf(f)] += P[T[f][0]].dot(P[T[f][1]] ^ P[T[f][2]]);
+  for (int p = 0; p < patches.parts; ++p) {
+    if (!patches.part_closed[p] || !(volume[p] < 0)) continue;
+    patches.part_inside_out[p] = true;
+    for (Patch& patch : patches.patches) {
+      patch.winding[p] = -patch.winding[p];
+      patch.coincident[p] = std::int8_t(-patch.coincident[p]);
+      patch.setSideWindings();
+    }
+  }
 
   // A patch can lie on both sides of another part where that part is open:
   // a curve that ends at the other part's border does not separate the

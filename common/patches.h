@@ -76,7 +76,12 @@ struct Patches {
   std::vector<int> patch_of_face;  // per face: its patch id
   std::vector<Patch> patches;  // by id: in the order of their first faces, then pieces split off
   int parts = 1;
-  std::vector<bool> part_closed;   // per part: no border edge (after classifyPatches)
+  std::vector<bool> part_closed;  // per part: no border edge (after classifyPatches)
+  // Per part (after classifyPatches): closed with its faces pointing inward
+  // (a negative volume, as some scans and exports come), so that its winding
+  // number is -1 inside. It is classified as if turned outward, and the
+  // booleans turn its kept patches so that the result faces out.
+  std::vector<bool> part_inside_out;
   std::size_t boundary_edges = 0;  // edges that bound patches
   // Patches classifyPatches found on both sides of an open part (a curve
   // that ends at the part's border does not separate them) and split where

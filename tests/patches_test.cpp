@@ -176,6 +176,50 @@ struct BoxCase {
   double union_volume, intersection_volume, difference_volume;
 };
 
+TEST(Patches, InsideOutPartsAreClassifiedAsTurned) {
+  // Some scans and exports come with every face pointing inward: a closed
+  // part with a negative volume, whose winding number is -1 inside. Each
+  // sphere turned so, and both: the same booleans as with both facing out,
+  // every result facing out.
+  const Mesh a = uvSphere(24, 32), b = uvSphere(20, 28, 1.0, {0.9, 0.13, 0.07});
+  auto volumesOf = [](const Mesh& x, const Mesh& y, std::vector<bool>* insideOut) {
+    SplitResult r = splitAlongIntersections({&x, &y});
+    const FaceLabels labels = labelsOf(r);
+    Patches p = paintPatches(r.merged, labels);
+    classifyPatches(r.merged, labels, p);
+    if (insideOut) *insideOut = p.part_inside_out;
+    std::vector<double> volumes;
+    for (BooleanOperation op : {BooleanOperation::kUnion, BooleanOperation::kIntersection,
+                                BooleanOperation::kDifference}) {
+      SCOPED_TRACE(toString(op));
+      const PatchChoice choice = choosePatches(p, op);
+      const InspectResult i = check(extractPatches(r.merged, p, choice.keep, choice.flip));
+      EXPECT_TRUE(i.is_closed);
+      EXPECT_EQ(i.non_manifold_edges, 0u);
+      EXPECT_EQ(*i.self_intersecting_pairs, 0u);
+      EXPECT_TRUE(i.consistently_oriented);
+      volumes.push_back(i.volume.value_or(0));
+    }
+    return volumes;
+  };
+  const std::vector<double> expected = volumesOf(a, b, nullptr);
+  ASSERT_GT(expected[1], 0);
+  const Mesh turnedA = testing::flipped(a), turnedB = testing::flipped(b);
+  const struct {
+    const Mesh *x, *y;
+    std::vector<bool> insideOut;
+  } cases[] = {{&turnedA, &b, {true, false}},
+               {&a, &turnedB, {false, true}},
+               {&turnedA, &turnedB, {true, true}}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(::testing::Message() << "inside out: " << c.insideOut[0] << c.insideOut[1]);
+    std::vector<bool> insideOut;
+    const std::vector<double> volumes = volumesOf(*c.x, *c.y, &insideOut);
+    EXPECT_EQ(insideOut, c.insideOut);
+    for (int op = 0; op < 3; ++op) EXPECT_NEAR(volumes[op], expected[op], 1e-9);
+  }
+}
+
 TEST(Patches, BooleansOfBoxesOverlappingInPlanes) {
   const BoxCase cases[] = {
       {"the same box", {0, 0, 0}, 1, 1, 0},

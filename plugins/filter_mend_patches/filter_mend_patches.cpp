@@ -116,11 +116,16 @@ vcg::Color4b colourOf(int id) {
   return vcg::Color4b(c[0], c[1], c[2], 255);
 }
 
-// What a user needs to know about the threshold when a part is open.
-std::vector<std::string> openPartNotes(const Patches& p) {
+// What a user needs to know about the threshold when a part is open, and
+// about parts taken turned.
+std::vector<std::string> partNotes(const Patches& p) {
   std::vector<std::string> notes;
   for (int part = 0; part < p.parts; ++part)
-    if (!p.part_closed[part])
+    if (part < int(p.part_inside_out.size()) && p.part_inside_out[part])
+      notes.push_back("part " + std::to_string(part) +
+                      " is inside out (its faces point inward: a negative volume): it is "
+                      "classified as if turned outward, and the result faces outward");
+    else if (!p.part_closed[part])
       notes.push_back("part " + std::to_string(part) +
                       " is open (it has border edges): its winding number is fractional near "
                       "the holes, and a patch counts as inside it where the winding number "
@@ -384,7 +389,7 @@ void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
   if (p.patches.size() > kListed)
     Log("  ... %zu more patches (all of them are in the report file)", p.patches.size() - kListed);
   if (classify)
-    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+    for (const std::string& note : partNotes(p)) Log("  note: %s", note.c_str());
 }
 
 void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters,
@@ -417,7 +422,7 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
           "there is only one part: inside / outside other parts needs the "
           "merged output of 'Intersect and Split Layers' or several layers");
     classifyPatches(a.mesh, a.labels, p);
-    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+    for (const std::string& note : partNotes(p)) Log("  note: %s", note.c_str());
     for (std::size_t id = 0; id < p.patches.size(); ++id) {
       const Patch& patch = p.patches[id];
       switch (by) {
@@ -489,7 +494,7 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
           "visible layers");
     reportProgress(progressFrom(cb), 20, "Classifying patches");
     classifyPatches(a.mesh, a.labels, p);
-    for (const std::string& note : openPartNotes(p)) Log("  note: %s", note.c_str());
+    for (const std::string& note : partNotes(p)) Log("  note: %s", note.c_str());
     choice = choosePatches(p, op);
   }
   std::size_t kept = 0;
