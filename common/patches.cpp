@@ -666,8 +666,11 @@ JsonObject toJson(const Patches& patches) {
   j.set("patches", patches.patches.size())
       .set("parts", patches.parts)
       .set("boundary_edges", patches.boundary_edges)
-      .set("patches_split_at_open_parts", patches.patches_split_at_open_parts)
-      .set("patch_list", list);
+      .set("patches_split_at_open_parts", patches.patches_split_at_open_parts);
+  std::vector<double> insideOut;  // the parts classified as turned
+  for (std::size_t p = 0; p < patches.part_inside_out.size(); ++p)
+    if (patches.part_inside_out[p]) insideOut.push_back(double(p));
+  j.set("parts_inside_out", insideOut).set("patch_list", list);
   return j;
 }
 
