@@ -141,6 +141,32 @@ def test_booleans_of_cubes_overlapping_in_planes(tmp_path, offset, volumes):
         assert check["volume"] == pytest.approx(volume, abs=1e-6), (operation, check["volume"])
 
 
+def test_booleans_of_nested_parts_and_of_a_part_inside_out(tmp_path):
+    """Parts that do not cross (one inside the other) go through the three
+    steps of the samples all the same; a part whose faces point inward (as
+    some scans come) is taken turned, and every result faces out."""
+    V, F = cube()
+    outer = write_off(tmp_path / "outer.off", V, F)
+    inner = write_off(tmp_path / "inner.off", [tuple(0.25 + 0.5 * x for x in v) for v in V], F)
+    turned = write_off(tmp_path / "turned.off", V, [(f[0], f[2], f[1]) for f in F])
+    moved = write_off(tmp_path / "moved.off", shifted(V, 0.5), F)
+    cases = [((outer, inner), {"union": (1, 1), "intersection": (0.125, 1),
+                               "difference": (0.875, 2)}),
+             ((turned, moved), {"union": (1.875, 1), "intersection": (0.125, 1),
+                                "difference": (0.875, 1)})]
+    for inputs, volumes in cases:
+        for operation, (volume, components) in volumes.items():
+            out = tmp_path / f"{operation}.ply"
+            run = run_server(tmp_path, list(inputs), sample(SAMPLES[operation]), outputs=[out])
+            assert run.returncode == 0, run.log[-3000:]
+            assert ("inside out" in run.log) == (inputs[0] == turned), operation
+            check = meshcheck(out)
+            assert check["is_closed"] and check["non_manifold_edges"] == 0, (operation, check)
+            assert check["self_intersecting_pairs"] == 0 and check["consistently_oriented"]
+            assert check["connected_components"] == components, (operation, check)
+            assert check["volume"] == pytest.approx(volume, abs=1e-6), (operation, check["volume"])
+
+
 def test_bad_input(tmp_path):
     V, F = cube()
     a = write_off(tmp_path / "a.off", V, F)
