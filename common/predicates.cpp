@@ -96,9 +96,12 @@ PlaneFilter::PlaneFilter(const Point3& a, const Point3& b, const Point3& c) {
 
 int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {
   const Point3 normal = (b - a) ^ (c - a);  // component k = orientation dropping axis k
+  // The axes by decreasing |normal| component (three compares, no sort).
   int order[3] = {0, 1, 2};
-  std::sort(order, order + 3,
-            [&](int x, int y) { return std::fabs(normal[x]) > std::fabs(normal[y]); });
+  auto before = [&](int x, int y) { return std::fabs(normal[x]) > std::fabs(normal[y]); };
+  if (before(order[1], order[0])) std::swap(order[0], order[1]);
+  if (before(order[2], order[1])) std::swap(order[1], order[2]);
+  if (before(order[1], order[0])) std::swap(order[0], order[1]);
   for (int axis : order)
     if (orient2dDropping(a, b, c, axis) != 0) return axis;
   return -1;

@@ -1957,13 +1957,25 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   }
 
   auto crosses = [&](std::uint32_t f, std::uint32_t g) { return facesIntersect(P, T, f, g); };
-  // How many crossings the changed faces around v take part in.
-  auto localCrossings = [&](int v) {
+  // A changed face whose corners rounding made collinear (a face that was
+  // not) is worse than a crossing: it has no normal, a checker takes it for
+  // a hole in the surface, and a crossing elsewhere is still split again
+  // (splitRoundedAgain). It counts as two.
+  auto collapsed = [&](std::uint32_t f) {
+    return collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]) &&
+           !collinear(exact[T[f][0]], exact[T[f][1]], exact[T[f][2]]);
+  };
+  // How many crossings (and collapsed faces) the changed faces around v
+  // take part in, counted up to `enough` (a position is only worth knowing
+  // while it beats the best).
+  auto localCrossings = [&](int v, std::size_t enough) {
     std::size_t n = 0;
     for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k) {
       const std::uint32_t f = around[k];
+      if ((n += 2 * collapsed(f)) >= enough) return n;
       const int i = changedIndex[f];
-      for (std::uint32_t j = offsets[i]; j < offsets[i + 1]; ++j) n += crosses(f, others[j]);
+      for (std::uint32_t j = offsets[i]; j < offsets[i + 1]; ++j)
+        if ((n += crosses(f, others[j])) >= enough) return n;
     }
     return n;
   };
@@ -1976,7 +1988,7 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   // meet at a very small angle, neither may keep them apart, and the next
   // float out may.
   int reach = 1, passesAtReach = 0;
-  std::size_t before = std::numeric_limits<std::size_t>::max();  // crossings before the last pass
+  std::size_t before = std::numeric_limits<std::size_t>::max();  // defects before the last pass
   for (int pass = 0;; ++pass) {
     if (pass > 0) {
       // Only pairs with a face at a vertex that moved can have changed: the
@@ -1994,19 +2006,26 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
       std::fill(moved.begin(), moved.end(), 0);
     }
     remaining = crossing.size();
-    if (remaining == 0) break;
-    if (passesAtReach == passes || remaining >= before) {  // this reach has done what it can
+    std::vector<std::uint32_t> flat;
+    for (std::uint32_t f : changed)
+      if (collapsed(f)) flat.push_back(f);
+    const std::size_t defects = remaining + flat.size();
+    if (defects == 0) break;
+    if (passesAtReach == passes || defects >= before) {  // this reach has done what it can
       if (reach == kFarthestRounding) break;
       ++reach;
       passesAtReach = 0;
     }
-    before = remaining;
+    before = defects;
     ++passesAtReach;
     std::set<int> candidates;
+    auto addCorners = [&](std::uint32_t f) {
+      for (int v : T[f])
+        if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
+    };
     for (const auto& p : crossing)
-      for (std::uint32_t f : p)
-        for (int v : T[f])
-          if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
+      for (std::uint32_t f : p) addCorners(f);
+    for (std::uint32_t f : flat) addCorners(f);
     for (int v : candidates) {
       const Point3 e = exact[v], start = P[v];
       // Per coordinate, the floats nearest first: below, above, then the
@@ -2022,13 +2041,13 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
         }
       }
       Point3 best = start;
-      std::size_t bestCount = localCrossings(v);
+      std::size_t bestCount = localCrossings(v, std::numeric_limits<std::size_t>::max());
       const int n = 2 * reach;
       for (int choice = 0; choice < n * n * n && bestCount > 0; ++choice) {
         P[v] = Point3(options[0][choice % n], options[1][choice / n % n],
                       options[2][choice / (n * n)]);
         if (P[v] == start) continue;
-        const std::size_t count = localCrossings(v);
+        const std::size_t count = localCrossings(v, bestCount);
         if (count < bestCount) best = P[v], bestCount = count;
       }
       moved[v] = best != start;
