@@ -329,12 +329,16 @@ def test_separate_meshes_rounded_to_float_are_repaired_too(tmp_path):
 
 
 def test_split_rounded_to_float_repairs_points_a_float_step_apart(tmp_path):
-    # Here curve points lie a few float steps apart: no rounding alone keeps
-    # every face apart. Rounding for a float host merges such points (or
-    # splits again what still crosses): nothing crosses, nothing collapses.
+    # Here curve points lie a few float steps apart, where rounding to the
+    # nearest float makes faces cross or collapse (see the test above).
+    # Rounding for a float host re-rounds them (merging such points, or
+    # splitting again what still crosses, where that is not enough):
+    # nothing crosses, nothing collapses.
     (A, F), (B, G) = nearly_coincident_pair(3)
+    MV, MF = mm.intersect_and_split(A, F, B, G, separate_meshes=False).merged
+    nearest = meshcheck(write_off(tmp_path / "nearest.off", as_float(MV), MF))
+    assert nearest["self_intersecting_pairs"] + nearest["degenerate_faces"] > 0
     out = mm.intersect_and_split(A, F, B, G, round_to_float=True, separate_meshes=False)
-    assert out.report["snapped_for_float"] or out.report["pairs_split_after_rounding"] > 0
     assert out.report["remaining_intersecting_pairs"] == 0
     assert out.report["degenerate_new_faces"] == 0
     check = meshcheck(write_off(tmp_path / "rounded.off", *out.merged))
