@@ -1840,6 +1840,113 @@ std::size_t degenerateNewFaces(const SplitResult& result) {
   return n;
 }
 
+namespace {
+void separateFromMerged(SplitResult& r);
+}  // namespace
+
+std::size_t mendCollinearNewFaces(SplitResult& r) {
+  requireMergedOutput(r, "mending collinear faces");
+  Mesh& m = r.merged;
+  FaceOriginHandle origin = faceOrigins(m);
+  std::vector<Triangle> T = trianglesOf(m);
+  std::set<std::array<int, 2>> curves;
+  for (const auto& e : r.merged_curve_edges)
+    curves.insert({std::min(e[0], e[1]), std::max(e[0], e[1])});
+  std::size_t flipped = 0;
+  std::vector<char> removed(T.size(), 0);
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (!r.merged_new_face[f]) continue;
+    const Triangle t = T[f];
+    const Point3 &p0 = m.vert[t[0]].cP(), &p1 = m.vert[t[1]].cP(), &p2 = m.vert[t[2]].cP();
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || p0 == p1 || p1 == p2 || p2 == p0 ||
+        !collinear(p0, p1, p2))
+      continue;
+    // The corner strictly between the other two: the one opposite the
+    // longest side (distinct collinear points; compared along an axis on
+    // which they differ, exactly).
+    int k = 0;
+    const int axis = p0[0] != p1[0] ? 0 : p0[1] != p1[1] ? 1 : 2;
+    for (int i = 0; i < 3; ++i) {
+      const double x = m.vert[t[i]].cP()[axis], y = m.vert[t[(i + 1) % 3]].cP()[axis],
+                   z = m.vert[t[(i + 2) % 3]].cP()[axis];
+      if ((y < x && x < z) || (z < x && x < y)) k = i;
+    }
+    const int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+    // Per side of the flat face, the other faces along it running the same
+    // way and the other way (a closed surface has as many of each, curves
+    // included); g: the face running c to b beyond the long side.
+    int g = -1, others = 0, d = -1, same[3] = {0, 0, 0}, reverse[3] = {0, 0, 0};
+    const int side[3][2] = {{a, b}, {b, c}, {c, a}};
+    for (std::size_t h = 0; h < T.size(); ++h) {
+      if (h == f || removed[h]) continue;
+      for (int i = 0; i < 3; ++i) {
+        const int u = T[h][i], v = T[h][(i + 1) % 3];
+        for (int e = 0; e < 3; ++e) {
+          same[e] += u == side[e][0] && v == side[e][1];
+          reverse[e] += u == side[e][1] && v == side[e][0];
+        }
+        if (u == c && v == b) g = int(h), d = T[h][(i + 2) % 3];
+      }
+    }
+    others = same[1] + reverse[1];
+    // Nothing beyond the long side: the flat face only fills a gap of no
+    // area between faces that already meet along the short sides (a split
+    // there put a on that side). It goes where that leaves its sides
+    // closer to closed.
+    if (others == 0) {
+      int before = 0, after = 0;
+      for (int e = 0; e < 3; ++e) {
+        before += std::abs(1 + same[e] - reverse[e]);
+        after += std::abs(same[e] - reverse[e]);
+      }
+      if (after < before) {
+        removed[f] = 1;
+        ++flipped;
+      }
+      continue;
+    }
+    if (others != 1 || g < 0 || d == a) continue;
+    const Point3& pd = m.vert[d].cP();
+    if (collinear(m.vert[a].cP(), m.vert[b].cP(), pd) ||
+        collinear(m.vert[a].cP(), pd, m.vert[c].cP()))
+      continue;
+    T[f] = {a, b, d};
+    T[g] = {a, d, c};
+    for (int i = 0; i < 3; ++i) {
+      m.face[f].V(i) = &m.vert[T[f][i]];
+      m.face[g].V(i) = &m.vert[T[g][i]];
+    }
+    origin[f] = origin[g];
+    r.merged_new_face[g] = 1;
+    if (!r.merged_snapped_face.empty()) r.merged_snapped_face[f] = r.merged_snapped_face[g];
+    if (curves.erase({std::min(b, c), std::max(b, c)}))  // the curve now runs through a
+      curves.insert({std::min(a, b), std::max(a, b)}),
+          curves.insert({std::min(a, c), std::max(a, c)});
+    ++flipped;
+  }
+  if (std::count(removed.begin(), removed.end(), 1) > 0) {
+    std::size_t kept = 0;
+    for (std::size_t f = 0; f < T.size(); ++f) {
+      if (removed[f]) {
+        vcg::tri::Allocator<Mesh>::DeleteFace(m, m.face[f]);
+        continue;
+      }
+      r.merged_new_face[kept] = r.merged_new_face[f];
+      if (!r.merged_snapped_face.empty()) r.merged_snapped_face[kept] = r.merged_snapped_face[f];
+      ++kept;
+    }
+    vcg::tri::Allocator<Mesh>::CompactFaceVector(m);  // in order; attributes follow
+    r.merged_new_face.resize(kept);
+    if (!r.merged_snapped_face.empty()) r.merged_snapped_face.resize(kept);
+    r.collapsed_faces_removed += T.size() - kept;
+  }
+  if (flipped) {
+    r.merged_curve_edges.assign(curves.begin(), curves.end());
+    if (!r.meshes.empty() && r.coincident_faces_removed == 0) separateFromMerged(r);
+  }
+  return flipped;
+}
+
 FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options) {
   FloatOutput out;
@@ -1869,6 +1976,7 @@ FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& in
     reportProgress(options.progress, 97, "Splitting the rounded result where it crosses");
     out.crossing = splitRoundedAgain(r, inputs, used);
   }
+  if (degenerateNewFaces(r) > 0) out.collinear_faces_mended = mendCollinearNewFaces(r);
   return out;
 }
 

@@ -147,8 +147,9 @@ std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*
 inline constexpr int kFloatSnapSteps = 8;
 
 struct FloatOutput {
-  std::size_t crossing = 0;        // pairs still crossing, as roundToFloat counts them
-  bool snapped_for_float = false;  // the result is the second split (snap_float_steps)
+  std::size_t crossing = 0;                // pairs still crossing, as roundToFloat counts them
+  bool snapped_for_float = false;          // the result is the second split (snap_float_steps)
+  std::size_t collinear_faces_mended = 0;  // mendCollinearNewFaces
 };
 
 // The result as a float host (MeshLab 2020.09) stores it: rounded
@@ -156,9 +157,23 @@ struct FloatOutput {
 // options.snap_float_steps was 0, the split of `inputs` again with
 // snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then
 // what still crosses split again (splitRoundedAgain; the separate outputs
-// follow the merged one).
+// follow the merged one); last, new faces left with collinear corners are
+// mended (mendCollinearNewFaces).
 FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options);
+
+// Where rounding left a new face of the merged output (required, as
+// above) with three collinear corners (a point a float step from an edge,
+// where no float position keeps it off the line and nothing crossing), the
+// corner between the other two lies on the edge they span. With one face
+// beyond that edge (running the other way), the edge is flipped, splitting
+// that face at the corner: the two faces that replace the pair cover it
+// exactly, so nothing new can cross. With none, the flat face only fills a
+// gap of no area between faces that already meet along its short sides,
+// and is removed where that leaves its sides closer to closed (as many
+// faces running each way; collapsed_faces_removed counts it). Curve edges,
+// provenance and the separate outputs follow. Returns the flat faces gone.
+std::size_t mendCollinearNewFaces(SplitResult& result);
 
 // Intersecting pairs left in the merged output (required, as above), by the self-intersection
 // rule (faces that meet only along a shared curve edge or vertex do not

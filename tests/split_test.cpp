@@ -337,6 +337,60 @@ TEST(Split, PlanarOverlapsKeptInEachPartAreNoCrossingsForTheFloatRepair) {
   }
 }
 
+// A merged output as rounding might leave it: every face new, one of them
+// (the last) flat, its corner a = (1,0,0) between b = (0,0,0) and c = (2,0,0).
+SplitResult withFlatFace(const std::vector<Triangle>& faces) {
+  SplitResult r;
+  const Mesh m = makeMesh({{1, 0, 0}, {0, 0, 0}, {2, 0, 0}, {1, -1, 0}, {1, 1, 0}}, faces);
+  r.merged = m;
+  r.merged_new_face.assign(faces.size(), 1);
+  return r;
+}
+
+double areaOf(const Mesh& m) {
+  double area = 0;
+  for (const Face& f : m.face) area += ((f.cP(1) - f.cP(0)) ^ (f.cP(2) - f.cP(0))).Norm() / 2;
+  return area;
+}
+
+TEST(Split, AFlatNewFaceIsFlippedIntoTheFaceBeyondItsLongSide) {
+  // a = 0, b = 1, c = 2, d = 3 (below), e = 4 (above); the flat face
+  // (a, b, c) lies between the faces above, along a-b and c-a, and the face
+  // (c, b, d) below its long side.
+  SplitResult r = withFlatFace({{1, 0, 4}, {0, 2, 4}, {2, 1, 3}, {0, 1, 2}});
+  ASSERT_EQ(degenerateNewFaces(r), 1u);
+  const double area = areaOf(r.merged);
+  EXPECT_EQ(mendCollinearNewFaces(r), 1u);
+  EXPECT_EQ(degenerateNewFaces(r), 0u);
+  EXPECT_EQ(r.merged.face.size(), 4u);
+  EXPECT_DOUBLE_EQ(areaOf(r.merged), area);
+  const InspectResult i = check(r.merged);
+  EXPECT_EQ(i.border_edges, 4u);  // b-e, e-c, c-d, d-b
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_TRUE(i.consistently_oriented);
+  EXPECT_EQ(i.degenerate_faces, 0u);
+}
+
+TEST(Split, AFlatNewFaceFillingNoGapIsRemoved) {
+  // The faces above and below already meet along a-b and c-a (a split put a
+  // on both sides); the flat face (a, b, c) has nothing beyond its long side.
+  SplitResult r = withFlatFace({{1, 0, 4}, {0, 2, 4}, {0, 1, 3}, {2, 0, 3}, {0, 1, 2}});
+  ASSERT_EQ(check(r.merged).border_edges, 5u);  // the outline and the flat face's long side
+  EXPECT_EQ(mendCollinearNewFaces(r), 1u);
+  EXPECT_EQ(r.collapsed_faces_removed, 1u);
+  EXPECT_EQ(r.merged.face.size(), 4u);
+  EXPECT_EQ(r.merged_new_face.size(), 4u);
+  EXPECT_EQ(faceOrigins(r.merged)[3].face, 3);  // provenance follows the faces kept
+  const InspectResult i = check(r.merged);
+  EXPECT_EQ(i.border_edges, 4u);
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(i.degenerate_faces, 0u);
+  // A flat face whose removal would open the surface stays.
+  SplitResult alone = withFlatFace({{1, 0, 4}, {0, 2, 4}, {0, 1, 2}});
+  EXPECT_EQ(mendCollinearNewFaces(alone), 0u);
+  EXPECT_EQ(alone.merged.face.size(), 3u);
+}
+
 TEST(Split, CurvesThatBranchWithoutEndingAreClosed) {
   // A cube and the same cube turned 45° about z (and scaled by 1.4, so
   // that its corners are exact doubles): their tops and bottoms overlap in

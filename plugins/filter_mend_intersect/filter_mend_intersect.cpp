@@ -348,6 +348,10 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   if (r.pairs_split_after_rounding > 0)
     Log("  %zu pairs of faces that crossed once rounded to float were split again",
         r.pairs_split_after_rounding);
+  if (stored.collinear_faces_mended)
+    Log("  %zu new faces that rounding to float left flat (collinear corners) were mended: the "
+        "edge beyond flipped, or the face removed where it filled no gap",
+        stored.collinear_faces_mended);
   if (stored.snapped_for_float)
     Log("  curve points within %d float steps of a vertex or edge were merged into it (%zu "
         "vertices, %zu edges), as the float result could not keep them apart",
@@ -360,7 +364,9 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
         "small angle), no float rounding keeps every face apart: run again with a quality "
         "snapping tolerance of 0.05, which merges such points");
   JsonObject report = toJson(r);
-  report.set("degenerate_new_faces", collapsed).set("snapped_for_float", stored.snapped_for_float);
+  report.set("degenerate_new_faces", collapsed)
+      .set("snapped_for_float", stored.snapped_for_float)
+      .set("collinear_faces_mended", stored.collinear_faces_mended);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
