@@ -292,20 +292,25 @@ std::size_t keepOverlapsOnce(OutputArrays& merged, std::vector<char>& newFace,
     ++removed;
   }
   if (removed == 0 || !remove) return removed;  // (only counted)
-  // Per curve edge: does a face that had no twin use it?
+  // A curve edge stays one where a face that had no twin uses it (the
+  // overlap's outline), or where more than two faces are left on it (a
+  // crossing inside the overlap: the parts' own self-intersections there).
   std::vector<char> outline(curves.size(), 0);
+  std::vector<int> facesLeft(curves.size(), 0);
   for (std::size_t f = 0; f < merged.triangles.size(); ++f) {
     const Triangle& t = merged.triangles[f];
-    if (twin[f] != kSingle || int(onCurve[t[0]]) + onCurve[t[1]] + onCurve[t[2]] < 2) continue;
+    if (twin[f] == kTwinRemoved || int(onCurve[t[0]]) + onCurve[t[1]] + onCurve[t[2]] < 2) continue;
     for (int i = 0; i < 3; ++i) {
       const std::array<int, 2> e = {std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])};
       const auto at = std::lower_bound(curves.begin(), curves.end(), e);
-      if (at != curves.end() && *at == e) outline[at - curves.begin()] = 1;
+      if (at == curves.end() || *at != e) continue;
+      ++facesLeft[at - curves.begin()];
+      if (twin[f] == kSingle) outline[at - curves.begin()] = 1;
     }
   }
   std::size_t keptEdges = 0;
   for (std::size_t k = 0; k < curves.size(); ++k)
-    if (outline[k]) curves[keptEdges++] = curves[k];
+    if (outline[k] || facesLeft[k] > 2) curves[keptEdges++] = curves[k];
   curves.resize(keptEdges);
   std::size_t kept = 0;
   for (std::size_t f = 0; f < merged.triangles.size(); ++f) {

@@ -294,6 +294,24 @@ TEST(Split, TheSameSurfaceTwiceIsKeptOnce) {
   for (const Mesh& m : r.meshes) EXPECT_EQ(m.face.size(), a.face.size());
 }
 
+TEST(Split, TheSameSelfIntersectingSurfaceTwiceKeepsItsOwnCurves) {
+  // A layer that crosses itself (two boxes in one mesh) and its copy: the
+  // surface is there once, and its own intersection curves are still
+  // curves (four faces meet along them), as when the layer is split alone.
+  const Mesh a = appended(gridCube(2), moved(gridCube(2), {0.5, 0.25, 0.125}));
+  SplitOptions o;
+  o.self = true;
+  o.overlaps_once = true;
+  o.separate_meshes = false;
+  const SplitResult alone = splitAlongIntersections({&a}, o);
+  ASSERT_GT(alone.merged_curve_edges.size(), 0u);
+  const SplitResult twice = splitAlongIntersections({&a, &a}, o);
+  EXPECT_EQ(twice.merged.face.size(), alone.merged.face.size());
+  EXPECT_EQ(twice.merged_curve_edges.size(), alone.merged_curve_edges.size());
+  EXPECT_EQ(twice.curve_loops, alone.curve_loops);
+  EXPECT_EQ(check(twice.merged).non_manifold_edges, twice.merged_curve_edges.size());
+}
+
 TEST(Split, BoxesOverlappingInPlanesMeetAlongTheOverlapsOutline) {
   // A box and the same box moved by half its width: four of their sides
   // overlap in a plane, and the end faces of each cross the other box.
