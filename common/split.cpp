@@ -1854,22 +1854,44 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
   Mesh& m = r.merged;
   FaceOriginHandle origin = faceOrigins(m);
   std::vector<Triangle> T = trianglesOf(m);
-  std::set<std::array<int, 2>> curves;
-  for (const auto& e : r.merged_curve_edges)
-    curves.insert({std::min(e[0], e[1]), std::max(e[0], e[1])});
-  std::size_t flipped = 0;
-  std::vector<char> removed(T.size(), 0);
-  for (std::size_t f = 0; f < T.size(); ++f) {
-    if (!r.merged_new_face[f]) continue;
-    const Triangle t = T[f];
+  auto isFlat = [&](std::size_t f) {
+    const Triangle& t = T[f];
     const Point3 &p0 = m.vert[t[0]].cP(), &p1 = m.vert[t[1]].cP(), &p2 = m.vert[t[2]].cP();
-    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || p0 == p1 || p1 == p2 || p2 == p0 ||
-        !collinear(p0, p1, p2))
-      continue;
+    return r.merged_new_face[f] && t[0] != t[1] && t[1] != t[2] && t[2] != t[0] && p0 != p1 &&
+           p1 != p2 && p2 != p0 && collinear(p0, p1, p2);
+  };
+  // The faces along each side of a flat face, found in one pass (a pass per
+  // flat face would be quadratic where rounding leaves many). A flip below
+  // adds its two faces to the sides they take; entries it makes stale are
+  // told apart by the faces' current corners.
+  auto key = [](int u, int v) { return std::array<int, 2>{std::min(u, v), std::max(u, v)}; };
+  std::map<std::array<int, 2>, std::vector<int>> along;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (isFlat(f))
+      for (int i = 0; i < 3; ++i) along[key(T[f][i], T[f][(i + 1) % 3])];
+  if (along.empty()) return 0;
+  auto link = [&](int h) {
+    for (int i = 0; i < 3; ++i) {
+      const auto side = along.find(key(T[h][i], T[h][(i + 1) % 3]));
+      if (side != along.end() &&
+          std::find(side->second.begin(), side->second.end(), h) == side->second.end())
+        side->second.push_back(h);
+    }
+  };
+  for (std::size_t h = 0; h < T.size(); ++h) link(int(h));
+  std::set<std::array<int, 2>> curves;
+  for (const auto& e : r.merged_curve_edges) curves.insert(key(e[0], e[1]));
+  std::size_t mended = 0;
+  std::vector<char> removed(T.size(), 0);
+  std::vector<int> near;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (!isFlat(f)) continue;
+    const Triangle t = T[f];
     // The corner strictly between the other two: the one opposite the
     // longest side (distinct collinear points; compared along an axis on
     // which they differ, exactly).
     int k = 0;
+    const Point3 &p0 = m.vert[t[0]].cP(), &p1 = m.vert[t[1]].cP();
     const int axis = p0[0] != p1[0] ? 0 : p0[1] != p1[1] ? 1 : 2;
     for (int i = 0; i < 3; ++i) {
       const double x = m.vert[t[i]].cP()[axis], y = m.vert[t[(i + 1) % 3]].cP()[axis],
@@ -1880,20 +1902,27 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
     // Per side of the flat face, the other faces along it running the same
     // way and the other way (a closed surface has as many of each, curves
     // included); g: the face running c to b beyond the long side.
-    int g = -1, others = 0, d = -1, same[3] = {0, 0, 0}, reverse[3] = {0, 0, 0};
+    int g = -1, d = -1, same[3] = {0, 0, 0}, reverse[3] = {0, 0, 0};
     const int side[3][2] = {{a, b}, {b, c}, {c, a}};
-    for (std::size_t h = 0; h < T.size(); ++h) {
-      if (h == f || removed[h]) continue;
+    near.clear();
+    for (const auto& s : side) {
+      const std::vector<int>& faces = along.at(key(s[0], s[1]));
+      near.insert(near.end(), faces.begin(), faces.end());
+    }
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    for (int h : near) {
+      if (h == int(f) || removed[h]) continue;
       for (int i = 0; i < 3; ++i) {
         const int u = T[h][i], v = T[h][(i + 1) % 3];
         for (int e = 0; e < 3; ++e) {
           same[e] += u == side[e][0] && v == side[e][1];
           reverse[e] += u == side[e][1] && v == side[e][0];
         }
-        if (u == c && v == b) g = int(h), d = T[h][(i + 2) % 3];
+        if (u == c && v == b) g = h, d = T[h][(i + 2) % 3];
       }
     }
-    others = same[1] + reverse[1];
+    const int others = same[1] + reverse[1];
     // Nothing beyond the long side: the flat face only fills a gap of no
     // area between faces that already meet along the short sides (a split
     // there put a on that side). It goes where that leaves its sides
@@ -1906,7 +1935,7 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
       }
       if (after < before) {
         removed[f] = 1;
-        ++flipped;
+        ++mended;
       }
       continue;
     }
@@ -1924,12 +1953,13 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
     origin[f] = origin[g];
     r.merged_new_face[g] = 1;
     if (!r.merged_snapped_face.empty()) r.merged_snapped_face[f] = r.merged_snapped_face[g];
-    if (curves.erase({std::min(b, c), std::max(b, c)}))  // the curve now runs through a
-      curves.insert({std::min(a, b), std::max(a, b)}),
-          curves.insert({std::min(a, c), std::max(a, c)});
-    ++flipped;
+    if (curves.erase(key(b, c)))  // the curve now runs through a
+      curves.insert(key(a, b)), curves.insert(key(a, c));
+    link(int(f));
+    link(g);
+    ++mended;
   }
-  if (std::count(removed.begin(), removed.end(), 1) > 0) {
+  if (std::find(removed.begin(), removed.end(), 1) != removed.end()) {
     std::size_t kept = 0;
     for (std::size_t f = 0; f < T.size(); ++f) {
       if (removed[f]) {
@@ -1945,11 +1975,11 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
     if (!r.merged_snapped_face.empty()) r.merged_snapped_face.resize(kept);
     r.collapsed_faces_removed += T.size() - kept;
   }
-  if (flipped) {
+  if (mended) {
     r.merged_curve_edges.assign(curves.begin(), curves.end());
     if (!r.meshes.empty() && r.coincident_faces_removed == 0) separateFromMerged(r);
   }
-  return flipped;
+  return mended;
 }
 
 FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
