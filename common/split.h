@@ -129,15 +129,14 @@ std::size_t roundToFloat(SplitResult& result, int passes = 4);
 // float values) and rounds again, up to `rounds` times while crossings are
 // left (each round's new points, rounded, may cross a little again: near
 // coincident surfaces, a millionth of their size apart, took five to
-// seven). Points that the float values put a step apart now meet where
-// they cross. Provenance goes through to `inputs` (the meshes split first,
-// for the barycentric coordinates of new vertices), and the merged output's
-// curve edges, new-face flags and merged_vertex follow, and `meshes`
-// (separate outputs), when there are any, are made again from the merged
-// output (each input's vertices in their order, then the new ones), unless
-// planar overlaps were kept once there (overlaps_once: then they stay). Uses
-// options.snap_float_steps. Returns the pairs still crossing (as
-// roundToFloat counts them).
+// seven); a round that leaves more than twice the fewest crossings so far
+// is not taken and ends the rounds (they run away there). Points that the float values put a step
+// apart now meet where they cross. Provenance goes through to `inputs` (the meshes split first, for
+// the barycentric coordinates of new vertices), and the merged output's curve edges, new-face flags
+// and merged_vertex follow, and `meshes` (separate outputs), when there are any, are made again
+// from the merged output (each input's vertices in their order, then the new ones), unless planar
+// overlaps were kept once there (overlaps_once: then they stay). Uses options.snap_float_steps.
+// Returns the pairs still crossing (as roundToFloat counts them).
 std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options, int rounds = 8);
 
@@ -146,10 +145,18 @@ std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*
 // rounding confuses.
 inline constexpr int kFloatSnapSteps = 8;
 
+// The quality snapping roundForFloatHost tries (with kFloatSnapSteps) when
+// the float result is still broken without it: the tolerance that removes
+// most slivers (SplitOptions::snap_tolerance).
+inline constexpr double kFloatQualitySnapTolerance = 0.05;
+
 struct FloatOutput {
   std::size_t crossing = 0;                // pairs still crossing, as roundToFloat counts them
   bool snapped_for_float = false;          // the result is the second split (snap_float_steps)
   std::size_t collinear_faces_mended = 0;  // mendCollinearNewFaces
+  // The result is the split with quality snapping (kFloatQualitySnapTolerance)
+  // that roundForFloatHost tried (snapped_for_float is set too).
+  bool quality_snapped_for_float = false;
 };
 
 // The result as a float host (MeshLab 2020.09) stores it: rounded
@@ -157,8 +164,10 @@ struct FloatOutput {
 // options.snap_float_steps was 0, the split of `inputs` again with
 // snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then
 // what still crosses split again (splitRoundedAgain; the separate outputs
-// follow the merged one); last, new faces left with collinear corners are
-// mended (mendCollinearNewFaces).
+// follow the merged one); where crossings or collapsed new faces are still
+// left and options.snap_tolerance was 0, the same from `inputs` with quality
+// snapping (kFloatQualitySnapTolerance), kept if it leaves fewer; last, new
+// faces left with collinear corners are mended (mendCollinearNewFaces).
 FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options);
 

@@ -523,6 +523,34 @@ TEST(Split, CrossingsLeftByRoundingAreSplitAgain) {
       EXPECT_LT(Distance(r.merged.vert[r.merged_vertex[m][v]].cP(), inputs[m]->vert[v].cP()), 1e-6);
 }
 
+TEST(Split, SurfacesAFewFloatStepsApartGetQualitySnappingForTheFloatResult) {
+  // A sphere and its copy moved along x by a millionth of its size: the
+  // curves run where the surface turns parallel to x, their points crowd
+  // within float steps of each other and of the edges, and rounding them,
+  // merging those a few float steps apart and splitting again leave
+  // crossings. The float repair then tries quality snapping, which does
+  // not leave any (nor a collapsed face); the user asked for none.
+  const Mesh a = uvSphere(24, 36), b = moved(a, {2e-6, 0, 0});
+  SplitOptions o;
+  o.separate_meshes = false;
+  SplitResult r = splitAlongIntersections({&a, &b}, o);
+  ASSERT_GT(r.intersecting_pairs, 0u);
+  const FloatOutput stored = roundForFloatHost(r, {&a, &b}, o);
+  EXPECT_TRUE(stored.quality_snapped_for_float);
+  EXPECT_TRUE(stored.snapped_for_float);
+  EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
+  EXPECT_EQ(stored.crossing, 0u);
+  EXPECT_EQ(remainingIntersections(r, true), 0u);
+  EXPECT_EQ(degenerateNewFaces(r), 0u);
+  EXPECT_EQ(r.curve_loops, 1u);
+  EXPECT_EQ(r.open_curves, 0u);
+  // With quality snapping asked for, the split is the user's as asked.
+  SplitOptions asked = o;
+  asked.snap_tolerance = 0.01;
+  SplitResult s = splitAlongIntersections({&a, &b}, asked);
+  EXPECT_FALSE(roundForFloatHost(s, {&a, &b}, asked).quality_snapped_for_float);
+}
+
 TEST(Split, SeparateOutputsFollowTheSplitAfterRounding) {
   // The tubes above, kept as separate outputs: what the float host stores
   // is each input's own mesh, so the repair of the merged output must reach

@@ -352,21 +352,29 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     Log("  %zu new faces that rounding to float left flat (collinear corners) were mended: the "
         "edge beyond flipped, or the face removed where it filled no gap",
         stored.collinear_faces_mended);
-  if (stored.snapped_for_float)
+  if (stored.quality_snapped_for_float)
+    Log("  curve points within %d float steps or %g of the local edge length of a vertex or edge "
+        "were merged into it (quality snapping: %zu vertices, %zu edges), as the float result "
+        "could not keep them apart otherwise",
+        kFloatSnapSteps, kFloatQualitySnapTolerance, r.vertices_snapped, r.edges_snapped);
+  else if (stored.snapped_for_float)
     Log("  curve points within %d float steps of a vertex or edge were merged into it (%zu "
         "vertices, %zu edges), as the float result could not keep them apart",
         kFloatSnapSteps, r.vertices_snapped, r.edges_snapped);
   const std::size_t collapsed = degenerateNewFaces(r);
   if (collapsed > 0)
     Log("  warning: %zu new faces are degenerate (collinear corners) as stored", collapsed);
-  if (verify && remaining > 0 && kHostStoresFloat && r.complete && options.snap_tolerance <= 0)
+  if (verify && remaining > 0 && kHostStoresFloat && r.complete)
     Log("  warning: where curve points lie a few float steps apart (surfaces meeting at a very "
-        "small angle), no float rounding keeps every face apart: run again with a quality "
-        "snapping tolerance of 0.05, which merges such points");
+        "small angle), no float rounding keeps every face apart, also with quality snapping of "
+        "%g: a larger quality snapping tolerance may merge more such points, and the Python "
+        "module (round_to_float=False) keeps the exact double result, which has none",
+        options.snap_tolerance > 0 ? options.snap_tolerance : kFloatQualitySnapTolerance);
   JsonObject report = toJson(r);
   report.set("degenerate_new_faces", collapsed)
       .set("snapped_for_float", stored.snapped_for_float)
-      .set("collinear_faces_mended", stored.collinear_faces_mended);
+      .set("collinear_faces_mended", stored.collinear_faces_mended)
+      .set("quality_snapped_for_float", stored.quality_snapped_for_float);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));

@@ -134,8 +134,8 @@ OptionTable<SplitCall> splitTable() {
       "round the output to float (as MeshLab and STL, float PLY or OBJ files store it), "
       "re-rounding curve points where rounding to nearest would make faces cross, merging curve "
       "points a few float steps apart and splitting the merged output again where it still "
-      "crosses (the separate meshes follow it), as the MeshLab filter does; the check then "
-      "counts the float output");
+      "crosses (the separate meshes follow it), trying quality snapping where that still leaves "
+      "crossings, as the MeshLab filter does; the check then counts the float output");
   t.add(
       "verify", [](SplitCall& c) -> bool& { return c.verify; },
       "count the intersecting pairs left in the merged output (remaining_intersecting_pairs)");
@@ -166,7 +166,8 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   JsonObject report = toJson(r);
   report.set("degenerate_new_faces", degenerateNewFaces(r))
       .set("snapped_for_float", stored.snapped_for_float)
-      .set("collinear_faces_mended", stored.collinear_faces_mended);
+      .set("collinear_faces_mended", stored.collinear_faces_mended)
+      .set("quality_snapped_for_float", stored.quality_snapped_for_float);
   if (c.verify) report.set("remaining_intersecting_pairs", remaining);
   report.set("output", c.core.separate_meshes ? "separate" : "merged");
 
