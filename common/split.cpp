@@ -2011,6 +2011,7 @@ FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& in
     reportProgress(options.progress, 97, "Splitting the rounded result where it crosses");
     out.crossing = splitRoundedAgain(r, inputs, used);
   }
+  if (degenerateNewFaces(r) > 0) out.collinear_faces_mended = mendCollinearNewFaces(r);
   // Where surfaces nearly coincide over a region (a part and a copy a few
   // float steps away), curve points crowd within float steps of each other
   // everywhere and neither of the above keeps the float result apart:
@@ -2025,15 +2026,16 @@ FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& in
     SplitResult third = splitAlongIntersections(inputs, snapping);
     std::size_t left = roundToFloat(third);
     if (left > 0) left = splitRoundedAgain(third, inputs, snapping);
+    const std::size_t mended = degenerateNewFaces(third) > 0 ? mendCollinearNewFaces(third) : 0;
     if (left + degenerateNewFaces(third) < out.crossing + degenerateNewFaces(r)) {
       third.time_ms += r.time_ms;
       r = std::move(third);
       out.crossing = left;
       out.snapped_for_float = true;
       out.quality_snapped_for_float = true;
+      out.collinear_faces_mended = mended;
     }
   }
-  if (degenerateNewFaces(r) > 0) out.collinear_faces_mended = mendCollinearNewFaces(r);
   return out;
 }
 

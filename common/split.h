@@ -164,10 +164,11 @@ struct FloatOutput {
 // options.snap_float_steps was 0, the split of `inputs` again with
 // snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then
 // what still crosses split again (splitRoundedAgain; the separate outputs
-// follow the merged one); where crossings or collapsed new faces are still
-// left and options.snap_tolerance was 0, the same from `inputs` with quality
-// snapping (kFloatQualitySnapTolerance), kept if it leaves fewer; last, new
-// faces left with collinear corners are mended (mendCollinearNewFaces).
+// follow the merged one); new faces left with collinear corners are mended
+// (mendCollinearNewFaces); last, where crossings or collapsed new faces are
+// still left and options.snap_tolerance was 0, all of that from `inputs`
+// with quality snapping (kFloatQualitySnapTolerance), kept if it leaves
+// fewer.
 FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
                               const SplitOptions& options);
 
