@@ -1,9 +1,10 @@
-// The MeshLab a plugin is built for, and the few document operations whose
-// spelling differs between the two supported hosts. The build chooses the host
-// (plugins/CMakeLists.txt) by which headers the MeshLab source provides:
+// The MeshLab a plugin is built for, and the few types and document
+// operations whose spelling differs between the supported hosts. The build
+// chooses the plugin API (plugins/CMakeLists.txt) by which headers the MeshLab
+// source provides, and the scalar by MESHMEND_MESHLAB_SCALAR:
 //   MESHMEND_MESHLAB_API 2020: MeshLab 2020.09 (Debian bookworm), float, MeshFilterInterface;
-//   MESHMEND_MESHLAB_API 2022: MeshLab 2022.02 (pymeshlab 2022.2), double, FilterPlugin.
-// Everything else in the plugins is written once against what both share.
+//   MESHMEND_MESHLAB_API 2022: MeshLab 2022.02 and 2025.07, float or double, FilterPlugin.
+// Everything else in the plugins is written once against what all share.
 #pragma once
 
 #include <type_traits>
@@ -23,6 +24,15 @@
 #endif
 
 namespace meshmend::bridge {
+
+// A distance parameter that the dialog also takes as a percentage of the
+// bounding box diagonal ("RichAbsPerc" in scripts on every host); MeshLab
+// 2025.07 renamed its class.
+#if __has_include(<common/parameters/rich_parameter/rich_percentage.h>)
+using RichDistance = RichPercentage;
+#else
+using RichDistance = RichAbsPerc;
+#endif
 
 // MeshLab's own coordinate type: float in 2020.09, double in pymeshlab's build.
 using HostScalar = CMeshO::ScalarType;

@@ -87,7 +87,7 @@ void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
   const Box3m box = md.bbox();
   const float diagonal = box.IsNull() ? 1.0f : box.Diag();
   const bool measuring = ID(a) == MEASURE_CLEARANCE;
-  parameters.addParam(RichAbsPerc(
+  parameters.addParam(RichDistance(
       "tau", diagonal * 0.01f, 0, diagonal, "Clearance tau",
       measuring ? "The clearance to check, in mesh units or as a percentage of the bounding box "
                   "diagonal: faces of pairs closer than this are selected; 0 only measures the "
@@ -125,7 +125,7 @@ void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
         "Selected vertices do not move (select a part that must keep its shape, e.g. the bore "
         "a piston must fit). A pair short of tau whose faces are all locked is reported, not "
         "solved."));
-    parameters.addParam(RichAbsPerc(
+    parameters.addParam(RichDistance(
         "max_displacement", 0, 0, diagonal, "Max vertex displacement",
         "No vertex moves farther than this from where it was, in mesh units or as a percentage "
         "of the bounding box diagonal; a vertex that reaches it stays there and the others go "

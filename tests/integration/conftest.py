@@ -14,19 +14,11 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.append(str(ROOT / "tests"))  # shapes.py, shared with the Python module's tests
-BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
-SHARED = Path(os.environ.get("MESHMEND_SHARED_DIR", ROOT.parent / "shared"))
-DATA = SHARED / "data"
-MESHCHECK = Path(os.environ.get("MESHMEND_MESHCHECK", BUILD / "shared-tools" / "meshcheck"))
+sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared with the Python module's tests
+from environment import (BUILD, DATA, MESHCHECK, SHARED, VENDOR, Host, meshcheck, need,  # noqa: E402,F401
+                         require_meshcheck, require_shared_data)
+
 PLUGIN_DIR = BUILD / "plugins-out"
-
-
-def require_shared_data():
-    if not DATA.is_dir():
-        pytest.skip(f"corpus absent: {DATA} not found (the real meshes live in ../shared beside the project)")
-    if not MESHCHECK.is_file():
-        pytest.fail(f"{MESHCHECK} is missing: scripts/test builds it from ../shared/tools")
 
 
 _probe_cache = None
@@ -102,11 +94,6 @@ def run_server(tmp_path, inputs, script_text, outputs=(), timeout=600):
     cmd += ["-s", str(script)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     return Run(proc, [json.loads(p.read_text()) for p in reports if p.exists()])
-
-
-def meshcheck(path, *args):
-    out = subprocess.run([str(MESHCHECK), str(path), *args], capture_output=True, text=True)
-    return json.loads(out.stdout) if out.stdout.strip() else {"exit": out.returncode}
 
 
 # ---- small meshes in every format ------------------------------------------

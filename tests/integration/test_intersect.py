@@ -2,15 +2,10 @@
 
 import pytest
 
-from conftest import MESHCHECK, ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
+from conftest import ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
 from shapes import tube
 
 SELECT = "MeshMend: Select Intersecting Faces"
-
-
-def meshcheck_if_available(path):
-    """The independent check when ../shared/tools was built (scripts/test builds it)."""
-    return meshcheck(path) if MESHCHECK.is_file() else None
 
 
 def shifted(V, d):
@@ -117,11 +112,10 @@ def test_split_two_cubes_merged_is_free_of_intersections(tmp_path):
     assert r["remaining_intersecting_pairs"] == 0
     assert r["curve_loops"] >= 1 and r["open_curves"] == 0
     assert r["faces_split"] == 12 and r["curve_edges"] > 0
-    check = meshcheck_if_available(out)
-    if check:
-        assert check["self_intersecting_pairs"] == 0
-        assert check["non_manifold_edges"] == r["curve_edges"]
-        assert check["border_edges"] == 0
+    check = meshcheck(out)
+    assert check["self_intersecting_pairs"] == 0
+    assert check["non_manifold_edges"] == r["curve_edges"]
+    assert check["border_edges"] == 0
 
 
 def test_split_keeps_layers_separate_and_closed(tmp_path):
@@ -157,10 +151,9 @@ def test_split_refuses_layers_that_do_not_intersect(tmp_path):
     assert run.returncode == 0, run.log
     assert "do not intersect" in run.log and "smallest angle" not in run.log
     assert run.report["intersecting_pairs"] == 0 and run.report["faces_split"] == 0
-    check = meshcheck_if_available(out)
-    if check:
-        assert check["faces"] == 24 and check["connected_components"] == 2
-        assert check["is_closed"] and check["self_intersecting_pairs"] == 0
+    check = meshcheck(out)
+    assert check["faces"] == 24 and check["connected_components"] == 2
+    assert check["is_closed"] and check["self_intersecting_pairs"] == 0
 
 
 def test_split_refuses_a_bad_snapping_tolerance(tmp_path):
@@ -191,11 +184,10 @@ def test_split_with_snapping_on_two_cubes(tmp_path):
         assert run.returncode == 0, run.log
         results[tolerance] = run.report
         assert run.report["remaining_intersecting_pairs"] == 0
-        check = meshcheck_if_available(out)
-        if check:
-            assert check["self_intersecting_pairs"] == 0
-            assert check["non_manifold_edges"] == run.report["curve_edges"]
-            assert check["border_edges"] == 0
+        check = meshcheck(out)
+        assert check["self_intersecting_pairs"] == 0
+        assert check["non_manifold_edges"] == run.report["curve_edges"]
+        assert check["border_edges"] == 0
     plain, snapped = results[0], results[0.05]
     assert plain["vertices_snapped"] == 0 and snapped["vertices_snapped"] > 0
     assert snapped["smallest_new_angle_deg_unsnapped"] == plain["smallest_new_angle_deg"]
@@ -210,10 +202,9 @@ def test_split_of_a_mesh_and_itself_keeps_one_surface(tmp_path):
     assert run.report["coincident_faces_removed"] == 12
     assert run.report["remaining_intersecting_pairs"] == 0
     assert "keeps each once" in run.log
-    check = meshcheck_if_available(out)
-    if check:
-        assert check["faces"] == 12 and check["duplicate_faces"] == 0
-        assert check["self_intersecting_pairs"] == 0 and check["border_edges"] == 0
+    check = meshcheck(out)
+    assert check["faces"] == 12 and check["duplicate_faces"] == 0
+    assert check["self_intersecting_pairs"] == 0 and check["border_edges"] == 0
 
 
 def test_separate_layers_overlapping_in_planes_keep_their_faces_uncounted(tmp_path):
@@ -235,10 +226,9 @@ def test_separate_layers_overlapping_in_planes_keep_their_faces_uncounted(tmp_pa
     assert r["remaining_intersecting_pairs"] == 0 and r["pairs_split_after_rounding"] == 0
     assert not r["snapped_for_float"] and "snapping tolerance" not in run.log
     for layer in layers:
-        check = meshcheck_if_available(layer)
-        if check:
-            assert check["self_intersecting_pairs"] == 0 and check["is_closed"]
-            assert check["non_manifold_edges"] == 0 and check["duplicate_faces"] == 0
+        check = meshcheck(layer)
+        assert check["self_intersecting_pairs"] == 0 and check["is_closed"]
+        assert check["non_manifold_edges"] == 0 and check["duplicate_faces"] == 0
 
 
 def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
@@ -250,10 +240,9 @@ def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
     r = run.report
     assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_new_faces"] == 0
     assert r["snapped_for_float"] or r["pairs_split_after_rounding"] > 0
-    check = meshcheck_if_available(out)
-    if check:
-        assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
-        assert check["border_edges"] == 0
+    check = meshcheck(out)
+    assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
+    assert check["border_edges"] == 0
 
 
 def test_separate_layers_of_tangent_tubes_are_repaired_as_float(tmp_path):
@@ -283,9 +272,8 @@ def test_split_of_a_layer_that_meets_itself_only_through_duplicates(tmp_path):
     run = run_server(tmp_path, [path], script, outputs=[out])
     assert run.returncode == 0, run.log
     assert run.report["vertices_welded"] == 8 and run.report["duplicate_faces_removed"] == 12
-    check = meshcheck_if_available(out)
-    if check:
-        assert check["faces"] == 12 and check["self_intersecting_pairs"] == 0
+    check = meshcheck(out)
+    assert check["faces"] == 12 and check["self_intersecting_pairs"] == 0
 
 
 def test_split_refuses_a_layer_that_collapses_when_welded(tmp_path):

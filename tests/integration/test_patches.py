@@ -6,7 +6,7 @@ import subprocess
 
 import pytest
 
-from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, mlx, require_shared_data, run_server, \
+from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, mlx, need, require_shared_data, run_server, \
     write_off
 
 def shifted(V, d):
@@ -37,8 +37,7 @@ def sample(name):
 def cgal_volumes(a, b):
     """Volumes of A, B and CGAL's union (peer_corefine)."""
     peer = MESHCHECK.parent / "peer_corefine"
-    if not peer.is_file():
-        pytest.fail(f"{peer} is missing: scripts/test builds it from ../shared/tools")
+    need(peer.is_file(), f"{peer} (scripts/test builds it from ../shared/tools)")
     import tempfile
     with tempfile.TemporaryDirectory() as tmp:
         out = f"{tmp}/union.off"

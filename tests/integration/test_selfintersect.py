@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, require_shared_data, run_server, write_off
+from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, need, require_shared_data, run_server, write_off
 
 CORPUS = ["self_intersecting/cow.off", "self_intersecting/pig.off",
           "self_intersecting/self_intersectA.obj", "scanned/horse.ply",
@@ -103,8 +103,7 @@ def as_float(V):
 
 def cgal_union_volume(tmp_path, a, b):
     peer = MESHCHECK.parent / "peer_corefine"
-    if not peer.is_file():
-        pytest.fail(f"{peer} is missing: scripts/test builds it from ../shared/tools")
+    need(peer.is_file(), f"{peer} (scripts/test builds it from ../shared/tools)")
     out = tmp_path / "cgal_union.off"
     run = subprocess.run([str(peer), str(a), str(b), "--out", str(out)], capture_output=True, text=True)
     report = json.loads(run.stdout)

@@ -22,11 +22,11 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
-MESHCHECK = Path(os.environ.get("MESHMEND_MESHCHECK", BUILD / "shared-tools" / "meshcheck"))
 sys.path.insert(0, str(BUILD / "python"))
-sys.path.append(str(ROOT / "tests"))  # shapes.py, shared with the meshlabserver tests
+sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared with the meshlabserver tests
 
 import meshmend as mm  # noqa: E402
+from environment import MESHCHECK, Host, need, require_meshcheck  # noqa: E402
 from shapes import tube  # noqa: E402
 
 
@@ -136,8 +136,7 @@ def write_off(path, V, F):
 
 
 def meshcheck(path, *args):
-    if not MESHCHECK.is_file():
-        pytest.skip(f"meshcheck not built at {MESHCHECK} (scripts/test builds it from ../shared/tools)")
+    require_meshcheck()
     out = subprocess.run([str(MESHCHECK), str(path), *args], capture_output=True, text=True)
     assert out.returncode == 0, out.stdout + out.stderr
     return json.loads(out.stdout)
@@ -360,8 +359,7 @@ def test_split_gives_the_plugin_s_counts_and_keys(tmp_path, two_spheres):
     """The same inputs (rounded to float, as MeshLab stores them) through the
     MeshLab filter (meshlabserver, report_file) and through the module."""
     prefix = BUILD / "meshlab-prefix" / "bin" / "meshlabserver"
-    if not prefix.exists():
-        pytest.skip(f"no private MeshLab prefix at {prefix} (scripts/setup makes it)")
+    need(prefix.exists(), f"the private MeshLab prefix at {prefix} (scripts/setup makes it)")
     meshes = [(V.astype(np.float32).astype(np.float64), F) for V, F in two_spheres]
     paths = []
     for k, (V, F) in enumerate(meshes):
@@ -764,7 +762,11 @@ def test_tuples_lists_and_mesh_like_objects_convert():
 
 
 def test_pymeshlab_round_trip():
-    pymeshlab = pytest.importorskip("pymeshlab", reason="pymeshlab is not installed (not installable on Debian bookworm)")
+    """With the real pymeshlab 2025.7 that scripts/hosts builds."""
+    host = Host("2025.07d")
+    host.require_pymeshlab()
+    sys.path.insert(0, str(host.pymeshlab))
+    import pymeshlab
     V, F = icosphere(1)
     m = mm.to_pymeshlab(V, F)
     assert isinstance(m, pymeshlab.Mesh)
