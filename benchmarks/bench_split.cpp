@@ -34,6 +34,7 @@
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
 #include "common/mesh_io.h"
+#include "common/output_stage.h"
 #include "common/split.h"
 
 using namespace meshmend;

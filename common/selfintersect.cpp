@@ -14,6 +14,7 @@
 #include "common/errors.h"
 #include "common/intersections.h"
 #include "common/interval.h"
+#include "common/output_stage.h"
 #include "common/predicates.h"
 #include "common/split.h"
 #include "common/triangle_intersection.h"

@@ -1,4 +1,5 @@
 #include "common/split.h"
+#include "common/output_stage.h"
 
 #include <set>
 

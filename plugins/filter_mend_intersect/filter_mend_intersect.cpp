@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "common/intersections.h"
+#include "common/output_stage.h"
 #include "common/patches.h"
 #include "common/split.h"
 #include "plugins/bridge/filter_support.h"

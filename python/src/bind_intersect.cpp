@@ -5,6 +5,7 @@
 #include "common/inspect.h"
 #include "common/intersections.h"
 #include "common/mesh_io.h"
+#include "common/output_stage.h"
 #include "common/selfintersect.h"
 #include "common/split.h"
 #include "python/src/bindings.h"
