@@ -83,7 +83,9 @@ int main(int argc, char** argv) {
                              o.separate_meshes = false;
                            }
                            SplitResult r = splitAlongIntersections({ma.get(), mb.get()}, o);
-                           if (sample && roundToFloat(r) != 0) return -1L;
+                           OutputStageOptions stage;
+                           stage.scalar = Scalar::kFloat;
+                           if (sample && roundForHost(r, stage) != 0) return -1L;
                            return long(r.faces_split);
                          });
                        }});

@@ -205,9 +205,13 @@ FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes
 }
 
 std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat, bool sameVertices) {
+  return selfIntersectingPairs(mesh, asFloat ? Scalar::kFloat : Scalar::kDouble, sameVertices);
+}
+
+std::size_t selfIntersectingPairs(const Mesh& mesh, Scalar scalar, bool sameVertices) {
   MeshArrays arrays = arraysOf(mesh);
-  if (asFloat)
-    for (Point3& p : arrays.points) p = roundedToFloat(p);
+  if (scalar != Scalar::kDouble)
+    for (Point3& p : arrays.points) p = storedAs(p, scalar);
   FindIntersectionsOptions o;
   o.cross = false;
   o.same_vertices = sameVertices;
@@ -451,7 +455,7 @@ std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(const std::vecto
   std::vector<Box> changedBoxes;
   for (std::size_t f = 0; f < T.size(); ++f) {
     if (!changed[f]) continue;
-    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);  // float bounds
     for (int k = 0; k < 3; ++k)
       for (int i = 0; i < widenSteps; ++i) {
         b.lo[k] = std::nextafter(b.lo[k], -INFINITY);

@@ -73,12 +73,15 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
 // stores them; faces with the same three vertices count unless
 // `sameVertices` is false (FindIntersectionsOptions::same_vertices).
 std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false, bool sameVertices = true);
+// The same with the coordinates rounded to `scalar`.
+std::size_t selfIntersectingPairs(const Mesh& mesh, Scalar scalar, bool sameVertices);
 
 // Candidate pairs (box overlap) of faces of (points, triangles) where at
 // least one face is `changed`: after a local edit only those pairs can
 // intersect anew when every pair of two unchanged faces is known. Boxes of
 // changed faces are widened by `widenSteps` float steps (room for moving
-// their vertices by as many float steps). Each pair once, changed face first.
+// their vertices by as many float steps, or by more double steps). Each
+// pair once, changed face first.
 std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(
     const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
     const std::vector<char>& changed, int widenSteps = 0);

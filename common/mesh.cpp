@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "common/errors.h"
@@ -48,6 +49,19 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
 
 bool isFinite(const Point3& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+double scalarStep(const Point3& p, Scalar s) {
+  const double m = std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
+  if (s == Scalar::kFloat) {
+    const float f = float(m);
+    if (!std::isfinite(f)) return double(std::numeric_limits<float>::max()) * 0x1p-23;
+    return std::max(double(std::nextafter(f, INFINITY)) - double(f),
+                    double(std::numeric_limits<float>::min()) * 0x1p-23);
+  }
+  if (!std::isfinite(m) || m >= std::numeric_limits<double>::max())
+    return std::numeric_limits<double>::max() * 0x1p-52;
+  return std::max(std::nextafter(m, INFINITY) - m, std::numeric_limits<double>::min() * 0x1p-52);
 }
 
 Mesh makeMesh(const std::vector<Point3>& positions, const std::vector<Triangle>& triangles,

@@ -211,6 +211,21 @@ inline Point3 roundedToFloat(const Point3& p) {
   return Point3(double(float(p[0])), double(float(p[1])), double(float(p[2])));
 }
 
+// The scalar a host stores coordinates in: float (MeshLab 2020.09 and
+// MeshLab's float builds; STL and float PLY files) or double (pymeshlab,
+// MeshLab's "d" builds, the NumPy module). The core computes exactly and in
+// double; what a host stores is `p` rounded to its scalar (storedAs).
+enum class Scalar : std::uint8_t { kFloat, kDouble };
+inline const char* toString(Scalar s) {
+  return s == Scalar::kFloat ? "float" : "double";
+}
+inline Point3 storedAs(const Point3& p, Scalar s) {
+  return s == Scalar::kFloat ? roundedToFloat(p) : p;
+}
+// The step between values of scalar `s` at the magnitude of `p`'s largest
+// coordinate (at least the smallest normal step, so that it is never 0).
+double scalarStep(const Point3& p, Scalar s);
+
 // Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh
 // has no faces or a non-finite coordinate.
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what);

@@ -179,246 +179,297 @@ std::size_t mendCollinearNewFaces(SplitResult& r) {
   return mended;
 }
 
-FloatOutput roundForFloatHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options) {
-  FloatOutput out;
-  out.crossing = roundToFloat(r);
-  SplitOptions used = options;
-  // Where curve points lie a few float steps from each other or from an
-  // edge, no rounding keeps every face apart (or whole): split again with
-  // such points merged as quality snapping merges them.
-  if (options.snap_float_steps <= 0 && (out.crossing > 0 || degenerateNewFaces(r) > 0)) {
-    reportProgress(options.progress, 96, "Splitting again, merging points a float apart");
-    used.snap_float_steps = kFloatSnapSteps;
-    SplitResult second = splitAlongIntersections(inputs, used);
-    const std::size_t left = roundToFloat(second);
-    if (left + degenerateNewFaces(second) < out.crossing + degenerateNewFaces(r)) {
-      second.time_ms += r.time_ms;
-      r = std::move(second);
-      out.crossing = left;
-      out.snapped_for_float = true;
-    } else {
-      used.snap_float_steps = options.snap_float_steps;
-    }
+namespace {
+
+// The stored values of `scalar` around x: the largest at most x and the
+// smallest at least x (the same when x is stored exactly, always so for a
+// double), and the neighbour of a stored value towards +-infinity.
+double storedBelow(double x, Scalar scalar) {
+  if (scalar == Scalar::kDouble) return x;
+  const float f = float(x);
+  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+double storedAbove(double x, Scalar scalar) {
+  if (scalar == Scalar::kDouble) return x;
+  const float f = float(x);
+  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+double storedNext(double v, double towards, Scalar scalar) {
+  return scalar == Scalar::kDouble ? std::nextafter(v, towards)
+                                   : double(std::nextafter(float(v), float(towards)));
+}
+
+// How many stored values away from its unrounded value roundForHost may put
+// a coordinate of a new vertex (the nearest below or above is one away).
+// The choices grow as its cube; what two values each way cannot keep apart
+// is for snapping and splitStoredAgain.
+constexpr int kFarthestRounding = 2;
+
+constexpr std::size_t kNoLimit = std::numeric_limits<std::size_t>::max();
+
+// The values a coordinate x may take at `reach`, nearest first: those
+// below and above x (one each at reach 1, then the next out), and x itself
+// when it is a stored value.
+std::vector<double> roundingChoices(double x, int reach, Scalar scalar) {
+  double lo = storedBelow(x, scalar), hi = storedAbove(x, scalar);
+  std::vector<double> out;
+  if (lo == hi) {
+    out.push_back(x);
+  } else {
+    out.push_back(lo);
+    out.push_back(hi);
+    --reach;
   }
-  // What is left crosses as rounded: the merged output is split again along
-  // those crossings, on its float values, and rounded again (the separate
-  // outputs follow).
-  if (out.crossing > 0) {
-    reportProgress(options.progress, 97, "Splitting the rounded result where it crosses");
-    out.crossing = splitRoundedAgain(r, inputs, used);
-  }
-  if (degenerateNewFaces(r) > 0) out.collinear_faces_mended = mendCollinearNewFaces(r);
-  // Where surfaces nearly coincide over a region (a part and a copy a few
-  // float steps away), curve points crowd within float steps of each other
-  // everywhere and neither of the above keeps the float result apart:
-  // quality snapping removes the slivers that hold them. Tried only when
-  // none was asked for and crossings or collapsed faces are left; kept if
-  // it leaves fewer.
-  if (options.snap_tolerance <= 0 && out.crossing + degenerateNewFaces(r) > 0) {
-    reportProgress(options.progress, 98, "Splitting again with quality snapping");
-    SplitOptions snapping = options;
-    snapping.snap_tolerance = kFloatQualitySnapTolerance;
-    snapping.snap_float_steps = kFloatSnapSteps;
-    SplitResult third = splitAlongIntersections(inputs, snapping);
-    std::size_t left = roundToFloat(third);
-    if (left > 0) left = splitRoundedAgain(third, inputs, snapping);
-    const std::size_t mended = degenerateNewFaces(third) > 0 ? mendCollinearNewFaces(third) : 0;
-    if (left + degenerateNewFaces(third) < out.crossing + degenerateNewFaces(r)) {
-      third.time_ms += r.time_ms;
-      r = std::move(third);
-      out.crossing = left;
-      out.snapped_for_float = true;
-      out.quality_snapped_for_float = true;
-      out.collinear_faces_mended = mended;
-    }
+  for (int j = 0; j < reach; ++j) {
+    lo = storedNext(lo, -INFINITY, scalar);
+    hi = storedNext(hi, INFINITY, scalar);
+    if (std::isfinite(lo)) out.push_back(lo);
+    if (std::isfinite(hi)) out.push_back(hi);
   }
   return out;
 }
 
-std::size_t remainingIntersections(const SplitResult& result, bool asFloat) {
-  requireMergedOutput(result, "counting the intersections left");
-  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, asFloat, false);
-}
+// The faces around each vertex (compressed rows) and, per changed face, its
+// candidate pairs both ways.
+struct Rows {
+  std::vector<std::uint32_t> offsets, items;
+  std::pair<const std::uint32_t*, const std::uint32_t*> row(std::size_t i) const {
+    return {items.data() + offsets[i], items.data() + offsets[i + 1]};
+  }
+};
 
-namespace {
+// Step 1 on arrays: `reference` (the unrounded positions: input vertices
+// exactly, curve points within their error), `newFace` and `movable`
+// (vertices that may be re-rounded: the new ones) given; `P` receives the
+// stored positions. Returns the crossing pairs left.
+class Rounder {
+ public:
+  Rounder(const std::vector<Point3>& reference, const std::vector<Triangle>& T,
+          const std::vector<char>& newFace, const std::vector<char>& movable, Scalar scalar,
+          std::vector<Point3>& P)
+      : ref_(reference), T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
+    P_ = reference;
+    for (Point3& p : P_) p = storedAs(p, scalar);
+  }
 
-float below(double x) {
-  float f = float(x);
-  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
-}
-float above(double x) {
-  float f = float(x);
-  return double(f) < x ? std::nextafter(f, INFINITY) : f;
-}
+  // Re-rounds while defects are left, at most `passes` passes per reach and
+  // `budget` exact pair tests in all (bounded: the budget stopped it).
+  // Gives up at once, leaving the nearest rounding, where that has more
+  // than `giveUpAbove` defects.
+  std::size_t run(int passes, std::size_t budget, std::size_t giveUpAbove, const Progress& progress,
+                  std::size_t& rerounded, bool& bounded) {
+    if (!findChanged()) return 0;
+    findCandidates();
+    crossing_ = intersectingOf(P_, T_, pairs_);
+    budget_ = budget;
+    if (crossing_.size() > giveUpAbove) return crossing_.size();
+    std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
+    const std::vector<Point3> nearest = P_;
+    // Each coordinate goes to one of the `reach` values below its unrounded
+    // value or the `reach` above. One each way first (the two nearest);
+    // where faces meet at a very small angle, neither may keep them apart,
+    // and the next value out may.
+    int reach = 1, passesAtReach = 0;
+    std::size_t before = std::numeric_limits<std::size_t>::max();  // defects before the last pass
+    for (int pass = 0;; ++pass) {
+      if (pass > 0) recheck(moved);
+      const std::vector<std::uint32_t> flat = collapsedFaces();
+      const std::size_t defects = crossing_.size() + flat.size();
+      if (defects == 0 || tests_ >= budget_) break;
+      if (passesAtReach == passes || defects >= before) {  // this reach has done what it can
+        if (reach == kFarthestRounding) break;
+        ++reach;
+        passesAtReach = 0;
+      }
+      before = defects;
+      ++passesAtReach;
+      reportProgress(progress, 96, "Rounding again where faces cross");
+      std::set<int> candidates;
+      auto addCorners = [&](std::uint32_t f) {
+        for (int v : T_[f])
+          if (movable_[v]) candidates.insert(v);
+      };
+      for (const auto& p : crossing_)
+        for (std::uint32_t f : p) addCorners(f);
+      for (std::uint32_t f : flat) addCorners(f);
+      for (int v : candidates) moved[v] = reround(v, reach);
+    }
+    bounded = tests_ >= budget_ && !crossing_.empty();
+    rerounded = 0;
+    for (std::size_t v = 0; v < P_.size(); ++v) rerounded += P_[v] != nearest[v];
+    return crossing_.size();
+  }
+
+ private:
+  // Faces that are new or that rounding moved: only those can cross
+  // anything they did not cross before (every other face is an input face,
+  // exactly as it was).
+  bool findChanged() {
+    isChanged_.assign(T_.size(), 0);
+    changedIndex_.assign(T_.size(), -1);
+    for (std::size_t f = 0; f < T_.size(); ++f) {
+      isChanged_[f] = f < newFace_.size() && newFace_[f];
+      for (int v : T_[f]) isChanged_[f] |= P_[v] != ref_[v];
+      if (isChanged_[f]) {
+        changedIndex_[f] = int(changed_.size());
+        changed_.push_back(std::uint32_t(f));
+      }
+    }
+    return !changed_.empty();
+  }
+
+  // Candidates: boxes widened by more steps than re-rounding moves a vertex
+  // (at most kFarthestRounding from its unrounded position; the boxes are
+  // float, so a float step covers double steps too). Faces with the same
+  // three vertices (a planar overlap kept in each part) coincide however
+  // their vertices are rounded: never a crossing here.
+  void findCandidates() {
+    pairs_ = pairsWithChangedFaces(P_, T_, isChanged_, kFarthestRounding + 2);
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                [&](const auto& p) { return sameVertices(T_[p[0]], T_[p[1]]); }),
+                 pairs_.end());
+    others_.offsets.assign(changed_.size() + 1, 0);
+    for (const auto& [f, g] : pairs_) {
+      ++others_.offsets[changedIndex_[f] + 1];
+      if (changedIndex_[g] >= 0) ++others_.offsets[changedIndex_[g] + 1];
+    }
+    for (std::size_t i = 0; i < changed_.size(); ++i) others_.offsets[i + 1] += others_.offsets[i];
+    others_.items.resize(others_.offsets.back());
+    {
+      std::vector<std::uint32_t> next(others_.offsets.begin(), others_.offsets.end() - 1);
+      for (const auto& [f, g] : pairs_) {
+        others_.items[next[changedIndex_[f]]++] = g;
+        if (changedIndex_[g] >= 0) others_.items[next[changedIndex_[g]]++] = f;
+      }
+    }
+    around_.offsets.assign(P_.size() + 1, 0);
+    for (std::uint32_t f : changed_)
+      for (int v : T_[f]) ++around_.offsets[v + 1];
+    for (std::size_t v = 0; v < P_.size(); ++v) around_.offsets[v + 1] += around_.offsets[v];
+    around_.items.resize(around_.offsets.back());
+    std::vector<std::uint32_t> next(around_.offsets.begin(), around_.offsets.end() - 1);
+    for (std::uint32_t f : changed_)
+      for (int v : T_[f]) around_.items[next[v]++] = f;
+  }
+
+  // Only pairs with a face at a vertex that moved can have changed: the
+  // others keep what the last check found.
+  void recheck(std::vector<char>& moved) {
+    auto touches = [&](std::uint32_t f) {
+      return moved[T_[f][0]] | moved[T_[f][1]] | moved[T_[f][2]];
+    };
+    std::vector<std::array<std::uint32_t, 2>> again, still;
+    for (const auto& p : pairs_)
+      if (touches(p[0]) || touches(p[1])) again.push_back(p);
+    for (const auto& p : crossing_)
+      if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
+    crossing_ = intersectingOf(P_, T_, again);
+    crossing_.insert(crossing_.end(), still.begin(), still.end());
+    std::fill(moved.begin(), moved.end(), 0);
+  }
+
+  // A changed face whose corners rounding made collinear is worse than a
+  // crossing: it has no normal, a checker takes it for a hole in the
+  // surface, and a crossing elsewhere is still split again. New faces are
+  // never collinear exactly; an input face only when it was already.
+  bool collapsed(std::uint32_t f) const {
+    const Triangle& t = T_[f];
+    return collinear(P_[t[0]], P_[t[1]], P_[t[2]]) &&
+           ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]]));
+  }
+  std::vector<std::uint32_t> collapsedFaces() const {
+    std::vector<std::uint32_t> flat;
+    for (std::uint32_t f : changed_)
+      if (collapsed(f)) flat.push_back(f);
+    return flat;
+  }
+
+  // How many crossings (and collapsed faces, as two each) the changed faces
+  // around v take part in, counted up to `enough` (a position is only worth
+  // knowing while it beats the best).
+  std::size_t localCrossings(int v, std::size_t enough) {
+    std::size_t n = 0;
+    for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
+      if ((n += 2 * collapsed(*f)) >= enough) return n;
+      for (auto [g, last] = others_.row(std::size_t(changedIndex_[*f])); g != last; ++g) {
+        ++tests_;
+        if ((n += facesIntersect(P_, T_, *f, *g)) >= enough) return n;
+      }
+    }
+    return n;
+  }
+
+  // Moves new vertex v to the rounding choice under which the faces around
+  // it take part in the fewest crossings, trying the choices nearest its
+  // unrounded position first; true when it moved.
+  bool reround(int v, int reach) {
+    const Point3 start = P_[v];
+    std::array<std::vector<double>, 3> choices;
+    for (int k = 0; k < 3; ++k) choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
+    std::vector<std::array<std::uint8_t, 3>> order;
+    for (std::size_t i = 0; i < choices[0].size(); ++i)
+      for (std::size_t j = 0; j < choices[1].size(); ++j)
+        for (std::size_t k = 0; k < choices[2].size(); ++k)
+          order.push_back({std::uint8_t(i), std::uint8_t(j), std::uint8_t(k)});
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+      return a[0] + a[1] + a[2] < b[0] + b[1] + b[2];
+    });
+    Point3 best = start;
+    std::size_t bestCount = localCrossings(v, std::numeric_limits<std::size_t>::max());
+    for (const auto& [i, j, k] : order) {
+      if (bestCount == 0 || tests_ >= budget_) break;
+      P_[v] = Point3(choices[0][i], choices[1][j], choices[2][k]);
+      if (P_[v] == start) continue;
+      const std::size_t count = localCrossings(v, bestCount);
+      if (count < bestCount) best = P_[v], bestCount = count;
+    }
+    P_[v] = best;
+    return best != start;
+  }
+
+  const std::vector<Point3>& ref_;
+  const std::vector<Triangle>& T_;
+  const std::vector<char>& newFace_;
+  const std::vector<char>& movable_;
+  const Scalar scalar_;
+  std::vector<Point3>& P_;
+  std::vector<char> isChanged_;
+  std::vector<int> changedIndex_;
+  std::vector<std::uint32_t> changed_;
+  std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
+  Rows others_, around_;
+  std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
+
+ public:
+  std::size_t tests() const { return tests_; }
+};
 
 }  // namespace
 
-// How many floats away from its exact value roundToFloat may put a
-// coordinate of a new vertex (the nearest below or above is one away). The
-// choices grow as its cube; what two floats each way cannot keep apart is
-// for snapping and splitRoundedAgain.
-constexpr int kFarthestRounding = 2;
-
-std::size_t roundToFloat(SplitResult& r, int passes) {
-  requireMergedOutput(r, "rounding to float");
+std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, StoredOutput* out,
+                         std::size_t giveUpAbove) {
+  requireMergedOutput(r, "rounding for the host");
   Mesh& merged = r.merged;
   if (merged.fn == 0) return 0;
-  const std::vector<Point3> exact = positionsOf(merged);
-  std::vector<Point3> P = exact;
-  for (Point3& p : P) p = roundedToFloat(p);
+  const std::vector<Point3> reference = positionsOf(merged);
   const std::vector<Triangle> T = trianglesOf(merged);
   VertexOriginHandle vo = vertexOrigins(merged);
-
-  // Only faces that are new or that rounding moves can cross anything they
-  // did not cross before: every other face is an input face, exactly as it was.
-  std::vector<char> isChanged(T.size(), 0);
-  std::vector<int> changedIndex(T.size(), -1);
-  std::vector<std::uint32_t> changed;
-  for (std::size_t f = 0; f < T.size(); ++f) {
-    isChanged[f] = f < r.merged_new_face.size() && r.merged_new_face[f];
-    for (int v : T[f]) isChanged[f] |= P[v] != exact[v];
-    if (isChanged[f]) {
-      changedIndex[f] = int(changed.size());
-      changed.push_back(std::uint32_t(f));
-    }
+  std::vector<char> movable(reference.size(), 0);  // new vertices: inputs stay as they are
+  for (std::size_t v = 0; v < reference.size(); ++v) movable[v] = vo[v].vertex < 0;
+  std::vector<Point3> P;
+  std::size_t moved = 0;
+  bool bounded = false;
+  const std::size_t used = out ? out->rounding_tests : 0;
+  Rounder rounder(reference, T, r.merged_new_face, movable, stage.scalar, P);
+  const std::size_t remaining = rounder.run(
+      stage.rounding_passes, stage.max_rounding_tests > used ? stage.max_rounding_tests - used : 0,
+      giveUpAbove, stage.progress, moved, bounded);
+  if (out) {
+    out->vertices_rerounded += moved;
+    out->bounded |= bounded;
+    out->rounding_tests += rounder.tests();
   }
-  if (changed.empty()) return 0;
-  // Candidates: boxes widened by more float steps than re-rounding moves a
-  // vertex (at most kFarthestRounding from its exact position).
-  // Faces with the same three vertices (a planar overlap kept in each part)
-  // coincide however their vertices are rounded: never a crossing here.
-  std::vector<std::array<std::uint32_t, 2>> pairs =
-      pairsWithChangedFaces(P, T, isChanged, kFarthestRounding + 2);
-  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
-                             [&](const auto& p) { return sameVertices(T[p[0]], T[p[1]]); }),
-              pairs.end());
-  // Candidates of each changed face, both ways (compressed rows).
-  std::vector<std::uint32_t> offsets(changed.size() + 1, 0), others;
-  for (const auto& [f, g] : pairs) {
-    ++offsets[changedIndex[f] + 1];
-    if (changedIndex[g] >= 0) ++offsets[changedIndex[g] + 1];
-  }
-  for (std::size_t i = 0; i < changed.size(); ++i) offsets[i + 1] += offsets[i];
-  others.resize(offsets.back());
-  {
-    std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
-    for (const auto& [f, g] : pairs) {
-      others[next[changedIndex[f]]++] = g;
-      if (changedIndex[g] >= 0) others[next[changedIndex[g]]++] = f;
-    }
-  }
-  // Changed faces around each vertex.
-  std::vector<std::uint32_t> aroundOffsets(P.size() + 1, 0), around;
-  for (std::uint32_t f : changed)
-    for (int v : T[f]) ++aroundOffsets[v + 1];
-  for (std::size_t v = 0; v < P.size(); ++v) aroundOffsets[v + 1] += aroundOffsets[v];
-  around.resize(aroundOffsets.back());
-  {
-    std::vector<std::uint32_t> next(aroundOffsets.begin(), aroundOffsets.end() - 1);
-    for (std::uint32_t f : changed)
-      for (int v : T[f]) around[next[v]++] = f;
-  }
-
-  auto crosses = [&](std::uint32_t f, std::uint32_t g) { return facesIntersect(P, T, f, g); };
-  // A changed face whose corners rounding made collinear (a face that was
-  // not) is worse than a crossing: it has no normal, a checker takes it for
-  // a hole in the surface, and a crossing elsewhere is still split again
-  // (splitRoundedAgain). It counts as two.
-  auto collapsed = [&](std::uint32_t f) {
-    return collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]) &&
-           !collinear(exact[T[f][0]], exact[T[f][1]], exact[T[f][2]]);
-  };
-  // How many crossings (and collapsed faces) the changed faces around v
-  // take part in, counted up to `enough` (a position is only worth knowing
-  // while it beats the best).
-  auto localCrossings = [&](int v, std::size_t enough) {
-    std::size_t n = 0;
-    for (std::uint32_t k = aroundOffsets[v]; k < aroundOffsets[v + 1]; ++k) {
-      const std::uint32_t f = around[k];
-      if ((n += 2 * collapsed(f)) >= enough) return n;
-      const int i = changedIndex[f];
-      for (std::uint32_t j = offsets[i]; j < offsets[i + 1]; ++j)
-        if ((n += crosses(f, others[j])) >= enough) return n;
-    }
-    return n;
-  };
-
-  std::size_t remaining = 0;
-  std::vector<std::array<std::uint32_t, 2>> crossing = intersectingOf(P, T, pairs);
-  std::vector<char> moved(P.size(), 0);  // re-rounded in the last pass
-  // Each coordinate goes to one of the `reach` floats below its exact value
-  // or the `reach` above. One each way first (the two nearest); where faces
-  // meet at a very small angle, neither may keep them apart, and the next
-  // float out may.
-  int reach = 1, passesAtReach = 0;
-  std::size_t before = std::numeric_limits<std::size_t>::max();  // defects before the last pass
-  for (int pass = 0;; ++pass) {
-    if (pass > 0) {
-      // Only pairs with a face at a vertex that moved can have changed: the
-      // others keep what the last check found.
-      auto touches = [&](std::uint32_t f) {
-        return moved[T[f][0]] | moved[T[f][1]] | moved[T[f][2]];
-      };
-      std::vector<std::array<std::uint32_t, 2>> recheck, still;
-      for (const auto& p : pairs)
-        if (touches(p[0]) || touches(p[1])) recheck.push_back(p);
-      for (const auto& p : crossing)
-        if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
-      crossing = intersectingOf(P, T, recheck);
-      crossing.insert(crossing.end(), still.begin(), still.end());
-      std::fill(moved.begin(), moved.end(), 0);
-    }
-    remaining = crossing.size();
-    std::vector<std::uint32_t> flat;
-    for (std::uint32_t f : changed)
-      if (collapsed(f)) flat.push_back(f);
-    const std::size_t defects = remaining + flat.size();
-    if (defects == 0) break;
-    if (passesAtReach == passes || defects >= before) {  // this reach has done what it can
-      if (reach == kFarthestRounding) break;
-      ++reach;
-      passesAtReach = 0;
-    }
-    before = defects;
-    ++passesAtReach;
-    std::set<int> candidates;
-    auto addCorners = [&](std::uint32_t f) {
-      for (int v : T[f])
-        if (vo[v].vertex < 0) candidates.insert(v);  // new vertices only: inputs stay as they are
-    };
-    for (const auto& p : crossing)
-      for (std::uint32_t f : p) addCorners(f);
-    for (std::uint32_t f : flat) addCorners(f);
-    for (int v : candidates) {
-      const Point3 e = exact[v], start = P[v];
-      // Per coordinate, the floats nearest first: below, above, then the
-      // next ones out.
-      std::array<std::array<float, 2 * kFarthestRounding>, 3> options;
-      for (int k = 0; k < 3; ++k) {
-        float lo = below(e[k]), hi = above(e[k]);
-        for (int j = 0; j < reach; ++j) {
-          options[k][2 * j] = lo;
-          options[k][2 * j + 1] = hi;
-          lo = std::nextafter(lo, -INFINITY);
-          hi = std::nextafter(hi, INFINITY);
-        }
-      }
-      Point3 best = start;
-      std::size_t bestCount = localCrossings(v, std::numeric_limits<std::size_t>::max());
-      const int n = 2 * reach;
-      for (int choice = 0; choice < n * n * n && bestCount > 0; ++choice) {
-        P[v] = Point3(options[0][choice % n], options[1][choice / n % n],
-                      options[2][choice / (n * n)]);
-        if (P[v] == start) continue;
-        const std::size_t count = localCrossings(v, bestCount);
-        if (count < bestCount) best = P[v], bestCount = count;
-      }
-      moved[v] = best != start;
-      P[v] = best;
-    }
-  }
-  // Write the float positions back, to the merged output and to each mesh.
+  // The stored positions, to the merged output and to each mesh.
   for (std::size_t v = 0; v < P.size(); ++v) merged.vert[v].P() = P[v];
   for (std::size_t m = 0; m < r.meshes.size(); ++m)
     for (std::size_t v = 0; v < r.merged_vertex[m].size(); ++v)
@@ -426,13 +477,31 @@ std::size_t roundToFloat(SplitResult& r, int passes) {
   return remaining;
 }
 
+std::size_t crossingsLeft(const SplitResult& result, Scalar scalar) {
+  requireMergedOutput(result, "counting the crossings left");
+  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, scalar, false);
+}
+
+std::size_t storedIntersectingPairs(const Mesh& mesh, Scalar scalar) {
+  return mesh.fn == 0 ? 0 : selfIntersectingPairs(mesh, scalar, true);
+}
+
+std::size_t storedIntersectingPairs(MeshArrays mesh, Scalar scalar) {
+  if (mesh.triangles.empty()) return 0;
+  for (Point3& p : mesh.points) p = storedAs(p, scalar);
+  FindIntersectionsOptions o;
+  o.cross = false;
+  o.same_vertices = true;
+  return findIntersectionsInArrays({&mesh}, o).self_pairs[0];
+}
+
 namespace {
 
 // The curve edge a-b of a merged output split again, in the new output:
 // the edge itself, or the path the split put on it (the shortest through
-// vertices that split made and that lie on the segment, within a float step
-// or so: they were rounded).
-void carryCurveEdge(int a, int b, const Mesh& mesh,
+// vertices that split made and that lie on the segment, within a step or so
+// of `scalar`: they were rounded).
+void carryCurveEdge(int a, int b, const Mesh& mesh, Scalar scalar,
                     const std::unordered_map<int, std::vector<int>>& changed,
                     const std::vector<char>& isNew, std::vector<std::array<int, 2>>& curves) {
   const auto around = changed.find(a);
@@ -446,7 +515,7 @@ void carryCurveEdge(int a, int b, const Mesh& mesh,
     const Point3 av = mesh.vert[v].cP() - pa;
     const double t = (av * ab) / ab.SquaredNorm();
     return t > 0 && t < 1 &&
-           (av - ab * t).Norm() <= 1e-5 * ab.Norm() + 4 * floatStep(mesh.vert[v].cP());
+           (av - ab * t).Norm() <= 1e-5 * ab.Norm() + 4 * scalarStep(mesh.vert[v].cP(), scalar);
   };
   std::unordered_map<int, int> from{{a, -1}};
   std::vector<int> layer{a};
@@ -523,33 +592,47 @@ void separateFromMerged(SplitResult& r) {
 
 }  // namespace
 
-std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options, int rounds) {
-  requireMergedOutput(r, "splitting the rounded output again");
+std::size_t splitStoredAgain(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                             const SplitOptions& split, const OutputStageOptions& stage,
+                             StoredOutput& out) {
+  requireMergedOutput(r, "splitting the stored output again");
   const std::size_t splitBefore = r.pairs_split_after_rounding;
-  std::size_t left = std::numeric_limits<std::size_t>::max();  // not counted yet
-  std::size_t fewest = left;  // the fewest crossings a round has left (none yet)
-  for (int round = 0; round < rounds && left > 0 && r.merged.fn > 0; ++round) {
+  std::size_t left = out.crossing;  // as the rounding before left them
+  std::size_t fewest = left;        // the fewest crossings a round has left
+  for (int round = 0; round < stage.split_rounds && left > 0 && r.merged.fn > 0; ++round) {
+    // The next round splits at least the pairs left: past the bound, the
+    // stage stops here with them.
+    if (out.pairs_split_again + left > stage.max_pairs_split_again) {
+      out.bounded = true;
+      break;
+    }
+    reportProgress(stage.progress, 97, "Splitting the stored result where it crosses");
     const auto start = std::chrono::steady_clock::now();
     Mesh& old = r.merged;
     SplitOptions again;
     again.between_meshes = false;
     again.self = true;
     again.separate_meshes = false;
-    again.snap_float_steps = options.snap_float_steps;
-    again.overlaps_once = options.overlaps_once;
-    again.progress = options.progress;
+    again.snap_host_steps = split.snap_host_steps;
+    again.host = stage.scalar;
+    again.overlaps_once = split.overlaps_once;
+    again.progress = progressWithin(stage.progress, 97, 97);
     SplitResult next = splitAlongIntersections({&old}, again);
     if (next.intersecting_pairs == 0) {
       left = 0;
       break;
     }
-    const std::size_t stillCrossing = roundToFloat(next);
+    ++out.rounds_split_again;
+    out.pairs_split_again += next.intersecting_pairs;
     // Rounds may leave a few more crossings than the round before and still
     // end at none; where surfaces nearly coincide over a region they can
     // also run away, each round's new slivers crossing more (99, 12, 16,
     // 36, 169, 1,547, ... pairs): a round that leaves more than twice the
-    // fewest so far is not taken, and the rounds end.
+    // fewest so far is not taken, and the rounds end. Re-rounding removes
+    // some three crossings in four: a round that rounded to nearest leaves
+    // more than eight times the fewest is not re-rounded either.
+    const std::size_t stillCrossing =
+        roundForHost(next, stage, &out, round > 0 ? 8 * fewest : kNoLimit);
     if (round > 0 && stillCrossing > 2 * fewest) break;
     fewest = std::min(fewest, stillCrossing);
     // Provenance through the old output to the inputs.
@@ -601,7 +684,7 @@ std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& in
       }
     std::vector<std::array<int, 2>> curves = next.merged_curve_edges;
     for (const auto& e : r.merged_curve_edges)
-      carryCurveEdge(moved[e[0]], moved[e[1]], next.merged, changed, isNew, curves);
+      carryCurveEdge(moved[e[0]], moved[e[1]], next.merged, stage.scalar, changed, isNew, curves);
     // Only edges of the mesh (a face that collapsed takes its edges along).
     curves.erase(std::remove_if(curves.begin(), curves.end(),
                                 [&](const std::array<int, 2>& e) {
@@ -637,7 +720,147 @@ std::size_t splitRoundedAgain(SplitResult& r, const std::vector<const Mesh*>& in
   if (r.pairs_split_after_rounding > splitBefore && !r.meshes.empty() &&
       r.coincident_faces_removed == 0)
     separateFromMerged(r);
-  return left == std::numeric_limits<std::size_t>::max() ? remainingIntersections(r, true) : left;
+  return left;
+}
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// Defects of a stored result: crossings (as counted) and collapsed new faces.
+std::size_t defectsOf(const SplitResult& r, std::size_t crossing) {
+  return crossing + degenerateNewFaces(r);
+}
+
+// Steps 3 and 4 on `r` as rounded (crossing: what the rounding left).
+void splitAgainAndMend(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                       const SplitOptions& split, const OutputStageOptions& stage,
+                       StoredOutput& out) {
+  if (out.crossing > 0) out.crossing = splitStoredAgain(r, inputs, split, stage, out);
+  if (degenerateNewFaces(r) > 0) {
+    reportProgress(stage.progress, 98, "Mending flat faces");
+    out.collinear_faces_mended += mendCollinearNewFaces(r);
+  }
+}
+
+// The split of `inputs` with `split`, through steps 1, 3 and 4: a
+// candidate for steps 2 and 5.
+SplitResult splitAndStore(const std::vector<const Mesh*>& inputs, const SplitOptions& split,
+                          const OutputStageOptions& stage, StoredOutput& out) {
+  SplitResult again = splitAlongIntersections(inputs, split);
+  out.crossing = roundForHost(again, stage, &out);
+  splitAgainAndMend(again, inputs, split, stage, out);
+  return again;
+}
+
+// Keeps `candidate` (and what the stage did to make it) in place of `r`
+// when it leaves fewer defects.
+bool keepIfBetter(SplitResult& r, StoredOutput& out, SplitResult& candidate,
+                  const StoredOutput& made) {
+  if (defectsOf(candidate, made.crossing) >= defectsOf(r, out.crossing)) {
+    out.rounding_tests = made.rounding_tests;  // the work was done all the same
+    out.bounded |= made.bounded;
+    return false;
+  }
+  candidate.time_ms += r.time_ms;
+  r = std::move(candidate);
+  const StoredOutput before = out;
+  out = made;
+  out.snapped_for_host = true;
+  out.quality_snapped_for_host = before.quality_snapped_for_host || made.quality_snapped_for_host;
+  return true;
+}
+
+}  // namespace
+
+StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                          const SplitOptions& options, const OutputStageOptions& stage) {
+  requireMergedOutput(r, "storing for the host");
+  const auto start = std::chrono::steady_clock::now();
+  StoredOutput out;
+  out.scalar = stage.scalar;
+  reportProgress(
+      stage.progress, 95,
+      stage.scalar == Scalar::kFloat ? "Rounding to float" : "Checking the double result");
+  out.crossing = roundForHost(r, stage, &out);
+  SplitOptions used = options;
+  used.host = stage.scalar;
+  // Step 2: where curve points lie a few steps from each other or from an
+  // edge, no rounding keeps every face apart (or whole): split again with
+  // such points merged as quality snapping merges them.
+  if (stage.resplit_with_snapping && options.snap_host_steps <= 0 &&
+      defectsOf(r, out.crossing) > 0) {
+    reportProgress(stage.progress, 96, "Splitting again, merging points a step apart");
+    SplitOptions second = used;
+    second.snap_host_steps = kHostSnapSteps;
+    second.progress = progressWithin(stage.progress, 96, 96);
+    StoredOutput made;
+    made.scalar = stage.scalar;
+    made.rounding_tests = out.rounding_tests;
+    SplitResult candidate = splitAlongIntersections(inputs, second);
+    made.crossing = roundForHost(candidate, stage, &made);
+    if (keepIfBetter(r, out, candidate, made)) used = second;
+  }
+  // Steps 3 and 4: what is left crosses as stored; split again along those
+  // crossings on the stored values, rounded again; flat faces mended.
+  splitAgainAndMend(r, inputs, used, stage, out);
+  // Step 5: where surfaces nearly coincide over a region (a part and a copy
+  // a few steps away), curve points crowd within steps of each other
+  // everywhere and neither of the above keeps the stored result apart:
+  // quality snapping removes the slivers that hold them. Tried only when
+  // none was asked for; kept if it leaves fewer defects.
+  if (stage.resplit_with_snapping && options.snap_tolerance <= 0 &&
+      defectsOf(r, out.crossing) > 0) {
+    reportProgress(stage.progress, 98, "Splitting again with quality snapping");
+    SplitOptions snapping = used;
+    snapping.snap_tolerance = kQualitySnapTolerance;
+    snapping.snap_host_steps = kHostSnapSteps;
+    snapping.progress = progressWithin(stage.progress, 98, 98);
+    StoredOutput made;
+    made.scalar = stage.scalar;
+    made.quality_snapped_for_host = true;
+    made.rounding_tests = out.rounding_tests;
+    SplitResult candidate = splitAndStore(inputs, snapping, stage, made);
+    keepIfBetter(r, out, candidate, made);
+  }
+  out.degenerate_new_faces = degenerateNewFaces(r);
+  out.time_ms = msSince(start);
+  return out;
+}
+
+std::string StoredOutput::explanation() const {
+  if (crossing == 0 && degenerate_new_faces == 0) return {};
+  std::string why = std::to_string(crossing) + " pairs of faces cross and " +
+                    std::to_string(degenerate_new_faces) + " new faces are flat once stored in " +
+                    toString(scalar) + ": ";
+  if (bounded)
+    return why + "splitting the stored result again stopped at its work bound (" +
+           std::to_string(pairs_split_again) + " pairs split in " +
+           std::to_string(rounds_split_again) + " rounds)";
+  return why + "curve points lie a few " + toString(scalar) +
+         " steps apart where surfaces meet at a very small angle, and no rounding, snapping of "
+         "points within " +
+         std::to_string(kHostSnapSteps) + " steps or splitting again (" +
+         std::to_string(rounds_split_again) + " rounds) kept them apart" +
+         (scalar == Scalar::kFloat ? "; a double host (pymeshlab, MeshLab's double build, the "
+                                     "Python module) has room for them"
+                                   : "");
+}
+
+void addToReport(const StoredOutput& stored, JsonObject& report) {
+  report.set("host_scalar", toString(stored.scalar))
+      .set("crossings_left", stored.crossing)
+      .set("degenerate_new_faces", stored.degenerate_new_faces)
+      .set("vertices_rerounded", stored.vertices_rerounded)
+      .set("snapped_for_host", stored.snapped_for_host)
+      .set("quality_snapped_for_host", stored.quality_snapped_for_host)
+      .set("collinear_faces_mended", stored.collinear_faces_mended)
+      .set("rounds_split_again", std::size_t(stored.rounds_split_again))
+      .set("output_stage_bounded", stored.bounded)
+      .set("output_stage_ms", stored.time_ms);
 }
 
 }  // namespace meshmend

@@ -1,108 +1,167 @@
-// The split's output stage (DESIGN §4): the result is exact until it is
-// stored; storing it in the host's scalar rounds it, checks it exactly and
-// repairs what rounding broke.
+// The output stage (DESIGN §4). A split's result is exact until it is
+// stored: its curve points are rationals, kept in double as approximations
+// within a proven error. Storing it in the host's scalar (float or double,
+// mesh.h: Scalar) rounds every coordinate, and near-coincident surfaces (CAD
+// parts a hair apart, faces meeting at a tiny angle) may then cross or
+// collapse where they met only along a curve: a double is not exact either.
+// storeForHost rounds, checks exactly on the stored values and repairs, for
+// either scalar:
+//  1. roundForHost: each new vertex of a crossing or collapsed face is
+//     re-rounded to the neighbouring scalar values (one, then two steps
+//     each way per coordinate) where that removes the defect;
+//  2. where defects are left, the split again from the inputs with curve
+//     points within kHostSnapSteps steps of a vertex or edge merged into it;
+//  3. splitStoredAgain: the stored result split along its own crossings (on
+//     the stored values) and rounded again, a bounded number of rounds;
+//  4. mendCollinearNewFaces: new faces left flat are flipped away or removed;
+//  5. where defects are still left, all of that from the inputs with quality
+//     snapping (kQualitySnapTolerance), kept if it leaves fewer.
+// Every loop is bounded (rounds, pairs) and reports progress, which may
+// cancel it (CancelledError).
 #pragma once
 
 #include <cstddef>
+#include <limits>
+#include <string>
 #include <vector>
 
+#include "common/json.h"
 #include "common/mesh.h"
+#include "common/progress.h"
 #include "common/split.h"
 
 namespace meshmend {
 
-// Prepares the output for float storage (MeshLab's), which needs the merged
-// output (SplitOptions::merged_output; throws InvalidInputError without
-// it): every coordinate is rounded to float, and where that makes faces that
-// met only along a curve cross, the new vertices of those faces are rounded
-// the other way (each coordinate to the float just below or above its exact
-// value, or where neither keeps surfaces meeting at a very small angle
-// apart, the next float out), choosing the rounding under which the faces
-// around the vertex cross nothing. Curve points a few float steps apart may
-// leave crossings no rounding removes: snapping (snap_float_steps or
-// snap_tolerance) merges them, and splitRoundedAgain splits what is left.
-// Applied to `merged` and to `meshes` alike. Returns the pairs still
-// crossing among those with a new face or a face that rounding moved (faces
-// kept exactly as they were cannot cross anything new; faces with the same
-// three vertices are never a crossing, see remainingIntersections); with
-// `complete`, that is every intersecting pair of the rounded output.
-std::size_t roundToFloat(SplitResult& result, int passes = 4);
+// How close (in steps of the host's scalar) the second split merges curve
+// points: far below any feature the host can hold, and enough to take the
+// points rounding confuses.
+inline constexpr int kHostSnapSteps = 8;
 
-// Where roundToFloat left faces of the merged output crossing: splits the
-// merged output along its own intersections as rounded (exactly, on the
-// float values) and rounds again, up to `rounds` times while crossings are
-// left (each round's new points, rounded, may cross a little again: near
-// coincident surfaces, a millionth of their size apart, took five to
-// seven); a round that leaves more than twice the fewest crossings so far
-// is not taken and ends the rounds (they run away there). Points that the float values put a step
-// apart now meet where they cross. Provenance goes through to `inputs` (the meshes split first, for
-// the barycentric coordinates of new vertices), and the merged output's curve edges, new-face flags
-// and merged_vertex follow, and `meshes` (separate outputs), when there are any, are made again
-// from the merged output (each input's vertices in their order, then the new ones), unless planar
-// overlaps were kept once there (overlaps_once: then they stay). Uses options.snap_float_steps.
-// Returns the pairs still crossing (as roundToFloat counts them).
-std::size_t splitRoundedAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options, int rounds = 8);
+// The quality snapping tried last (SplitOptions::snap_tolerance): the
+// tolerance that removes most slivers.
+inline constexpr double kQualitySnapTolerance = 0.05;
 
-// How close (in float steps) roundForFloatHost merges curve points: far
-// below any feature a float mesh can hold, and enough to take the points
-// rounding confuses.
-inline constexpr int kFloatSnapSteps = 8;
-
-// The quality snapping roundForFloatHost tries (with kFloatSnapSteps) when
-// the float result is still broken without it: the tolerance that removes
-// most slivers (SplitOptions::snap_tolerance).
-inline constexpr double kFloatQualitySnapTolerance = 0.05;
-
-struct FloatOutput {
-  std::size_t crossing = 0;                // pairs still crossing, as roundToFloat counts them
-  bool snapped_for_float = false;          // the result is the second split (snap_float_steps)
-  std::size_t collinear_faces_mended = 0;  // mendCollinearNewFaces
-  // The result is the split with quality snapping (kFloatQualitySnapTolerance)
-  // that roundForFloatHost tried (snapped_for_float is set too).
-  bool quality_snapped_for_float = false;
+struct OutputStageOptions {
+  Scalar scalar = Scalar::kDouble;  // the host's storage
+  // Re-rounding passes at each reach (one step, then two steps away).
+  int rounding_passes = 4;
+  // Work bound of step 1: the most exact pair tests its runs make in all
+  // (each re-rounding choice of a vertex tests the faces around it against
+  // their neighbours), over the whole stage; past it, rounding stops where
+  // it is (some ten million tests a second).
+  std::size_t max_rounding_tests = 20000000;
+  // Rounds of splitting the stored result again where it still crosses;
+  // surfaces a millionth of their size apart took five to seven.
+  int split_rounds = 8;
+  // Work bound of step 3: the most pairs all its rounds together split
+  // again. A round that would pass it is not run, and the stage ends with
+  // the defects left (StoredOutput::bounded).
+  std::size_t max_pairs_split_again = 100000;
+  // Steps 2 and 5 (whole splits again, with snapping). Off: re-rounding,
+  // splitting again and mending only, without moving any curve point by
+  // more than the rounding does.
+  bool resplit_with_snapping = true;
+  Progress progress;  // between steps and rounds; returning false cancels
 };
 
-// The result as a float host (MeshLab 2020.09) stores it: rounded
-// (roundToFloat); where that left crossings or collapsed new faces and
-// options.snap_float_steps was 0, the split of `inputs` again with
-// snap_float_steps = kFloatSnapSteps, kept if it leaves fewer of both; then
-// what still crosses split again (splitRoundedAgain; the separate outputs
-// follow the merged one); new faces left with collinear corners are mended
-// (mendCollinearNewFaces); last, where crossings or collapsed new faces are
-// still left and options.snap_tolerance was 0, all of that from `inputs`
-// with quality snapping (kFloatQualitySnapTolerance), kept if it leaves
-// fewer.
-FloatOutput roundForFloatHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
-                              const SplitOptions& options);
+struct StoredOutput {
+  Scalar scalar = Scalar::kDouble;
+  // Pairs with a new or moved face still crossing once stored, by the
+  // stage's rule: faces meeting only at shared vertices or along a shared
+  // edge do not count, nor faces with the same three vertices (a planar
+  // overlap kept in each part), which no rounding moves apart. With the
+  // split's `complete`, no other pair can cross. The count of intersecting
+  // pairs a checker gives is storedIntersectingPairs.
+  std::size_t crossing = 0;
+  std::size_t degenerate_new_faces = 0;  // new faces with collinear corners as stored
+  std::size_t vertices_rerounded = 0;    // new vertices not at their nearest scalar values
+  std::size_t rounding_tests = 0;        // exact pair tests step 1 made, over all its runs
+  // Step 2 (or 5) made the result: curve points within kHostSnapSteps steps
+  // of a vertex or edge were merged into it.
+  bool snapped_for_host = false;
+  bool quality_snapped_for_host = false;  // step 5 made it
+  std::size_t collinear_faces_mended = 0;
+  std::size_t pairs_split_again = 0;  // step 3, over its rounds
+  int rounds_split_again = 0;
+  // A work bound (max_rounding_tests, max_pairs_split_again) stopped a step
+  // with defects left.
+  bool bounded = false;
+  double time_ms = 0;
+  // Why defects are left, or empty: a sentence for the log and the report.
+  std::string explanation() const;
+};
 
-// Where rounding left a new face of the merged output (required, as
-// above) with three collinear corners (a point a float step from an edge,
-// where no float position keeps it off the line and nothing crossing), the
-// corner between the other two lies on the edge they span. With one face
-// beyond that edge (running the other way), the edge is flipped, splitting
-// that face at the corner: the two faces that replace the pair cover it
-// exactly, so nothing new can cross. With none, the flat face only fills a
-// gap of no area between faces that already meet along its short sides,
-// and is removed where that leaves its sides closer to closed (as many
-// faces running each way; collapsed_faces_removed counts it). Curve edges,
-// provenance and the separate outputs follow. Returns the flat faces gone.
+// Rounds, checks and repairs `result` (which needs the merged output,
+// SplitOptions::merged_output; throws InvalidInputError without it) for the
+// host: `merged` and `meshes` hold the stored coordinates afterwards.
+// `inputs` and `options` are those of the split (steps 2 and 5 split them
+// again).
+StoredOutput storeForHost(SplitResult& result, const std::vector<const Mesh*>& inputs,
+                          const SplitOptions& options, const OutputStageOptions& stage);
+
+// Step 1: every coordinate rounded to stage.scalar, and where that makes
+// faces that met only along a curve cross (or a new face collinear), the
+// new vertices of those faces re-rounded to the neighbouring values (each
+// coordinate to the value just below or above its unrounded one, then the
+// next out), choosing the position under which the faces around the vertex
+// cross nothing: stage.rounding_passes passes per reach, at most
+// stage.max_rounding_tests exact pair tests in all. Applied to `merged` and
+// `meshes` alike. Returns the crossing pairs left (StoredOutput::crossing);
+// `out` (optional) adds the vertices moved off their nearest value and
+// whether the bound stopped it.
+// Where rounding to nearest leaves more than `giveUpAbove` defects, nothing
+// is re-rounded (a round of step 3 that ran away).
+std::size_t roundForHost(SplitResult& result, const OutputStageOptions& stage,
+                         StoredOutput* out = nullptr,
+                         std::size_t giveUpAbove = std::numeric_limits<std::size_t>::max());
+
+// Step 3: where the stored merged output still crosses, it is split along
+// its own intersections as stored (exactly, on the stored values) and
+// rounded again, up to stage.split_rounds times while crossings are left; a
+// round that leaves more than twice the fewest crossings so far is not taken
+// and ends the rounds (they run away where surfaces nearly coincide over a
+// region). Provenance goes through to `inputs` (the meshes split first),
+// curve edges, new-face flags and merged_vertex follow, and `meshes` are
+// made again from the merged output unless planar overlaps were kept once
+// there. Uses split.snap_host_steps. Returns the crossings left; `out`
+// receives the pairs split, the rounds and whether the bound stopped it.
+std::size_t splitStoredAgain(SplitResult& result, const std::vector<const Mesh*>& inputs,
+                             const SplitOptions& split, const OutputStageOptions& stage,
+                             StoredOutput& out);
+
+// Step 4: where rounding left a new face of the merged output (required, as
+// above) with three collinear corners (a point a step from an edge, where no
+// position keeps it off the line and nothing crossing), the corner between
+// the other two lies on the edge they span. With one face beyond that edge
+// (running the other way), the edge is flipped, splitting that face at the
+// corner: the two faces that replace the pair cover it exactly, so nothing
+// new can cross. With none, the flat face only fills a gap of no area
+// between faces that already meet along its short sides, and is removed
+// where that leaves its sides closer to closed (as many faces running each
+// way; collapsed_faces_removed counts it). Curve edges, provenance and the
+// separate outputs follow. Returns the flat faces gone.
 std::size_t mendCollinearNewFaces(SplitResult& result);
 
-// Intersecting pairs left in the merged output (required, as above), by the self-intersection
-// rule (faces that meet only along a shared curve edge or vertex do not
-// count), with coordinates as stored in double or, with `asFloat`, rounded
-// to float as MeshLab stores them. Faces with the same three vertices do not
-// count either: a planar overlap kept in each part (overlaps_once off;
-// coincident_faces counts them) or duplicate faces of an input, which no
-// split or rounding changes (a checker that takes them for intersecting
-// pairs, as meshcheck does, counts one pair each).
-std::size_t remainingIntersections(const SplitResult& result, bool asFloat);
+// Pairs crossing in the merged output (required, as above) by the stage's
+// rule (StoredOutput::crossing), over the whole output, with coordinates
+// rounded to `scalar`.
+std::size_t crossingsLeft(const SplitResult& result, Scalar scalar);
 
 // New faces of the merged output (required, as above) whose corners, as
-// stored, coincide or are collinear (exactly): after rounding to float,
-// curve points a float step apart may collapse a face. (Faces kept from
-// the inputs are as the inputs had them.)
+// stored, coincide or are collinear (exactly).
 std::size_t degenerateNewFaces(const SplitResult& result);
+
+// Intersecting pairs of `mesh` stored in `scalar`, by the rule of the
+// checker meshcheck and of CGAL's self_intersections (vertex identity =
+// vertex index; faces with the same three vertices count, degenerate faces
+// are never compared): what any such tool counts in the written file. Every
+// report's remaining_intersecting_pairs is this count.
+std::size_t storedIntersectingPairs(const Mesh& mesh, Scalar scalar);
+std::size_t storedIntersectingPairs(MeshArrays mesh, Scalar scalar);
+
+// The report keys of the stage: host_scalar, snapped_for_host,
+// quality_snapped_for_host, collinear_faces_mended, vertices_rerounded,
+// rounds_split_again, output_stage_bounded, output_stage_ms.
+void addToReport(const StoredOutput& stored, JsonObject& report);
 
 }  // namespace meshmend

@@ -12,4 +12,9 @@ using Progress = std::function<bool(int percent, const char* stage)>;
 // Reports progress if a callback is set; throws CancelledError when asked to stop.
 void reportProgress(const Progress& progress, int percent, const char* stage);
 
+// `outer` for a part of the work that takes its range [from, to]: the
+// part's own 0..100 mapped onto that range, so that the percentages a user
+// sees only grow. Empty when `outer` is.
+Progress progressWithin(const Progress& outer, int from, int to);
+
 }  // namespace meshmend

@@ -10,6 +10,7 @@
 
 #include "common/json.h"
 #include "common/mesh.h"
+#include "common/output_stage.h"
 #include "common/progress.h"
 
 namespace meshmend {
@@ -87,6 +88,7 @@ struct SelfIntersectionResult {
   // Snapping left crossings or non-manifold edges (sheets closer than its
   // tolerance): this result was made again without it.
   bool snapping_dropped = false;
+  StoredOutput stored;                           // the output stage on the cut (output_stage.h)
   bool verified = false;                         // remaining_intersecting_pairs was counted
   std::size_t remaining_intersecting_pairs = 0;  // in the result, as stored (float if rounded)
   double time_ms = 0;

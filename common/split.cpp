@@ -58,12 +58,6 @@ void sortUnique(std::vector<std::array<int, 2>>& pairs, std::size_t bound) {
   }
 }
 
-// The step between floats where `p` lies (at its largest coordinate).
-double floatStep(const Point3& p) {
-  const float m = float(std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}));
-  return double(std::nextafter(m, INFINITY)) - double(m);
-}
-
 // Barycentric coordinates of p in triangle (a, b, c), from the rounded values.
 Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Point3& c) {
   const Point3 n = (b - a) ^ (c - a);
@@ -871,7 +865,7 @@ class FacesAroundVertices {
 class CurveSnapper {
  public:
   CurveSnapper(OutputArrays& mesh, std::set<std::array<int, 2>>& curves, std::vector<char>& newFace,
-               double tolerance, double floatSteps)
+               double tolerance, double hostSteps, Scalar host)
       : P_(mesh.positions),
         T_(mesh.triangles),
         faceOrigin_(mesh.face_origin),
@@ -879,7 +873,8 @@ class CurveSnapper {
         curves_(curves),
         newFace_(newFace),
         tolerance_(tolerance),
-        floatSteps_(floatSteps),
+        hostSteps_(hostSteps),
+        host_(host),
         alive_(T_.size(), 1),
         snapped_(T_.size(), 0),
         around_(T_, P_.size()),
@@ -900,7 +895,7 @@ class CurveSnapper {
         near.push_back(boxOf(P_[T_[f][0]], P_[T_[f][1]], P_[T_[f][2]]));
         for (int i = 0; i < 3; ++i) {
           longest = std::max(longest, Distance(P_[T_[f][i]], P_[T_[f][(i + 1) % 3]]));
-          farthest = std::max(farthest, floatReach(P_[T_[f][i]]));
+          farthest = std::max(farthest, hostReach(P_[T_[f][i]]));
         }
       }
     for (Box& b : near) b = grown(b, 2 * std::max(tolerance_ * longest, farthest));
@@ -934,7 +929,7 @@ class CurveSnapper {
           // Into an input vertex, or along the curve into another new vertex.
           if (w == int(v) || (vertexOrigin_[w].vertex < 0 && !isCurveEdge(int(v), w))) continue;
           const double d = Distance(P_[v], P_[w]);
-          if (d < tolerance_ * longest || d < floatReach(P_[v]))
+          if (d < tolerance_ * longest || d < hostReach(P_[v]))
             candidates.push_back({d / longest, int(v), w});
         }
     }
@@ -963,7 +958,7 @@ class CurveSnapper {
         const double t = ((P_[v] - P_[a]) * ab) / ab.SquaredNorm();
         if (!(t > 0 && t < 1)) continue;
         const double distance = (P_[v] - (P_[a] + ab * t)).Norm();
-        if ((distance < tolerance_ * ab.Norm() || distance < floatReach(P_[v])) &&
+        if ((distance < tolerance_ * ab.Norm() || distance < hostReach(P_[v])) &&
             splitEdgeAt(std::uint32_t(s), v, a, b)) {
           ++snapped;
           break;
@@ -1018,10 +1013,10 @@ class CurveSnapper {
     return curves_.count({std::min(a, b), std::max(a, b)}) > 0;
   }
 
-  // floatSteps_ float steps at `p`: closer than this, a float host can
-  // hardly tell points apart.
-  double floatReach(const Point3& p) const {
-    return floatSteps_ > 0 ? floatSteps_ * floatStep(p) : 0;
+  // hostSteps_ steps of the host's scalar at `p`: closer than this, the
+  // host can hardly tell points apart.
+  double hostReach(const Point3& p) const {
+    return hostSteps_ > 0 ? hostSteps_ * scalarStep(p, host_) : 0;
   }
 
   std::vector<std::uint32_t> facesAround(int v) const {
@@ -1281,7 +1276,8 @@ class CurveSnapper {
   std::set<std::array<int, 2>>& curves_;
   std::vector<char>& newFace_;
   double tolerance_;
-  double floatSteps_;  // SplitOptions::snap_float_steps
+  double hostSteps_;  // SplitOptions::snap_host_steps
+  Scalar host_;       // SplitOptions::host
   std::vector<char> alive_;
   std::vector<char> snapped_;  // per face: reshaped or made by snapping
   FacesAroundVertices around_;
@@ -1388,7 +1384,7 @@ std::size_t removeDuplicateFaces(WeldedArrays& in) {
 
 // Does the split snap curve points (quality snapping, or within float steps)?
 bool snaps(const SplitOptions& o) {
-  return o.snap_tolerance > 0 || o.snap_float_steps > 0;
+  return o.snap_tolerance > 0 || o.snap_host_steps > 0;
 }
 
 }  // namespace
@@ -1770,7 +1766,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
       const std::size_t facesBefore = merged.triangles.size();              // edge snaps add faces
       std::set<std::array<int, 2>> curveSet(curves.begin(), curves.end());  // snapping edits it
       CurveSnapper snapper(merged, curveSet, r.merged_new_face, options.snap_tolerance,
-                           options.snap_float_steps);
+                           options.snap_host_steps, options.host);
       r.vertices_snapped = snapper.snapVertices();
       r.edges_snapped = snapper.snapEdges();
       const std::vector<int> snappedTo = snapper.snappedTo();

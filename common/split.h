@@ -50,12 +50,13 @@ struct SplitOptions {
   // curve: those are no longer bit-identical to the input.
   double snap_tolerance = 0;
   // Snapping by absolute distance as well, 0 = off: a new curve vertex
-  // closer than this many float steps (at its coordinates' magnitude) to a
-  // vertex or edge as above is merged or splits it, under the same checks.
-  // A float host (MeshLab 2020.09 stores float) cannot keep such points
-  // apart; rounding them to float may make faces cross or collapse.
-  double snap_float_steps = 0;
-  Progress progress;  // called between stages
+  // closer than this many steps of the host's scalar (`host`, at its
+  // coordinates' magnitude) to a vertex or edge as above is merged or splits
+  // it, under the same checks. A host cannot keep such points apart:
+  // rounding them to its scalar may make faces cross or collapse.
+  double snap_host_steps = 0;
+  Scalar host = Scalar::kDouble;  // the scalar whose steps snap_host_steps counts
+  Progress progress;              // called between stages
 };
 
 struct SplitResult {

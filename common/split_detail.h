@@ -27,9 +27,6 @@ struct OutputArrays {
 // larger than their number.
 void sortUnique(std::vector<std::array<int, 2>>& pairs, std::size_t bound);
 
-// The step between floats where `p` lies (at its largest coordinate).
-double floatStep(const Point3& p);
-
 // Barycentric coordinates of p in triangle (a, b, c), from the rounded values.
 Point3 barycentric(const Point3& p, const Point3& a, const Point3& b, const Point3& c);
 

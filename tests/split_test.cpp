@@ -24,6 +24,31 @@ InspectResult check(const Mesh& m) {
   return inspect(m, o);
 }
 
+// The output stage for a float host, as MeshLab 2020.09's filter runs it.
+StoredOutput storeAsFloat(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                          const SplitOptions& o) {
+  OutputStageOptions stage;
+  stage.scalar = Scalar::kFloat;
+  return storeForHost(r, inputs, o, stage);
+}
+
+// Step 1 of that stage alone.
+std::size_t roundAsFloat(SplitResult& r) {
+  OutputStageOptions stage;
+  stage.scalar = Scalar::kFloat;
+  return roundForHost(r, stage);
+}
+
+// Step 3 of that stage alone, on a result rounded to float.
+std::size_t splitAgainAsFloat(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                              const SplitOptions& o) {
+  OutputStageOptions stage;
+  stage.scalar = Scalar::kFloat;
+  StoredOutput out;
+  out.crossing = crossingsLeft(r, Scalar::kFloat);
+  return splitStoredAgain(r, inputs, o, stage, out);
+}
+
 TEST(Split, TwoSpheresMeetAlongOneClosedCurve) {
   const Mesh a = uvSphere(24, 32), b = uvSphere(24, 32, 1.0, {0.9, 0.13, 0.07});
   const SplitResult r = splitAlongIntersections({&a, &b});
@@ -195,13 +220,13 @@ TEST(Split, WeldingDuplicatesFirstClosesSeams) {
 TEST(Split, RoundToFloatKeepsTheResultFreeOfCrossings) {
   const Mesh a = uvSphere(30, 40), b = uvSphere(30, 40, 0.9, {0.7, 0.31, 0.17});
   SplitResult r = splitAlongIntersections({&a, &b});
-  EXPECT_EQ(roundToFloat(r), 0u);
+  EXPECT_EQ(roundAsFloat(r), 0u);
   for (const Vertex& v : r.merged.vert)
     for (int k = 0; k < 3; ++k) EXPECT_EQ(v.cP()[k], double(float(v.cP()[k])));
   for (std::size_t m = 0; m < 2; ++m)  // the per-mesh outputs got the same positions
     for (std::size_t v = 0; v < r.meshes[m].vert.size(); ++v)
       EXPECT_EQ(r.meshes[m].vert[v].cP(), r.merged.vert[r.merged_vertex[m][v]].cP());
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
 }
 
 TEST(Split, CurveThroughAnExistingVertex) {
@@ -214,7 +239,7 @@ TEST(Split, CurveThroughAnExistingVertex) {
       makeMesh({{-3, -3, -1}, {3, 3, -1}, {3, 3, 1}, {-3, -3, 1}}, {{0, 1, 2}, {0, 2, 3}});
   const SplitResult r = splitAlongIntersections({&flat, &wall});
   EXPECT_GT(r.intersecting_pairs, 0u);
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
   // The flat sheet needs no new vertex on the diagonal's interior points that
   // already are its vertices: its centre vertex stays a curve vertex.
   bool centreOnCurve = false;
@@ -231,7 +256,7 @@ TEST(Split, TrianglesTouchingAtOnePoint) {
   EXPECT_EQ(r.meshes[0].fn, 3);  // the point splits a into three
   EXPECT_EQ(r.meshes[1].fn, 1);  // b's own corner: nothing to split
   EXPECT_EQ(r.merged_curve_edges.size(), 0u);
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
 }
 
 TEST(Split, PointOnASharedEdgeSplitsBothFaces) {
@@ -244,7 +269,7 @@ TEST(Split, PointOnASharedEdgeSplitsBothFaces) {
   EXPECT_EQ(i.border_edges, 4u + 0u);  // still the square's outline, split nowhere on it
   EXPECT_EQ(i.non_manifold_edges, 0u);
   EXPECT_EQ(i.connected_components, 1u);
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
 }
 
 TEST(Split, CoplanarOverlappingTriangles) {
@@ -274,7 +299,7 @@ TEST(Split, CoplanarOverlappingTriangles) {
   EXPECT_EQ(merged.duplicate_faces, 0u);
   EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
   EXPECT_EQ(merged.non_manifold_edges, 0u);  // on each outline edge: the overlap, one piece beside
-  EXPECT_EQ(remainingIntersections(r, true), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kFloat), 0u);
 }
 
 TEST(Split, TheSameSurfaceTwiceIsKeptOnce) {
@@ -343,11 +368,11 @@ TEST(Split, PlanarOverlapsKeptInEachPartAreNoCrossingsForTheFloatRepair) {
     SplitResult r = splitAlongIntersections({&a, &b});
     ASSERT_GT(r.coincident_faces, 0u);
     EXPECT_EQ(selfIntersectingPairs(r.merged), r.coincident_faces);  // as a checker counts them
-    EXPECT_EQ(remainingIntersections(r, true), 0u);
+    EXPECT_EQ(crossingsLeft(r, Scalar::kFloat), 0u);
     const std::size_t faces = r.merged.face.size(), curves = r.merged_curve_edges.size();
-    const FloatOutput stored = roundForFloatHost(r, {&a, &b}, SplitOptions{});
+    const StoredOutput stored = storeAsFloat(r, {&a, &b}, SplitOptions{});
     EXPECT_EQ(stored.crossing, 0u);
-    EXPECT_FALSE(stored.snapped_for_float);
+    EXPECT_FALSE(stored.snapped_for_host);
     EXPECT_EQ(r.pairs_split_after_rounding, 0u);
     EXPECT_EQ(r.merged.face.size(), faces);
     EXPECT_EQ(r.merged_curve_edges.size(), curves);
@@ -457,17 +482,18 @@ TEST(Split, PointsAFloatStepApartAreMergedWhenAsked) {
   // Two unit spheres far from the origin (1e5 on every axis: a float step
   // is 1/128 there, an edge a seventh): rounded to float, curve points that
   // close to a vertex or an edge make faces cross or collapse, unless they
-  // are merged first (snap_float_steps).
+  // are merged first (snap_host_steps).
   const Point3 far(1e5, 1e5, 1e5);
   const Mesh a = moved(icosphere(3), far), b = moved(icosphere(3), far + Point3(0.7, 0.3, 0.2));
   SplitResult plain = splitAlongIntersections({&a, &b});
-  const std::size_t plainLeft = roundToFloat(plain);
+  const std::size_t plainLeft = roundAsFloat(plain);
   EXPECT_GT(plainLeft + degenerateNewFaces(plain), 0u);
   SplitOptions o;
-  o.snap_float_steps = 8;
+  o.snap_host_steps = 8;
+  o.host = Scalar::kFloat;
   SplitResult r = splitAlongIntersections({&a, &b}, o);
   EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
-  EXPECT_EQ(roundToFloat(r), 0u);
+  EXPECT_EQ(roundAsFloat(r), 0u);
   EXPECT_EQ(degenerateNewFaces(r), 0u);
   const InspectResult merged = check(r.merged);
   EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
@@ -485,12 +511,13 @@ TEST(Split, CrossingsLeftByRoundingAreSplitAgain) {
   const Mesh tube = testing::cappedCylinder(24, 4, 0.5, 0.5, -1, 2);
   const Mesh a = cycled(tube, 1), b = cycled(tube, 2);
   SplitOptions o;
-  o.snap_float_steps = 8;
+  o.snap_host_steps = 8;
+  o.host = Scalar::kFloat;
   SplitResult r = splitAlongIntersections({&a, &b}, o);
-  EXPECT_GT(roundToFloat(r), 0u);  // the case this is about
-  EXPECT_EQ(splitRoundedAgain(r, {&a, &b}, o), 0u);
+  EXPECT_GT(roundAsFloat(r), 0u);  // the case this is about
+  EXPECT_EQ(splitAgainAsFloat(r, {&a, &b}, o), 0u);
   EXPECT_GT(r.pairs_split_after_rounding, 0u);
-  EXPECT_EQ(remainingIntersections(r, true), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kFloat), 0u);
   EXPECT_EQ(degenerateNewFaces(r), 0u);
   const InspectResult merged = check(r.merged);
   EXPECT_EQ(*merged.self_intersecting_pairs, 0u);
@@ -536,12 +563,12 @@ TEST(Split, SurfacesAFewFloatStepsApartGetQualitySnappingForTheFloatResult) {
   o.separate_meshes = false;
   SplitResult r = splitAlongIntersections({&a, &b}, o);
   ASSERT_GT(r.intersecting_pairs, 0u);
-  const FloatOutput stored = roundForFloatHost(r, {&a, &b}, o);
-  EXPECT_TRUE(stored.quality_snapped_for_float);
-  EXPECT_TRUE(stored.snapped_for_float);
+  const StoredOutput stored = storeAsFloat(r, {&a, &b}, o);
+  EXPECT_TRUE(stored.quality_snapped_for_host);
+  EXPECT_TRUE(stored.snapped_for_host);
   EXPECT_GT(r.vertices_snapped + r.edges_snapped, 0u);
   EXPECT_EQ(stored.crossing, 0u);
-  EXPECT_EQ(remainingIntersections(r, true), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kFloat), 0u);
   EXPECT_EQ(degenerateNewFaces(r), 0u);
   EXPECT_EQ(r.curve_loops, 1u);
   EXPECT_EQ(r.open_curves, 0u);
@@ -549,7 +576,7 @@ TEST(Split, SurfacesAFewFloatStepsApartGetQualitySnappingForTheFloatResult) {
   SplitOptions asked = o;
   asked.snap_tolerance = 0.01;
   SplitResult s = splitAlongIntersections({&a, &b}, asked);
-  EXPECT_FALSE(roundForFloatHost(s, {&a, &b}, asked).quality_snapped_for_float);
+  EXPECT_FALSE(storeAsFloat(s, {&a, &b}, asked).quality_snapped_for_host);
 }
 
 TEST(Split, SeparateOutputsFollowTheSplitAfterRounding) {
@@ -562,7 +589,7 @@ TEST(Split, SeparateOutputsFollowTheSplitAfterRounding) {
   SplitOptions o;
   o.separate_meshes = true;
   SplitResult r = splitAlongIntersections({&a, &b}, o);
-  const FloatOutput stored = roundForFloatHost(r, {&a, &b}, o);
+  const StoredOutput stored = storeAsFloat(r, {&a, &b}, o);
   EXPECT_GT(r.pairs_split_after_rounding, 0u);  // the repair ran
   EXPECT_EQ(stored.crossing, 0u);
   ASSERT_EQ(r.meshes.size(), 2u);
@@ -606,7 +633,7 @@ TEST(Split, TJunctionOfTwoCurvesInOneFace) {
   const SplitResult r = splitAlongIntersections({&big, &plateX, &plateY});
   EXPECT_EQ(r.intersecting_pairs, 3u);
   EXPECT_EQ(r.faces_split, 3u);
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
 }
 
 TEST(Split, DuplicateFacesAreRemovedFirst) {
@@ -618,12 +645,12 @@ TEST(Split, DuplicateFacesAreRemovedFirst) {
   // The duplicate intersects its twin (a self-intersection checker counts
   // the pair); no split or rounding changes that, so it is no crossing left.
   EXPECT_GT(selfIntersectingPairs(kept.merged), 0u);
-  EXPECT_EQ(remainingIntersections(kept, false), 0u);
+  EXPECT_EQ(crossingsLeft(kept, Scalar::kDouble), 0u);
   SplitOptions remove;
   remove.remove_duplicate_faces = true;
   SplitResult r = splitAlongIntersections({&sheet, &plate}, remove);
   EXPECT_EQ(r.duplicate_faces_removed, 1u);
-  EXPECT_EQ(remainingIntersections(r, false), 0u);
+  EXPECT_EQ(crossingsLeft(r, Scalar::kDouble), 0u);
   FaceOriginHandle birth = faceOrigins(r.meshes[0]);
   for (std::size_t f = 0; f < r.meshes[0].face.size(); ++f)
     EXPECT_EQ(birth[f].face, 0);  // the first of the two stays, and its pieces say so
@@ -709,9 +736,9 @@ TEST(Split, WithoutTheMergedOutputEachMeshIsTheSame) {
     EXPECT_EQ(r.vertices_snapped, full.vertices_snapped);
     EXPECT_EQ(toJson(r).str(), toJson(full).set("time_ms", r.time_ms).str());
     // Rounding and the check need the merged output.
-    EXPECT_THROW(roundToFloat(r), InvalidInputError);
-    EXPECT_THROW(remainingIntersections(r, true), InvalidInputError);
-    EXPECT_THROW(splitRoundedAgain(r, {&a, &b}, SplitOptions{}), InvalidInputError);
+    EXPECT_THROW(roundAsFloat(r), InvalidInputError);
+    EXPECT_THROW(crossingsLeft(r, Scalar::kFloat), InvalidInputError);
+    EXPECT_THROW(splitAgainAsFloat(r, {&a, &b}, SplitOptions{}), InvalidInputError);
   }
   SplitOptions none;
   none.separate_meshes = none.merged_output = false;

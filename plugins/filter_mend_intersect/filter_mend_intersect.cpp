@@ -130,12 +130,19 @@ void IntersectPlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
     parameters.addParam(RichBool(
         "verify", true, "Check the written result",
         QString("Counts the intersecting pairs left in the result as written (in %1, as "
-                "MeshLab stores meshes; faces meeting only along a shared curve do not count) "
-                "and logs them. ")
-                .arg(kHostPrecision) +
-            "When every intersection of the inputs was split (self-intersections included), the "
-            "faces left as they were cannot intersect anything, so only pairs with a new face are "
-            "checked; otherwise the whole result is."));
+                "this MeshLab stores meshes) by the rule of CGAL's self_intersections and of the "
+                "checker meshcheck, so that any such tool gives the same count: faces that share "
+                "an edge or a vertex count only where they meet beyond it, and faces with the "
+                "same three vertices (planar overlaps kept in each layer) count. In each layer "
+                "as written, or in the merged layer.")
+            .arg(kHostPrecision)));
+    parameters.addParam(RichBool(
+        "all_or_nothing", true, "All or nothing",
+        QString("On: when faces would still cross, or new faces be flat, once the result is "
+                "stored in %1 (what rounding breaks and the repair cannot mend), the layers are "
+                "left unchanged and the filter fails with the reason. Off: that result is "
+                "written all the same, and the log and the report say what is left.")
+            .arg(kHostPrecision)));
   } else {
     parameters.addParam(RichBool(
         "segments_layer", false, "Create a layer with the segments",
@@ -289,6 +296,55 @@ void markParts(const Mesh& core, CMeshO& cm) {
 
 }  // namespace
 
+namespace {
+
+// The scalar this MeshLab stores coordinates in.
+constexpr Scalar kHostScalar = kHostStoresFloat ? Scalar::kFloat : Scalar::kDouble;
+
+}  // namespace
+
+// What the output stage did and what it left, in the log.
+void IntersectPlugin::logStored(const StoredOutput& stored, const SplitResult& r) {
+  if (r.pairs_split_after_rounding > 0)
+    Log("  %zu pairs of faces that crossed once stored in %s were split again (%d rounds)",
+        r.pairs_split_after_rounding, kHostPrecision, stored.rounds_split_again);
+  if (stored.collinear_faces_mended)
+    Log("  %zu new faces that rounding to %s left flat (collinear corners) were mended: the "
+        "edge beyond flipped, or the face removed where it filled no gap",
+        stored.collinear_faces_mended, kHostPrecision);
+  if (stored.quality_snapped_for_host)
+    Log("  curve points within %d %s steps or %g of the local edge length of a vertex or edge "
+        "were merged into it (quality snapping: %zu vertices, %zu edges), as the %s result "
+        "could not keep them apart otherwise",
+        kHostSnapSteps, kHostPrecision, kQualitySnapTolerance, r.vertices_snapped, r.edges_snapped,
+        kHostPrecision);
+  else if (stored.snapped_for_host)
+    Log("  curve points within %d %s steps of a vertex or edge were merged into it (%zu "
+        "vertices, %zu edges), as the %s result could not keep them apart",
+        kHostSnapSteps, kHostPrecision, r.vertices_snapped, r.edges_snapped, kHostPrecision);
+  const std::string why = stored.explanation();
+  if (!why.empty()) Log("  warning: %s", why.c_str());
+}
+
+// Intersecting pairs the check counts that the output stage does not: faces
+// with the same three vertices, and the inputs' own self-intersections
+// where those were not split.
+void IntersectPlugin::explainRemaining(const SplitResult& r, std::size_t others, bool merge) {
+  std::string parts;
+  if (r.coincident_faces > r.coincident_faces_removed)
+    parts += std::to_string(r.coincident_faces - r.coincident_faces_removed) +
+             " faces lie twice where surfaces overlap in a plane (each layer keeps its copy, "
+             "as the boolean filters need; 'Planar overlaps once' keeps each once)";
+  if (!r.complete)
+    parts += std::string(parts.empty() ? "" : "; ") +
+             "the layers' own self-intersections were not split ('Also split "
+             "self-intersections' splits them)";
+  if (!merge)
+    parts += std::string(parts.empty() ? "" : "; ") + "each layer is checked as written on its own";
+  Log("  %zu of those pairs are no crossing the split left%s%s", others, parts.empty() ? "" : ": ",
+      parts.c_str());
+}
+
 void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
                                         vcg::CallBackPos* cb) {
   const int mode = parameters.getEnum("mode");
@@ -304,7 +360,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.snap_tolerance = parameters.getFloat("snap_tolerance");
   if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
     throw InvalidInputError("the snapping tolerance must be at least 0 (off) and below 0.5");
-  options.progress = progressFrom(cb);
+  options.progress = progressWithin(progressFrom(cb), 0, 94);
   const bool merge = parameters.getEnum("output") == 1;
   options.separate_meshes = !merge;
   const auto start = std::chrono::steady_clock::now();
@@ -322,60 +378,38 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     throw InvalidInputError(
         "the chosen layers do not intersect: nothing to split (to combine parts that do not "
         "meet, nested or apart, for the boolean filters, choose the merged output)");
-  // A float host (2020.09) gets the result rounded here, re-rounding curve
-  // points where that keeps faces that meet along a curve from crossing; a
-  // double host (2022.02) stores it as computed and is checked whole.
-  std::size_t remaining = 0;
-  const bool checkWhole = !kHostStoresFloat || !r.complete;
-  FloatOutput stored;
-  if (kHostStoresFloat) {
-    reportProgress(progressFrom(cb), 95, "Rounding to float");
-    stored = roundForFloatHost(r, in.meshes, options);
-    remaining = stored.crossing;
-  }
+  // The output stage (output_stage.h): rounded to the host's scalar,
+  // checked exactly on the stored values and repaired.
+  OutputStageOptions stage;
+  stage.scalar = kHostScalar;
+  stage.progress = progressFrom(cb);
+  const StoredOutput stored = storeForHost(r, in.meshes, options, stage);
+  if (parameters.getBool("all_or_nothing") && !stored.explanation().empty())
+    throw InvalidInputError(
+        "the result is not exact once stored, so the layers were left "
+        "unchanged ('All or nothing'): " +
+        stored.explanation());
   const bool verify = parameters.getBool("verify");
-  if (verify && checkWhole) {  // rounding did not count every pair: check everything
-    reportProgress(progressFrom(cb), 97, "Checking the result");
-    remaining = remainingIntersections(r, false);  // all layers together, welded along the curves
+  std::size_t remaining = 0;
+  if (verify) {
+    reportProgress(progressFrom(cb), 99, "Checking the result");
+    if (merge)
+      remaining = storedIntersectingPairs(r.merged, kHostScalar);
+    else
+      for (const Mesh& m : r.meshes) remaining += storedIntersectingPairs(m, kHostScalar);
   }
   // The whole computation once (the core's time_ms adds up the splits it ran).
   r.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (nothingMet) Log("  the layers do not intersect: the merged layer holds them as they are");
+  logStored(stored, r);
   if (verify)
-    Log("  check of the %s result: %zu intersecting pairs remain%s",
-        kHostStoresFloat ? "float" : "double", remaining,
-        checkWhole ? "" : " (all with a new face: the others are input faces as they were)");
-  if (r.pairs_split_after_rounding > 0)
-    Log("  %zu pairs of faces that crossed once rounded to float were split again",
-        r.pairs_split_after_rounding);
-  if (stored.collinear_faces_mended)
-    Log("  %zu new faces that rounding to float left flat (collinear corners) were mended: the "
-        "edge beyond flipped, or the face removed where it filled no gap",
-        stored.collinear_faces_mended);
-  if (stored.quality_snapped_for_float)
-    Log("  curve points within %d float steps or %g of the local edge length of a vertex or edge "
-        "were merged into it (quality snapping: %zu vertices, %zu edges), as the float result "
-        "could not keep them apart otherwise",
-        kFloatSnapSteps, kFloatQualitySnapTolerance, r.vertices_snapped, r.edges_snapped);
-  else if (stored.snapped_for_float)
-    Log("  curve points within %d float steps of a vertex or edge were merged into it (%zu "
-        "vertices, %zu edges), as the float result could not keep them apart",
-        kFloatSnapSteps, r.vertices_snapped, r.edges_snapped);
-  const std::size_t collapsed = degenerateNewFaces(r);
-  if (collapsed > 0)
-    Log("  warning: %zu new faces are degenerate (collinear corners) as stored", collapsed);
-  if (verify && remaining > 0 && kHostStoresFloat && r.complete)
-    Log("  warning: where curve points lie a few float steps apart (surfaces meeting at a very "
-        "small angle), no float rounding keeps every face apart, also with quality snapping of "
-        "%g: a larger quality snapping tolerance may merge more such points, and the Python "
-        "module (round_to_float=False) keeps the exact double result, which has none",
-        options.snap_tolerance > 0 ? options.snap_tolerance : kFloatQualitySnapTolerance);
+    Log("  check of the written %s result: %zu intersecting pairs remain%s", kHostPrecision,
+        remaining, merge ? "" : " within the layers (each as written)");
+  if (verify && remaining > stored.crossing)
+    explainRemaining(r, remaining - stored.crossing, merge);
   JsonObject report = toJson(r);
-  report.set("degenerate_new_faces", collapsed)
-      .set("snapped_for_float", stored.snapped_for_float)
-      .set("collinear_faces_mended", stored.collinear_faces_mended)
-      .set("quality_snapped_for_float", stored.quality_snapped_for_float);
+  addToReport(stored, report);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
@@ -424,8 +458,8 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
         r.coincident_faces_removed);
   else if (r.coincident_faces && merge)
     Log("  %zu faces lie twice where the surfaces overlap in a plane, each layer's own (for the "
-        "boolean filters; the check above leaves them out, a checker of self-intersections "
-        "counts each as an intersecting pair): 'Planar overlaps once' keeps each once",
+        "boolean filters; the check above counts each as an intersecting pair, as every "
+        "checker of self-intersections does): 'Planar overlaps once' keeps each once",
         r.coincident_faces);
   else if (r.coincident_faces)
     Log("  %zu faces lie in two layers where the surfaces overlap in a plane", r.coincident_faces);

@@ -2,6 +2,8 @@
 // Faces" and "MeshMend: Intersect and Split Layers".
 #pragma once
 
+#include "common/output_stage.h"
+#include "common/split.h"
 #include "plugins/bridge/filter_plugin.h"
 
 class IntersectPlugin : public QObject, public meshmend::bridge::FilterAdapter {
@@ -35,4 +37,6 @@ class IntersectPlugin : public QObject, public meshmend::bridge::FilterAdapter {
                           vcg::CallBackPos* cb);
   void intersectAndSplit(MeshDocument& md, const RichParameterList& parameters,
                          vcg::CallBackPos* cb);
+  void logStored(const meshmend::StoredOutput& stored, const meshmend::SplitResult& r);
+  void explainRemaining(const meshmend::SplitResult& r, std::size_t others, bool merge);
 };

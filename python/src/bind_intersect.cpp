@@ -107,6 +107,7 @@ struct SplitCall {
   SplitOptions core;
   bool round_to_float = false;  // prepare the output for float storage (roundToFloat)
   bool verify = true;           // count the intersecting pairs left in the merged output
+  bool all_or_nothing = true;   // fail instead of returning a result with defects once stored
 };
 
 OptionTable<SplitCall> splitTable() {
@@ -139,7 +140,14 @@ OptionTable<SplitCall> splitTable() {
       "crossings, as the MeshLab filter does; the check then counts the float output");
   t.add(
       "verify", [](SplitCall& c) -> bool& { return c.verify; },
-      "count the intersecting pairs left in the merged output (remaining_intersecting_pairs)");
+      "count the intersecting pairs left in the output (remaining_intersecting_pairs), by the "
+      "rule of meshcheck and CGAL's self_intersections: in each returned mesh "
+      "(separate_meshes), else in the merged one");
+  t.add(
+      "all_or_nothing", [](SplitCall& c) -> bool& { return c.all_or_nothing; },
+      "raise InvalidInputError instead of returning a result in which faces still cross or new "
+      "faces are flat once stored (in float with round_to_float, else in double); False returns "
+      "it, the report saying what is left");
   return t;
 }
 
@@ -151,24 +159,34 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
     throw InvalidInputError("snap_tolerance must be at least 0 (off) and below 0.5");
   if (!c.core.self && !c.core.between_meshes)
     throw InvalidInputError("between_meshes and self are both off: nothing to split");
-  c.core.progress = call.progress();
+  c.core.progress = progressWithin(call.progress(), 0, 94);
   std::vector<const Mesh*> pointers;
   for (const Mesh& m : inputs) pointers.push_back(&m);
   const auto start = std::chrono::steady_clock::now();
   SplitResult r = call([&] { return splitAlongIntersections(pointers, c.core); });
+  // The output stage (output_stage.h), as the MeshLab filter runs it for its host.
+  OutputStageOptions stage;
+  stage.scalar = c.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+  stage.progress = call.progress();
+  const StoredOutput stored = call([&] { return storeForHost(r, pointers, c.core, stage); });
+  if (c.all_or_nothing && !stored.explanation().empty())
+    throw InvalidInputError("the result is not exact once stored (all_or_nothing): " +
+                            stored.explanation());
   std::size_t remaining = 0;
-  FloatOutput stored;  // as the MeshLab filter stores it
-  if (c.round_to_float) stored = call([&] { return roundForFloatHost(r, pointers, c.core); });
-  if (c.verify)  // the whole merged output as returned, by the self-intersection rule
-    remaining = call([&] { return remainingIntersections(r, c.round_to_float); });
+  if (c.verify)  // by the checker's rule, on what is returned as the output
+    remaining = call([&] {
+      std::size_t n = 0;
+      if (c.core.separate_meshes)
+        for (const Mesh& m : r.meshes) n += storedIntersectingPairs(m, stage.scalar);
+      else
+        n = storedIntersectingPairs(r.merged, stage.scalar);
+      return n;
+    });
   // The whole computation once (the core's time_ms adds up the splits it ran).
   r.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   JsonObject report = toJson(r);
-  report.set("degenerate_new_faces", degenerateNewFaces(r))
-      .set("snapped_for_float", stored.snapped_for_float)
-      .set("collinear_faces_mended", stored.collinear_faces_mended)
-      .set("quality_snapped_for_float", stored.quality_snapped_for_float);
+  addToReport(stored, report);
   if (c.verify) report.set("remaining_intersecting_pairs", remaining);
   report.set("output", c.core.separate_meshes ? "separate" : "merged");
 

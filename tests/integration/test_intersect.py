@@ -224,7 +224,7 @@ def test_separate_layers_overlapping_in_planes_keep_their_faces_uncounted(tmp_pa
     r = run.report
     assert r["coincident_faces"] > 0 and "lie in two layers" in run.log
     assert r["remaining_intersecting_pairs"] == 0 and r["pairs_split_after_rounding"] == 0
-    assert not r["snapped_for_float"] and "snapping tolerance" not in run.log
+    assert not r["snapped_for_host"] and "snapping tolerance" not in run.log
     for layer in layers:
         check = meshcheck(layer)
         assert check["self_intersecting_pairs"] == 0 and check["is_closed"]
@@ -239,7 +239,7 @@ def test_split_of_tangent_tubes_is_free_of_intersections_as_float(tmp_path):
     run, out = split_merged(tmp_path, tube(0), tube(1))
     r = run.report
     assert r["remaining_intersecting_pairs"] == 0 and r["degenerate_new_faces"] == 0
-    assert r["snapped_for_float"] or r["pairs_split_after_rounding"] > 0
+    assert r["snapped_for_host"] or r["pairs_split_after_rounding"] > 0
     check = meshcheck(out)
     assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
     assert check["border_edges"] == 0
