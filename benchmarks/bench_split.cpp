@@ -30,6 +30,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <optional>
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
@@ -46,11 +47,13 @@ namespace {}  // namespace
 
 int main(int argc, char** argv) {
   int repeat = 3, limit = 600;
-  bool sample = false, autorefine = false, warm = false;
+  bool sample = false, autorefine = false, warm = false, outputStage = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--sample"))
       sample = true;
+    else if (!std::strcmp(argv[i], "--output-stage"))
+      outputStage = true;
     else if (!std::strcmp(argv[i], "--autorefine"))
       autorefine = true;
     else if (!std::strcmp(argv[i], "--warm-allocator"))
@@ -65,7 +68,7 @@ int main(int argc, char** argv) {
   if (files.size() != 2) {
     std::fprintf(stderr,
                  "usage: bench_split [--repeat N] [--limit SECONDS] [--sample] [--autorefine] "
-                 "[--warm-allocator] A B\n");
+                 "[--warm-allocator] [--output-stage] A B\n");
     return 1;
   }
   if (warm) warmAllocator();  // before the children fork: all methods alike
@@ -90,7 +93,39 @@ int main(int argc, char** argv) {
                          });
                        }});
   };
-  if (sample) {
+  // The output stage (output_stage.h) after the sample's split, for each
+  // host scalar, and with the check of the stored result the filter makes
+  // (storedIntersectingPairs). The result of the stage's methods is its
+  // own time in microseconds (-1 where it left defects), of the checked one
+  // the intersecting pairs the check counts.
+  auto stored = [&](const char* name, std::optional<Scalar> scalar, bool check) {
+    methods.push_back({name, "ours", [=] {
+                         auto ma = std::make_shared<Mesh>(readMesh(a));
+                         auto mb = std::make_shared<Mesh>(readMesh(b));
+                         return std::function<long()>([=] {
+                           SplitOptions o;
+                           o.self = o.weld_duplicates = o.remove_duplicate_faces = true;
+                           o.separate_meshes = false;
+                           SplitResult r = splitAlongIntersections({ma.get(), mb.get()}, o);
+                           if (scalar) {
+                             OutputStageOptions stage;
+                             stage.scalar = *scalar;
+                             const StoredOutput s = storeForHost(r, {ma.get(), mb.get()}, o, stage);
+                             if (check) return long(storedIntersectingPairs(r.merged, *scalar));
+                             // The stage's own time, in microseconds (-1: defects left).
+                             if (s.crossing + s.degenerate_new_faces > 0) return -1L;
+                             return long(s.time_ms * 1000);
+                           }
+                           return long(r.faces_split);
+                         });
+                       }});
+  };
+  if (outputStage) {
+    stored("meshmend_split_sample_unstored", std::nullopt, false);
+    stored("meshmend_store_float", Scalar::kFloat, false);
+    stored("meshmend_store_double", Scalar::kDouble, false);
+    stored("meshmend_store_float_checked", Scalar::kFloat, true);
+  } else if (sample) {
     ours("meshmend_split_sample", "ours", true);
   } else {
     ours("meshmend_split_refine", "ours", false);
@@ -108,8 +143,8 @@ int main(int argc, char** argv) {
                          });
                        }});
   };
-  if (!sample) corefine("cgal_corefine", false);
-  corefine("cgal_corefine_checked", true);
+  if (!sample && !outputStage) corefine("cgal_corefine", false);
+  if (!outputStage) corefine("cgal_corefine_checked", true);
   if (autorefine)
     methods.push_back({"cgal_autorefine", "peer", [=] {
                          auto joined = std::make_shared<SurfaceMesh>(

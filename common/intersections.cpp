@@ -480,16 +480,20 @@ std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
   const BoxTree tree(changedBoxes);
   const BoxGrid nearChanged(changedBoxes);
   std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  // Two changed faces: one traversal of the tree against itself (a descent
+  // per changed face cost twice as much).
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
+    const std::uint32_t f = changedFaces[i], g = changedFaces[j];
+    found[worker].push_back({std::min(f, g), std::max(f, g)});
+  });
+  // The others: those near a changed face descend the tree.
   parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
     for (std::size_t g = begin; g < end; ++g) {
-      const Box b = changedIndex[g] >= 0 ? changedBoxes[changedIndex[g]]
-                                         : boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
+      if (changedIndex[g] >= 0) continue;
+      const Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
       if (!nearChanged.touches(b)) continue;
       tree.query(b, worker, [&](std::uint32_t i, unsigned) {
-        const std::uint32_t f = changedFaces[i];
-        // A pair of two changed faces is found from both sides: keep one.
-        if (f != g && (changedIndex[g] < 0 || f < g))
-          found[worker].push_back({f, std::uint32_t(g)});
+        found[worker].push_back({changedFaces[i], std::uint32_t(g)});
       });
     }
   });
@@ -531,8 +535,13 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 
 }  // namespace
 
-bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
-                    std::uint32_t g) {
+namespace {
+
+// facesIntersect with the degeneracy of f and g known (`knownFlat`: -1 not
+// known, 0 neither is degenerate); faces with the same three vertices meet
+// unless `sameVertices` is false.
+bool facesMeet(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+               std::uint32_t g, int knownFlat, bool sameVertices = true) {
   const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
   const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
   // Apart along an axis (exact): most candidates of a widened box search.
@@ -540,10 +549,18 @@ bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T
     if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
         std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
       return false;
-  if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
+  if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
   const SharedCorners c = sharedCorners(T[f], T[g]);
+  if (c.count == 3 && !sameVertices) return false;
   if (c.count < 3 && separatedInProjection(T[f], a, T[g], b)) return false;
   return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+}
+
+}  // namespace
+
+bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+                    std::uint32_t g) {
+  return facesMeet(P, T, f, g, -1);
 }
 
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(
@@ -555,6 +572,26 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(
       [&](std::size_t begin, std::size_t end, unsigned worker) {
         for (std::size_t i = begin; i < end; ++i)
           if (facesIntersect(P, T, pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
+      },
+      1024);
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+  return all;
+}
+
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs, const std::vector<char>& degenerate,
+    bool sameVertices) {
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+  parallelChunks(
+      pairs.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto [f, g] = pairs[i];
+          if (!degenerate[f] && !degenerate[g] && facesMeet(P, T, f, g, 0, sameVertices))
+            hits[worker].push_back(pairs[i]);
+        }
       },
       1024);
   std::vector<std::array<std::uint32_t, 2>> all;

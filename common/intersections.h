@@ -100,6 +100,13 @@ bool facesIntersect(const std::vector<Point3>& points, const std::vector<Triangl
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(
     const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
     const std::vector<std::array<std::uint32_t, 2>>& pairs);
+// The same given, per face, whether it is degenerate (collinear corners, as
+// collinear() decides): a face in many pairs is tested once. Faces with the
+// same three vertices count unless `sameVertices` is false.
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs, const std::vector<char>& degenerate,
+    bool sameVertices);
 
 // The contact segments of every pair (a coplanar overlap contributes its
 // outline, a single touching point nothing), with coinciding end points

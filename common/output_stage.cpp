@@ -260,9 +260,11 @@ class Rounder {
                   std::size_t& rerounded, bool& bounded) {
     if (!findChanged()) return 0;
     findCandidates();
-    crossing_ = intersectingOf(P_, T_, pairs_);
+    crossing_ = intersectingOf(P_, T_, pairs_, degenerate_, false);
     budget_ = budget;
     if (crossing_.size() > giveUpAbove) return crossing_.size();
+    if (crossing_.empty() && collapsedFaces().empty()) return 0;
+    buildRows();                            // only re-rounding needs them
     std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
     const std::vector<Point3> nearest = P_;
     // Each coordinate goes to one of the `reach` values below its unrounded
@@ -305,26 +307,40 @@ class Rounder {
   // anything they did not cross before (every other face is an input face,
   // exactly as it was).
   bool findChanged() {
+    std::vector<char> moved(P_.size(), 0);
+    if (scalar_ != Scalar::kDouble)
+      for (std::size_t v = 0; v < P_.size(); ++v) moved[v] = P_[v] != ref_[v];
     isChanged_.assign(T_.size(), 0);
-    changedIndex_.assign(T_.size(), -1);
     for (std::size_t f = 0; f < T_.size(); ++f) {
-      isChanged_[f] = f < newFace_.size() && newFace_[f];
-      for (int v : T_[f]) isChanged_[f] |= P_[v] != ref_[v];
-      if (isChanged_[f]) {
-        changedIndex_[f] = int(changed_.size());
-        changed_.push_back(std::uint32_t(f));
-      }
+      const Triangle& t = T_[f];
+      isChanged_[f] =
+          (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
+      if (isChanged_[f]) changed_.push_back(std::uint32_t(f));
     }
     return !changed_.empty();
   }
 
   // Candidates: boxes widened by more steps than re-rounding moves a vertex
   // (at most kFarthestRounding from its unrounded position; the boxes are
-  // float, so a float step covers double steps too). Faces with the same
-  // three vertices (a planar overlap kept in each part) coincide however
-  // their vertices are rounded: never a crossing here.
+  // float, so a float step covers double steps too).
   void findCandidates() {
     pairs_ = pairsWithChangedFaces(P_, T_, isChanged_, kFarthestRounding + 2);
+    // Whether each face of a pair is degenerate as stored, tested once.
+    degenerate_.assign(T_.size(), 0);
+    std::vector<char>& inPair = degenerate_;  // marks first, then the answer
+    for (const auto& [f, g] : pairs_) inPair[f] = inPair[g] = 1;
+    for (std::uint32_t f : changed_) inPair[f] = 1;
+    for (std::size_t f = 0; f < T_.size(); ++f)
+      if (inPair[f]) degenerate_[f] = isFlat(std::uint32_t(f));
+  }
+
+  // Per changed face, its candidates both ways, and per vertex the changed
+  // faces around it (compressed rows).
+  void buildRows() {
+    changedIndex_.assign(T_.size(), -1);
+    for (std::size_t i = 0; i < changed_.size(); ++i) changedIndex_[changed_[i]] = int(i);
+    // Faces with the same three vertices (a planar overlap kept in each
+    // part) coincide however their vertices are rounded: never a crossing.
     pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
                                 [&](const auto& p) { return sameVertices(T_[p[0]], T_[p[1]]); }),
                  pairs_.end());
@@ -352,6 +368,11 @@ class Rounder {
       for (int v : T_[f]) around_.items[next[v]++] = f;
   }
 
+  bool isFlat(std::uint32_t f) const {
+    const Triangle& t = T_[f];
+    return collinear(P_[t[0]], P_[t[1]], P_[t[2]]);
+  }
+
   // Only pairs with a face at a vertex that moved can have changed: the
   // others keep what the last check found.
   void recheck(std::vector<char>& moved) {
@@ -363,7 +384,10 @@ class Rounder {
       if (touches(p[0]) || touches(p[1])) again.push_back(p);
     for (const auto& p : crossing_)
       if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
-    crossing_ = intersectingOf(P_, T_, again);
+    for (std::size_t v = 0; v < moved.size(); ++v)
+      if (moved[v])
+        for (auto [f, end] = around_.row(v); f != end; ++f) degenerate_[*f] = isFlat(*f);
+    crossing_ = intersectingOf(P_, T_, again, degenerate_, false);
     crossing_.insert(crossing_.end(), still.begin(), still.end());
     std::fill(moved.begin(), moved.end(), 0);
   }
@@ -374,13 +398,18 @@ class Rounder {
   // never collinear exactly; an input face only when it was already.
   bool collapsed(std::uint32_t f) const {
     const Triangle& t = T_[f];
-    return collinear(P_[t[0]], P_[t[1]], P_[t[2]]) &&
+    return isFlat(f) &&
            ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]]));
   }
+  // The same from the degeneracy kept per face (degenerate_).
   std::vector<std::uint32_t> collapsedFaces() const {
     std::vector<std::uint32_t> flat;
-    for (std::uint32_t f : changed_)
-      if (collapsed(f)) flat.push_back(f);
+    for (std::uint32_t f : changed_) {
+      const Triangle& t = T_[f];
+      if (degenerate_[f] &&
+          ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]])))
+        flat.push_back(f);
+    }
     return flat;
   }
 
@@ -433,7 +462,7 @@ class Rounder {
   const std::vector<char>& movable_;
   const Scalar scalar_;
   std::vector<Point3>& P_;
-  std::vector<char> isChanged_;
+  std::vector<char> isChanged_, degenerate_;
   std::vector<int> changedIndex_;
   std::vector<std::uint32_t> changed_;
   std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
