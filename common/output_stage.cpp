@@ -515,6 +515,67 @@ std::size_t storedIntersectingPairs(const Mesh& mesh, Scalar scalar) {
   return mesh.fn == 0 ? 0 : selfIntersectingPairs(mesh, scalar, true);
 }
 
+namespace {
+
+// Pairs of non-degenerate faces of `mesh` with the same three vertices.
+// Faces are bucketed by their smallest vertex (a counting sort: linear in
+// the faces), and only faces in a group of equal ones are tested for
+// degeneracy.
+std::size_t sameVertexPairs(const Mesh& mesh) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  std::vector<std::uint32_t> start(mesh.vert.size() + 1, 0);
+  auto sorted = [&](std::size_t f) {
+    Triangle t = T[f];
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  for (const Triangle& t : T) ++start[*std::min_element(t.begin(), t.end()) + 1];
+  for (std::size_t v = 0; v < mesh.vert.size(); ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> byVertex(T.size());
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < T.size(); ++f)
+      byVertex[next[*std::min_element(T[f].begin(), T[f].end())]++] = std::uint32_t(f);
+  }
+  std::size_t pairs = 0;
+  std::vector<std::pair<Triangle, std::uint32_t>> bucket;
+  for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
+    if (start[v + 1] - start[v] < 2) continue;
+    bucket.clear();
+    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k)
+      bucket.push_back({sorted(byVertex[k]), byVertex[k]});
+    std::sort(bucket.begin(), bucket.end());
+    for (std::size_t i = 0, j; i < bucket.size(); i = j) {
+      std::size_t flat = 0;
+      for (j = i + 1; j < bucket.size() && bucket[j].first == bucket[i].first;) ++j;
+      if (j - i < 2) continue;
+      for (std::size_t k = i; k < j; ++k) {
+        const Face& f = mesh.face[bucket[k].second];
+        flat += collinear(f.cP(0), f.cP(1), f.cP(2));
+      }
+      const std::size_t n = j - i - flat;
+      pairs += n * (n - 1) / 2;
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+std::size_t storedIntersectingPairs(const SplitResult& r, const StoredOutput& stored,
+                                    bool separate) {
+  const bool complete = r.complete || stored.rounds_split_again > 0;
+  if (!separate) {
+    if (!complete || r.merged.fn == 0) return storedIntersectingPairs(r.merged, stored.scalar);
+    return stored.crossing + sameVertexPairs(r.merged);
+  }
+  std::size_t n = 0;
+  for (const Mesh& m : r.meshes)
+    n += complete && stored.crossing == 0 ? sameVertexPairs(m)
+                                          : storedIntersectingPairs(m, stored.scalar);
+  return n;
+}
+
 std::size_t storedIntersectingPairs(MeshArrays mesh, Scalar scalar) {
   if (mesh.triangles.empty()) return 0;
   for (Point3& p : mesh.points) p = storedAs(p, scalar);

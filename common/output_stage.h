@@ -159,6 +159,15 @@ std::size_t degenerateNewFaces(const SplitResult& result);
 std::size_t storedIntersectingPairs(const Mesh& mesh, Scalar scalar);
 std::size_t storedIntersectingPairs(MeshArrays mesh, Scalar scalar);
 
+// The same count for a split's stored output: the merged one, or with
+// `separate` the sum over `meshes` (each as its own file). Where every
+// intersecting pair of the mesh split last was split (the split was
+// complete, or the stage split its result again), faces the stage left as
+// they were cross nothing: the count is then the stage's crossings plus the
+// pairs of faces with the same three vertices, without a search.
+std::size_t storedIntersectingPairs(const SplitResult& result, const StoredOutput& stored,
+                                    bool separate);
+
 // The report keys of the stage: host_scalar, snapped_for_host,
 // quality_snapped_for_host, collinear_faces_mended, vertices_rerounded,
 // rounds_split_again, output_stage_bounded, output_stage_ms.

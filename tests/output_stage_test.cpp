@@ -70,6 +70,8 @@ TEST(OutputStage, DoubleRoundingOfNearlyCoplanarFacetsIsRepaired) {
   EXPECT_EQ(merged.degenerate_faces, 0u);
   EXPECT_EQ(merged.border_edges, 0u);
   EXPECT_EQ(storedIntersectingPairs(r.merged, Scalar::kDouble), 0u);
+  EXPECT_EQ(storedIntersectingPairs(r, stored, false), 0u);
+  EXPECT_EQ(storedIntersectingPairs(r, stored, true), 0u);
   for (const Mesh& m : r.meshes) {  // each input's own output follows
     EXPECT_EQ(storedIntersectingPairs(m, Scalar::kDouble), 0u);
     EXPECT_TRUE(check(m, Scalar::kDouble).is_closed);
@@ -102,6 +104,9 @@ TEST(OutputStage, TheCheckersCountIncludesFacesWithTheSameThreeVertices) {
   EXPECT_EQ(storedIntersectingPairs(r.merged, Scalar::kDouble), r.coincident_faces);
   EXPECT_EQ(storedIntersectingPairs(r.merged, Scalar::kDouble),
             *check(r.merged, Scalar::kDouble).self_intersecting_pairs);
+  // Without a search (the split was complete): the same count.
+  EXPECT_EQ(storedIntersectingPairs(r, stored, false), r.coincident_faces);
+  EXPECT_EQ(storedIntersectingPairs(r, stored, true), 0u);  // each part on its own
   // Kept once, there is nothing to count.
   SplitOptions once;
   once.overlaps_once = true;
@@ -125,8 +130,13 @@ TEST(OutputStage, TheWorkBoundStopsTheRepairAndSaysSo) {
   EXPECT_EQ(stored.rounds_split_again, 0);
   EXPECT_EQ(stored.pairs_split_again, 0u);
   EXPECT_NE(stored.explanation().find("work bound"), std::string::npos);
-  // What the report says is left is what is left.
+  // What the report says is left is what is left, counted either way.
   EXPECT_EQ(stored.crossing, crossingsLeft(r, Scalar::kDouble));
+  EXPECT_EQ(storedIntersectingPairs(r, stored, false),
+            storedIntersectingPairs(r.merged, Scalar::kDouble));
+  std::size_t each = 0;
+  for (const Mesh& m : r.meshes) each += storedIntersectingPairs(m, Scalar::kDouble);
+  EXPECT_EQ(storedIntersectingPairs(r, stored, true), each);
 }
 
 TEST(OutputStage, ProgressCanCancelIt) {

@@ -393,10 +393,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   std::size_t remaining = 0;
   if (verify) {
     reportProgress(progressFrom(cb), 99, "Checking the result");
-    if (merge)
-      remaining = storedIntersectingPairs(r.merged, kHostScalar);
-    else
-      for (const Mesh& m : r.meshes) remaining += storedIntersectingPairs(m, kHostScalar);
+    remaining = storedIntersectingPairs(r, stored, !merge);
   }
   // The whole computation once (the core's time_ms adds up the splits it ran).
   r.time_ms =

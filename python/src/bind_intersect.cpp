@@ -174,14 +174,7 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
                             stored.explanation());
   std::size_t remaining = 0;
   if (c.verify)  // by the checker's rule, on what is returned as the output
-    remaining = call([&] {
-      std::size_t n = 0;
-      if (c.core.separate_meshes)
-        for (const Mesh& m : r.meshes) n += storedIntersectingPairs(m, stage.scalar);
-      else
-        n = storedIntersectingPairs(r.merged, stage.scalar);
-      return n;
-    });
+    remaining = call([&] { return storedIntersectingPairs(r, stored, c.core.separate_meshes); });
   // The whole computation once (the core's time_ms adds up the splits it ran).
   r.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
