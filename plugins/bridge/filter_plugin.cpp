@@ -88,19 +88,31 @@ class JsonScanner {
       if (pos_ >= text_.size()) fail("unterminated escape");
       const char e = text_[pos_++];
       switch (e) {
-        case 'n': out += '\n'; break;
-        case 't': out += '\t'; break;
-        case 'r': out += '\r'; break;
-        case 'b': out += '\b'; break;
-        case 'f': out += '\f'; break;
+        case 'n':
+          out += '\n';
+          break;
+        case 't':
+          out += '\t';
+          break;
+        case 'r':
+          out += '\r';
+          break;
+        case 'b':
+          out += '\b';
+          break;
+        case 'f':
+          out += '\f';
+          break;
         case 'u': {
           if (pos_ + 4 > text_.size()) fail("short \\u escape");
-          const unsigned code = unsigned(std::stoul(std::string(text_.substr(pos_, 4)), nullptr, 16));
+          const unsigned code =
+              unsigned(std::stoul(std::string(text_.substr(pos_, 4)), nullptr, 16));
           pos_ += 4;
           appendUtf8(out, code);
           break;
         }
-        default: out += e;  // \" \\ \/
+        default:
+          out += e;  // \" \\ \/
       }
     }
     if (pos_ >= text_.size()) fail("unterminated string");
@@ -129,7 +141,8 @@ class JsonScanner {
         expect(close);
       }
     } else {
-      while (pos_ < text_.size() && std::string_view(",]} \n").find(text_[pos_]) == std::string_view::npos)
+      while (pos_ < text_.size() &&
+             std::string_view(",]} \n").find(text_[pos_]) == std::string_view::npos)
         ++pos_;
       if (pos_ == start) fail("expected a value");
     }
