@@ -555,7 +555,7 @@ def clearance(repeat):
         f"{o['min_distance_after']:.6g}, violating pairs {o['violating_pairs_before']:,} → "
         f"{o['violating_pairs_after']:,}, largest displacement {o['max_displacement']:.4g} "
         f"(mean over moved vertices {o['mean_displacement']:.4g}), "
-        f"{o.get('remaining_intersecting_pairs', 0)} intersecting pairs.",
+        f"{o.get('new_intersecting_pairs', 0)} intersecting pairs.",
         "",
         f"**Acceptance target** (issue 9): a 100k-face mesh with about 1,000 violating pairs "
         f"brought to tau in under 2 s: {fmt(enforce['median_ms'])} ms with "
@@ -615,7 +615,7 @@ def stitch(repeat):
            f"{fmt(r['unchecked']['stage_ms']['write'])} / "
            f"{fmt(r['checked']['stage_ms']['write'])}. Outcome: {o['faces_added']:,} faces, "
            f"border edges {o['border_edges_before']:,} → {o['border_edges_after']:,}, "
-           f"{o['remaining_intersecting_pairs']} intersecting pairs.",
+           f"{o['new_intersecting_pairs']} intersecting pairs.",
            "",
            f"**Acceptance target** (issue 8): stitching two paths of {paths // 1000}k vertices "
            f"each in under {target} ms: {fmt(plain['median_ms'])} ms wall without the check "

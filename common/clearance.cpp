@@ -1093,10 +1093,19 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   t0 = Clock::now();
   std::vector<char> movedVertex(nv, 0);
   for (std::size_t v = 0; v < nv; ++v) movedVertex[v] = !(P[v] == P0[v]);
-  if (options.round_to_float) {
-    for (std::size_t v = 0; v < nv; ++v)
-      if (movedVertex[v]) P[v] = roundedToFloat(P[v]);
-    result.rounded_to_float = true;
+  {
+    // The output stage (output_stage.h): the moved vertices as the host
+    // stores them, re-rounded where rounding would make a face around them
+    // cross another (the input is as stored already).
+    std::vector<char> aroundMoved(nf, 0);
+    for (std::size_t f = 0; f < nf; ++f) {
+      const Triangle& t = soup.triangles[f];
+      aroundMoved[f] = movedVertex[t[0]] || movedVertex[t[1]] || movedVertex[t[2]];
+    }
+    OutputStageOptions stage;
+    stage.scalar = options.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+    result.stored = storeNewPoints(P, soup.triangles, movedVertex, aroundMoved, stage);
+    result.rounded_to_float = options.round_to_float;
   }
   {
     std::vector<char> changed(nf, 0);
@@ -1114,7 +1123,7 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
                                    return !soup.checkedPair(p[0], p[1]);
                                  }),
                   touched.end());
-    result.remaining_intersecting_pairs = intersectingOf(P, soup.triangles, touched).size();
+    result.new_intersecting_pairs = intersectingOf(P, soup.triangles, touched).size();
     near.erase(std::remove_if(near.begin(), near.end(),
                               [&](const NearPair& p) { return changed[p.f] || changed[p.g]; }),
                near.end());
@@ -1141,7 +1150,7 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
       minimumOf(far, &result.min_distance_after, &none);
     }
   }
-  result.reached = result.violating_pairs_after == 0 && result.remaining_intersecting_pairs == 0;
+  result.reached = result.violating_pairs_after == 0 && result.new_intersecting_pairs == 0;
   if (result.reached) {
     result.stop_reason = "reached";
   } else if (result.stop_reason == "reached") {
@@ -1149,7 +1158,7 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
     result.stop_reason = "rounding";
     result.warnings.push_back(
         "rounding to float left " + std::to_string(result.violating_pairs_after) +
-        " pairs short of tau and " + std::to_string(result.remaining_intersecting_pairs) +
+        " pairs short of tau and " + std::to_string(result.new_intersecting_pairs) +
         " intersecting pairs");
   }
   result.short_pairs = listShortest(soup, P, near, tau, options.max_listed_pairs);
@@ -1252,7 +1261,7 @@ JsonObject toJson(const ClearanceResult& r) {
       .set("iterations", r.iterations)
       .set("step_halvings", r.step_halvings)
       .set("constraints_last", r.constraints_last)
-      .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs)
+      .set("new_intersecting_pairs", r.new_intersecting_pairs)
       .set("rounded_to_float", r.rounded_to_float)
       .set("short_pairs", toJson(r.short_pairs))
       .set("warnings", r.warnings)

@@ -24,6 +24,7 @@
 
 #include "common/json.h"
 #include "common/mesh.h"
+#include "common/output_stage.h"
 #include "common/progress.h"
 
 namespace meshmend {
@@ -143,8 +144,10 @@ struct ClearanceResult {
   std::size_t step_halvings = 0;           // line search halvings (intersection or no progress)
   std::size_t constraints_last = 0;        // vertex–face / edge–edge rows in the last step
   std::vector<ClearancePair> short_pairs;  // pairs still closer than tau (a few, closest first)
-  std::size_t remaining_intersecting_pairs =
-      0;  // exact, in the output (0 unless rounding broke it)
+  // Intersecting pairs (exact, the self-intersection rule) with a face
+  // around a moved vertex, as stored: 0 unless rounding broke it.
+  std::size_t new_intersecting_pairs = 0;
+  StoredOutput stored;  // the output stage on the moved vertices (output_stage.h)
   bool rounded_to_float = false;
   std::vector<std::string> warnings;
   double time_ms = 0;

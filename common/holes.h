@@ -16,6 +16,7 @@
 
 #include "common/json.h"
 #include "common/mesh.h"
+#include "common/output_stage.h"
 #include "common/progress.h"
 
 namespace meshmend {
@@ -96,8 +97,8 @@ struct HoleFillOptions {
   // disk) that were triangulated before the next one. Its counts make
   // remaining_intersecting_pairs exact.
   bool check_intersections = true;
-  // Recount, independently and exactly, the intersecting pairs that involve
-  // new or split faces in the finished mesh (costs about as much as the checks).
+  // Count every intersecting pair of the finished mesh as stored, by the
+  // checker's rule (remaining_intersecting_pairs): a search of the whole mesh.
   bool verify = false;
   // New vertices take float coordinates (as MeshLab stores them) before the
   // checks, so that what is checked is what is stored.
@@ -135,11 +136,16 @@ struct HoleFillResult {
   std::size_t vertices_added = 0;
   std::size_t edges_split = 0;  // boundary edges split by the pre-treatment
   std::size_t fallbacks = 0;    // holes whose patch took a flatter shape than asked
-  // remaining_intersecting_pairs is known: counted by the per-hole checks or by verify.
+  // new_intersecting_pairs is known (the output stage counts it).
   bool verified = false;
   // Intersecting pairs (exact, the self-intersection rule) that involve a
-  // patch or split face: 0 unless verification found a problem.
+  // patch or split face, as stored: 0 unless a problem was found.
+  std::size_t new_intersecting_pairs = 0;
+  // With verify: every intersecting pair of the result as stored, by the
+  // rule of meshcheck (the input's own ones included).
   std::size_t remaining_intersecting_pairs = 0;
+  bool remaining_counted = false;
+  StoredOutput stored;  // the output stage (output_stage.h)
   double time_ms = 0;
   // Where the time went, in milliseconds of wall time on the calling
   // thread, summed over the holes (they add up to about time_ms). While a

@@ -506,6 +506,26 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
   return remaining;
 }
 
+StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+                            const std::vector<char>& movable, const std::vector<char>& changed,
+                            const OutputStageOptions& stage) {
+  const auto start = std::chrono::steady_clock::now();
+  StoredOutput out;
+  out.scalar = stage.scalar;
+  const std::vector<Point3> reference = points;
+  Rounder rounder(reference, triangles, changed, movable, stage.scalar, points);
+  out.crossing = rounder.run(stage.rounding_passes, stage.max_rounding_tests, kNoLimit,
+                             stage.progress, out.vertices_rerounded, out.bounded);
+  out.rounding_tests = rounder.tests();
+  for (std::size_t f = 0; f < triangles.size() && f < changed.size(); ++f) {
+    const Triangle& t = triangles[f];
+    out.degenerate_new_faces += changed[f] && collinear(points[t[0]], points[t[1]], points[t[2]]);
+  }
+  out.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
 std::size_t crossingsLeft(const SplitResult& result, Scalar scalar) {
   requireMergedOutput(result, "counting the crossings left");
   return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, scalar, false);

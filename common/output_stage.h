@@ -115,6 +115,18 @@ std::size_t roundForHost(SplitResult& result, const OutputStageOptions& stage,
                          StoredOutput* out = nullptr,
                          std::size_t giveUpAbove = std::numeric_limits<std::size_t>::max());
 
+// Step 1 for any operation that computes new points in double (hole
+// patches, stitches, vertices moved for clearance): `points` rounded to
+// stage.scalar, and where that makes a face marked `changed` (new, or
+// around a new or moved vertex) cross another or collapse, the vertices
+// marked `movable` re-rounded. Returns what is left: `crossing` counts the
+// pairs with a changed face that intersect beyond their shared corners
+// (faces with the same three vertices apart), `degenerate_new_faces` the
+// changed faces left collinear.
+StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+                            const std::vector<char>& movable, const std::vector<char>& changed,
+                            const OutputStageOptions& stage);
+
 // Step 3: where the stored merged output still crosses, it is split along
 // its own intersections as stored (exactly, on the stored values) and
 // rounded again, up to stage.split_rounds times while crossings are left; a

@@ -1193,6 +1193,32 @@ std::size_t countBorderEdges(const Mesh& mesh) {
   return counter.count();
 }
 
+namespace {
+
+// The output stage (output_stage.h) on `mesh` once an operation added the
+// vertices from `firstNew` on and changed the faces marked `changed` (new
+// faces beyond its size): the positions as the host stores them, the new
+// vertices re-rounded where rounding made a changed face cross. Nothing to
+// store for a double host without new vertices.
+StoredOutput storeStitched(Mesh& mesh, std::size_t firstNew, std::vector<char> changed,
+                           bool roundToFloat) {
+  StoredOutput stored;
+  stored.scalar = roundToFloat ? Scalar::kFloat : Scalar::kDouble;
+  if (!roundToFloat && firstNew >= mesh.vert.size()) return stored;
+  std::vector<Point3> P = positionsOf(mesh);
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  std::vector<char> movable(P.size(), 0);
+  for (std::size_t v = firstNew; v < P.size(); ++v) movable[v] = 1;
+  changed.resize(T.size(), 1);
+  OutputStageOptions stage;
+  stage.scalar = stored.scalar;
+  stored = storeNewPoints(P, T, movable, changed, stage);
+  for (std::size_t v = 0; v < P.size(); ++v) mesh.vert[v].P() = P[v];
+  return stored;
+}
+
+}  // namespace
+
 StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
   const auto start = Clock::now();
   requireFacesAndFiniteCoordinates(mesh, "the mesh");
@@ -1251,7 +1277,7 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
     if (options.check_intersections) {
       reportProgress(options.progress, 50, "Checking intersections");
       clock = Clock::now();
-      r.remaining_intersecting_pairs = newIntersections(mesh, plan);
+      r.new_intersecting_pairs = newIntersections(mesh, plan);
       r.checked = true;
       r.stage_ms.check = msSince(clock);
     }
@@ -1263,7 +1289,12 @@ StitchResult stitchPaths(Mesh& mesh, const StitchOptions& options) {
   reportProgress(options.progress, 90, "Writing");
   std::tie(r.border_edges_before, r.stage_ms.count) = background.get();
   const auto clock = Clock::now();
+  const std::size_t verticesBefore = mesh.vert.size(), facesBefore = mesh.face.size();
   applyPlan(mesh, plan, r);
+  r.stored = storeStitched(mesh, verticesBefore, std::vector<char>(facesBefore, 0),
+                           options.round_to_float);
+  if (r.checked && (r.stored.vertices_rerounded > 0 || options.round_to_float))
+    r.new_intersecting_pairs = r.stored.crossing;  // as stored
   r.stage_ms.write = msSince(clock);
   r.border_edges_after = std::size_t(long(r.border_edges_before) + plan.borderDelta);
   reportProgress(options.progress, 100, "Done");
@@ -1382,7 +1413,7 @@ StitchSequenceResult stitchPathsSequence(Mesh& mesh, const StitchSequenceOptions
     }
     result.faces_added += r.faces_added;
     result.vertices_added += r.vertices_added;
-    result.remaining_intersecting_pairs += r.remaining_intersecting_pairs;
+    result.new_intersecting_pairs += r.new_intersecting_pairs;
     result.steps.push_back(r);
   }
   result.border_edges_after = countBorderEdges(work);
@@ -2112,6 +2143,7 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
   }
   r.border_edges_after_merge = borderEdgesOf(T);
   r.border_edges_after = r.border_edges_after_merge;
+  const std::size_t verticesAfterMerge = mesh.vert.size();
 
   // ---- Step 2: facing borders, in rounds: a stitch can leave borders that
   // face each other anew (the rest of an L-shaped slit), so they are looked
@@ -2134,6 +2166,7 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
           so.a = {g.path_a, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
           so.b = {g.path_b, g.closed ? BorderPath::Shape::Closed : BorderPath::Shape::Open};
           so.max_aspect_ratio = options.max_aspect_ratio;
+          so.round_to_float = options.round_to_float;
           try {
             const StitchPlan plan = planStitch(mesh, so);
             if (plan.conflicts > 0) {
@@ -2160,15 +2193,20 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options) {
       if (stitched == 0) break;
     }
   }
-  // ---- The output's intersecting pairs that involve a merged or new face.
+  // ---- The output stage: new vertices (subdivided strips) as stored.
+  r.stored = storeStitched(mesh, verticesAfterMerge, changedFace, options.round_to_float);
+  // ---- The output's intersecting pairs: those that involve a merged or new
+  // face, and all of them by the checker's rule.
   if (options.verify) {
     reportProgress(options.progress, 90, "Checking the result");
     changedFace.resize(mesh.face.size(), 1);
     const std::vector<Point3> points = positionsOf(mesh);
     const std::vector<Triangle> triangles = trianglesOf(mesh);
-    r.remaining_intersecting_pairs =
+    r.new_intersecting_pairs =
         intersectingOf(points, triangles, pairsWithChangedFaces(points, triangles, changedFace))
             .size();
+    r.remaining_intersecting_pairs =
+        storedIntersectingPairs(MeshArrays{points, triangles}, r.stored.scalar);
     r.verified = true;
   }
   reportProgress(options.progress, 100, "Done");
@@ -2203,7 +2241,7 @@ JsonObject toJson(const StitchResult& r) {
       .set("reversed_b", r.reversed_b)
       .set("orientation_conflicts", r.orientation_conflicts)
       .set("max_aspect_ratio", r.max_aspect_ratio);
-  if (r.checked) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
+  if (r.checked) j.set("new_intersecting_pairs", r.new_intersecting_pairs);
   j.set("time_ms", r.time_ms);
   return j;
 }
@@ -2217,7 +2255,7 @@ JsonObject toJson(const StitchSequenceResult& r) {
       .set("faces_added", r.faces_added)
       .set("vertices_merged", 0)
       .set("vertices_added", r.vertices_added)
-      .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs)
+      .set("new_intersecting_pairs", r.new_intersecting_pairs)
       .set("steps", steps)
       .set("time_ms", r.time_ms);
   return j;
@@ -2252,7 +2290,9 @@ JsonObject toJson(const CloseGapsResult& r) {
       .set("vertices_added", r.vertices_added)
       .set("gaps_found", r.gaps_found)
       .set("gaps_stitched", r.gaps_stitched);
-  if (r.verified) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
+  if (r.verified)
+    j.set("new_intersecting_pairs", r.new_intersecting_pairs)
+        .set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
   j.set("gaps", gaps).set("time_ms", r.time_ms);
   return j;
 }

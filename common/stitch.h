@@ -18,6 +18,7 @@
 
 #include "common/json.h"
 #include "common/mesh.h"
+#include "common/output_stage.h"
 #include "common/progress.h"
 
 namespace meshmend {
@@ -99,8 +100,12 @@ struct StitchOptions {
   // then the new faces follow path a's side and the conflicts are counted.
   bool allow_orientation_conflict = false;
   // Exact check that no new face intersects the mesh (or another new face)
-  // beyond the corners they share; counted in remaining_intersecting_pairs.
+  // beyond the corners they share; counted in new_intersecting_pairs.
   bool check_intersections = true;
+  // Store the result in float (MeshLab's float hosts): the mesh and the new
+  // vertices rounded through the output stage (output_stage.h), the count
+  // of new_intersecting_pairs on the stored values.
+  bool round_to_float = false;
   Progress progress;  // called between stages
 };
 
@@ -115,8 +120,9 @@ struct StitchResult {
                                           // (+ the whole side when allow_orientation_conflict)
   // Intersecting pairs (exact, the self-intersection rule) involving a new
   // face: with check_intersections, how many the stitch created.
-  std::size_t remaining_intersecting_pairs = 0;
-  bool checked = false;         // remaining_intersecting_pairs was counted
+  std::size_t new_intersecting_pairs = 0;
+  bool checked = false;         // new_intersecting_pairs was counted
+  StoredOutput stored;          // the output stage on the new vertices (output_stage.h)
   double max_aspect_ratio = 0;  // of the new faces: longest edge / shortest altitude
   // The two end rungs of an open stitch (vertex on path a, vertex on path b),
   // which are new border edges unless they existed; {-1,-1} for loops.
@@ -168,7 +174,7 @@ struct StitchSequenceResult {
   std::size_t vertices_added = 0;
   std::size_t border_edges_before = 0;
   std::size_t border_edges_after = 0;
-  std::size_t remaining_intersecting_pairs = 0;
+  std::size_t new_intersecting_pairs = 0;
   double time_ms = 0;
 };
 
@@ -224,9 +230,11 @@ struct CloseGapsOptions {
   // left out (with its reason).
   bool check_intersections = true;
   // Count, exactly, the output's intersecting pairs that involve a merged or
-  // stitched face (remaining_intersecting_pairs).
+  // stitched face (new_intersecting_pairs), and all of them by the checker's
+  // rule (remaining_intersecting_pairs).
   bool verify = true;
-  Progress progress;  // called between stages
+  bool round_to_float = false;  // store in float, as StitchOptions::round_to_float
+  Progress progress;            // called between stages
 };
 
 // One pair of facing border paths.
@@ -258,8 +266,12 @@ struct CloseGapsResult {
   // With verify: intersecting pairs (exact, the self-intersection rule) of
   // the output with a merged or stitched face in them. Faces that only touch
   // where coincident vertices stay apart count.
+  std::size_t new_intersecting_pairs = 0;
+  // With verify: every intersecting pair of the output as stored, by the
+  // rule of meshcheck (the input's own ones included).
   std::size_t remaining_intersecting_pairs = 0;
   bool verified = false;
+  StoredOutput stored;  // the output stage on the new vertices (output_stage.h)
   std::vector<GapReport> gaps;
   // For every input vertex its index in the output (merged vertices share one).
   std::vector<int> vertex_index;

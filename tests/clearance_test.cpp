@@ -294,7 +294,7 @@ TEST(EnforceClearance, ParallelSquaresMoveHalfTheShortfallEach) {
   EXPECT_NEAR(r.mean_displacement_all, 0.1, 1e-3);
   EXPECT_GE(bruteMinimum(view(layers), false, true, 1), 0.5);
   EXPECT_EQ(intersectingPairs(view(layers)), 0u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
 }
 
 TEST(EnforceClearance, LockedSideMakesTheOtherMoveTheWholeShortfall) {
@@ -417,7 +417,7 @@ TEST(EnforceClearance, ThinPlateThinnerThanTauIsReportedNotTorn) {
   EXPECT_FALSE(r.short_pairs.empty());
   EXPECT_LE(r.max_displacement, 0.02 * (1 + 1e-9));
   EXPECT_EQ(intersectingPairs(view(layers)), 0u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   // The top and bottom went apart as far as the cap lets them.
   double lo = INFINITY, hi = -INFINITY;
   for (const Point3& q : positionsOf(plate)) {

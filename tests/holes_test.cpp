@@ -45,8 +45,7 @@ void expectSound(const Mesh& mesh, std::size_t borderEdges) {
   EXPECT_EQ(selfIntersectingPairs(mesh), 0u);
 }
 
-// Options with one shape, and the independent recount on (so that
-// remaining_intersecting_pairs is counted, not only known).
+// Options with one shape, and the whole-mesh count on (verify).
 HoleFillOptions withFairing(HoleFairing fairing) {
   HoleFillOptions o;
   o.fairing = fairing;
@@ -254,7 +253,7 @@ TEST(HoleFront, PlanarRoundHoleIsCoveredWithGoodTriangles) {
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_found, 2u);
   ASSERT_EQ(r.holes_filled, 1u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 120);
   EXPECT_GT(border, 120u);
   const std::vector<Point3> P = positionsOf(m);
@@ -280,7 +279,7 @@ TEST(HoleFront, ElongatedHole) {
   o.max_boundary_edges = 300;  // not the outer border
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_filled, 1u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 320);
   EXPECT_GT(smallestNewAngle(m, r), 15);
   // The flat slot stays flat whatever the shape (the plane's Laplacians are 0).
@@ -306,7 +305,7 @@ TEST(HoleFront, SaddleHoleInEveryMode) {
         EXPECT_EQ(h.fairing, mode) << h.reason;
       }
     }
-    EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+    EXPECT_EQ(r.new_intersecting_pairs, 0u);
     expectSound(m, 160);
     const std::vector<Point3> P = positionsOf(m);
     double worst = 0;
@@ -385,7 +384,7 @@ TEST(HoleShape, SphereCapInEveryMode) {
     ASSERT_EQ(r.holes_found, 1u);
     ASSERT_EQ(r.holes_filled, 1u);
     EXPECT_EQ(r.holes[0].fairing, mode) << r.holes[0].reason;
-    EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+    EXPECT_EQ(r.new_intersecting_pairs, 0u);
     expectSound(m, 0);
     EXPECT_GT(volumeOf(m), 0);
     deviation[mode] = maxSphereDeviation(m, r);
@@ -411,7 +410,7 @@ TEST(HoleShape, HoleInATubeOfSliversFollowsTheCylinder) {
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_found, 3u);  // the tube's two ends and the hole
   ASSERT_EQ(r.holes_filled, 3u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 0);
   const std::vector<Point3> P = positionsOf(m);
   double worst = 0;
@@ -451,7 +450,7 @@ TEST(HoleShape, BandAroundATubeIsRefinedWhereTheShapeStretchesIt) {
       *std::find_if(r.holes.begin(), r.holes.end(), [](const HoleReport& h) { return h.filled; });
   EXPECT_EQ(band.fairing, HoleFairing::Biharmonic) << band.reason;
   EXPECT_TRUE(band.planar_domain);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 2 * 64);
   const std::vector<Point3> P = positionsOf(m);
   const std::vector<Triangle> T = trianglesOf(m);
@@ -486,7 +485,7 @@ TEST(HoleShape, HoleAroundTheRimOfAThinPlate) {
   ASSERT_EQ(r.holes_found, 1u);
   ASSERT_EQ(r.holes_filled, 1u) << r.holes[0].reason;
   EXPECT_EQ(r.holes[0].fairing, HoleFairing::Biharmonic) << r.holes[0].reason;
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 0);
   const std::vector<Point3> P = positionsOf(m);
   for (int v : r.new_vertices) {
@@ -517,7 +516,7 @@ TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
   const HoleReport& hole = r.holes[0].filled ? r.holes[0] : r.holes[1];
   EXPECT_NE(hole.fairing, HoleFairing::LaplacianRegression);
   EXPECT_NE(hole.reason.find("intersect"), std::string::npos) << hole.reason;
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   EXPECT_EQ(selfIntersectingPairs(m), 0u);
 }
 
@@ -535,7 +534,11 @@ TEST(HoleChecks, VerificationCountsWhatAnUncheckedPatchCrosses) {
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_filled, 2u);  // the plate's border too, by a copy of the plate
   EXPECT_TRUE(r.verified);
-  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
+  EXPECT_GT(r.new_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, selfIntersectingPairs(m));
+  // The whole-mesh count, by the checker's rule, is the same here (the
+  // input crossed nothing).
+  EXPECT_TRUE(r.remaining_counted);
   EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
 }
 
@@ -564,7 +567,7 @@ TEST(HoleChecks, HoleWhoseFillMustCrossAnotherPartIsSkipped) {
             << shape << ": " << h.reason;
     }
   }
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   EXPECT_EQ(std::size_t(m.fn), facesBefore);
   EXPECT_EQ(positionsOf(m), before);  // splits of a skipped hole are undone
 }
@@ -735,7 +738,7 @@ TEST(HoleSelection, ManySmallHolesAreAllFilled) {
   const HoleFillResult r = fillHoles(m, o);
   EXPECT_EQ(r.holes_found, 17u);
   EXPECT_EQ(r.holes_filled, 16u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectSound(m, 160);
 }
 
@@ -780,7 +783,7 @@ TEST(HoleLarge, ThousandBorderVertexHoleIsFilled) {
   const HoleFillResult r = fillHoles(m, o);
   ASSERT_EQ(r.holes_found, 2u);
   ASSERT_EQ(r.holes_filled, 1u) << r.holes[0].reason << " / " << r.holes[1].reason;
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   const HoleReport& hole = r.holes[0].filled ? r.holes[0] : r.holes[1];
   EXPECT_EQ(hole.boundary_edges, 1000u);
   EXPECT_EQ(hole.fairing, HoleFairing::Biharmonic) << hole.reason;
@@ -799,7 +802,7 @@ TEST(HoleReportJson, HasTheKeysScriptsRead) {
   const HoleFillResult r = fillHoles(m, o);
   const std::string json = toJson(r).str();
   for (const char* key : {"\"holes_found\": 2", "\"holes_filled\": 1", "\"holes_skipped\": 1",
-                          "\"faces_added\": ", "\"remaining_intersecting_pairs\": 0",
+                          "\"faces_added\": ", "\"new_intersecting_pairs\": 0",
                           "\"time_ms\": ", "\"skipped\": [{", "\"reason\": "})
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
   EXPECT_EQ(r.new_faces.size(), r.faces_added);

@@ -144,7 +144,7 @@ TEST(StitchFigure2, ParallelPathsWithWideningGap) {
   EXPECT_FALSE(r.reversed_b);
   EXPECT_EQ(r.orientation_conflicts, 0u);
   EXPECT_TRUE(r.checked);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(s.mesh, r.border_edges_after, vertices);
 }
 
@@ -161,14 +161,14 @@ TEST(StitchCheck, CountsThePairsTheStitchMakesAsAWholeMeshCountDoes) {
   o.b.vertices = s.b;
   const StitchResult r = stitchPaths(m, o);
   ASSERT_TRUE(r.checked);
-  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
+  EXPECT_GT(r.new_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, selfIntersectingPairs(m));
   // Without the check nothing is counted, and the same faces are added.
   Mesh unchecked = appended(s.mesh, pin);
   o.check_intersections = false;
   const StitchResult u = stitchPaths(unchecked, o);
   EXPECT_FALSE(u.checked);
-  EXPECT_EQ(u.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(u.new_intersecting_pairs, 0u);
   EXPECT_EQ(trianglesOf(unchecked), trianglesOf(m));
 }
 
@@ -236,7 +236,7 @@ TEST(StitchFigure2, SharplyTurningStaircasePaths) {
   const std::size_t pathEdges = o.a.vertices.size() - 1 + o.b.vertices.size() - 1;
   EXPECT_EQ(r.faces_added, pathEdges);
   EXPECT_EQ(r.border_edges_after, borderBefore - pathEdges + 2);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(m, r.border_edges_after, vertices);
 }
 
@@ -257,7 +257,7 @@ TEST(StitchFigure2, WideGapSubdivided) {
   EXPECT_EQ(s.mesh.vert.size(), vertices + r.vertices_added);
   EXPECT_LT(r.max_aspect_ratio, coarse.max_aspect_ratio / 2);
   EXPECT_LT(r.max_aspect_ratio, 8);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   const EdgeStats st = edgeStats(s.mesh);
   EXPECT_EQ(st.border, r.border_edges_after);
   EXPECT_EQ(st.nonManifold, 0u);
@@ -286,7 +286,7 @@ TEST(StitchFigure4, NonCoplanarPatches) {
   o.b.vertices = row(nb, nv, int(A.vert.size()));
   const StitchResult r = stitchPaths(m, o);
   EXPECT_EQ(r.faces_added, std::size_t(na + nb));
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(m, 2 * (na + nv) + 2 * (nb + nv) - na - nb + 2, vertices);
 }
 
@@ -337,7 +337,7 @@ TEST(StitchFigure3, JunctionOfThreePatchesIsCovered) {
   // Only the hexagon's outline is left open: its three patch sides and the
   // three gap ends.
   EXPECT_EQ(r.border_edges_after, t.outerBorder + 3);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(t.mesh, t.outerBorder + 3, vertices);
 }
 
@@ -369,7 +369,7 @@ TEST(StitchLoops, TwoTubeEndsOfDifferentDensity) {
   EXPECT_TRUE(r.closed);
   EXPECT_EQ(r.faces_added, 24u + 17u);
   EXPECT_EQ(r.border_edges_after, 24u + 17u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(m, 24 + 17, vertices);
 }
 
@@ -749,8 +749,8 @@ TEST(CloseGaps, SolidsTouchingAlongAnEdgeCloseSeparately) {
   // The cubes touch along the edge without sharing a vertex there: those
   // pairs count, and the count is the whole output's (every face merged).
   ASSERT_TRUE(r.verified);
-  EXPECT_GT(r.remaining_intersecting_pairs, 0u);
-  EXPECT_EQ(r.remaining_intersecting_pairs, selfIntersectingPairs(m));
+  EXPECT_GT(r.new_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, selfIntersectingPairs(m));
 }
 
 TEST(CloseGaps, BorderEdgeOfZeroLengthCollapsesItsFace) {
@@ -849,7 +849,7 @@ TEST(CloseGaps, SlitOneEdgeWideIsClosedByDefault) {
   ASSERT_EQ(r.gaps_stitched, 1u);
   EXPECT_EQ(r.faces_added, 6u);
   EXPECT_EQ(r.border_edges_after, 2u * (nu + nv));
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   expectClean(m, 2u * (nu + nv), vertices);
   // With the diagonal's fraction alone it stays open.
   Mesh open = slitSheet(nu, nv);
@@ -912,9 +912,9 @@ TEST(CloseGaps, VerifyCountsThePairsOfMergedAndStitchedFaces) {
   const CloseGapsResult r = closeGaps(m, o);
   ASSERT_EQ(r.gaps_stitched, 1u);
   EXPECT_TRUE(r.verified);
-  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(r.new_intersecting_pairs, 0u);
   EXPECT_EQ(selfIntersectingPairs(m), 0u);
-  EXPECT_NE(toJson(r).str().find("remaining_intersecting_pairs"), std::string::npos);
+  EXPECT_NE(toJson(r).str().find("new_intersecting_pairs"), std::string::npos);
   // A small triangle across the gap, through the wall y = 0: the checked
   // stitch leaves the gap open; unchecked, the verification finds the pairs
   // the stitch made (the only ones: the triangle touches nothing else).
@@ -927,13 +927,13 @@ TEST(CloseGaps, VerifyCountsThePairsOfMergedAndStitchedFaces) {
   o.check_intersections = false;
   const CloseGapsResult rc = closeGaps(crossed, o);
   ASSERT_GE(rc.gaps_stitched, 1u);
-  EXPECT_GT(rc.remaining_intersecting_pairs, 0u);
-  EXPECT_EQ(rc.remaining_intersecting_pairs, selfIntersectingPairs(crossed));
+  EXPECT_GT(rc.new_intersecting_pairs, 0u);
+  EXPECT_EQ(rc.new_intersecting_pairs, selfIntersectingPairs(crossed));
   o.verify = false;
   Mesh unverified = openBoxHalves(4, 0.02);
   const CloseGapsResult ru = closeGaps(unverified, o);
   EXPECT_FALSE(ru.verified);
-  EXPECT_EQ(toJson(ru).str().find("remaining_intersecting_pairs"), std::string::npos);
+  EXPECT_EQ(toJson(ru).str().find("new_intersecting_pairs"), std::string::npos);
 }
 
 TEST(Reports, JsonKeys) {

@@ -539,8 +539,8 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
       Log("  short pair %zu: %s", i + 1, describe(r.short_pairs[i], in.cores, layers).c_str());
   }
   for (const std::string& w : r.warnings) Log("  warning: %s", w.c_str());
-  if (r.remaining_intersecting_pairs)
-    Log("  check: %zu intersecting pairs in the float result", r.remaining_intersecting_pairs);
+  if (r.new_intersecting_pairs)
+    Log("  check: %zu intersecting pairs in the float result", r.new_intersecting_pairs);
   reportProgress(options.progress, 100, "MeshMend: done");
 }
 

@@ -92,13 +92,15 @@ void HolesPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& par
       "restrict later filters such as smoothing to the selection."));
   parameters.addParam(RichBool(
       "verify", defaults.verify, "Verify the result",
-      "Recounts, independently and exactly, the intersecting pairs that involve new or split "
-      "faces (remaining_intersecting_pairs in the log and report)."));
+      "Counts every intersecting pair of the result as stored, by the rule of CGAL's "
+      "self_intersections and of the checker meshcheck (remaining_intersecting_pairs in the log "
+      "and report; the mesh's own pairs included). The pairs that involve new or split faces "
+      "are always counted (new_intersecting_pairs)."));
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
-      "holes_found, holes_filled, holes_skipped, skipped, faces_added, "
-      "remaining_intersecting_pairs, time_ms, holes, ...)."));
+      "holes_found, holes_filled, holes_skipped, skipped, faces_added, new_intersecting_pairs, "
+      "remaining_intersecting_pairs (with verify), time_ms, holes, ...)."));
 }
 
 void HolesPlugin::apply(QAction*, MeshDocument& md, const RichParameterList& parameters,
@@ -156,7 +158,11 @@ void HolesPlugin::apply(QAction*, MeshDocument& md, const RichParameterList& par
     else
       Log("  hole %zu: %zu border edges, left open: %s", i, h.boundary_edges, h.reason.c_str());
   }
-  if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
+  if (r.verified)
+    Log("  check of the stored result: %zu intersecting pairs with a new or split face",
+        r.new_intersecting_pairs);
+  if (r.remaining_counted)
+    Log("  verify: %zu intersecting pairs in the whole result", r.remaining_intersecting_pairs);
   if (r.holes_found == 0) {
     Log("MeshMend: the mesh has no holes (no border edges); nothing to do");
     return;  // the layer stays exactly as it was

@@ -332,7 +332,7 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
     parameters.addParam(
         RichBool("check_intersections", true, "Check intersections",
                  "Counts, exactly, the pairs of faces that a new face makes intersect "
-                 "(remaining_intersecting_pairs in the log and report)."));
+                 "(new_intersecting_pairs in the log and report)."));
     parameters.addParam(
         RichEnum("output", kNewLayer,
                  QStringList() << "New layer 'stitched' (inputs kept, hidden)"
@@ -518,6 +518,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
     throw InvalidInputError("unknown path source " + std::to_string(mode) + ": use 0 to 2");
   StitchOptions options;
   options.max_aspect_ratio = parameters.getFloat("max_aspect_ratio");
+  options.round_to_float = kHostStoresFloat;  // store what this MeshLab stores
   options.max_rows = parameters.getInt("max_rows");
   if (!(options.max_aspect_ratio >= 0) || options.max_rows < 0)
     throw InvalidInputError("the aspect ratio bound and the number of rows must not be negative");
@@ -607,7 +608,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
     Log("MeshMend: %zu stitches in sequence on %s: %zu faces and %zu vertices added, border "
         "edges %zu -> %zu, %zu intersecting pairs with new faces (%.0f ms)",
         r.steps.size(), layerName(current).c_str(), r.faces_added, r.vertices_added,
-        r.border_edges_before, r.border_edges_after, r.remaining_intersecting_pairs, r.time_ms);
+        r.border_edges_before, r.border_edges_after, r.new_intersecting_pairs, r.time_ms);
     for (std::size_t k = 0; k < r.concatenated.size(); ++k)
       for (const auto& c : r.concatenated[k])
         Log("  after stitch %zu: paths %d and %d concatenated at the junction", k, c[0], c[1]);
@@ -637,8 +638,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
         layers.size() == 2 ? "two layers" : layerName(current).c_str(), options.a.vertices.size(),
         options.b.vertices.size(), r.closed ? ", two loops" : "", r.faces_added, r.vertices_added,
         r.border_edges_before, r.border_edges_after, r.max_aspect_ratio, r.time_ms);
-    if (r.checked)
-      Log("  check: %zu intersecting pairs with a new face", r.remaining_intersecting_pairs);
+    if (r.checked) Log("  check: %zu intersecting pairs with a new face", r.new_intersecting_pairs);
     if (r.orientation_conflicts)
       Log("  warning: %zu border edges run against the orientation of the new faces",
           r.orientation_conflicts);
@@ -692,6 +692,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   options.orient_faces = parameters.getBool("orient_faces");
   options.min_path_vertices = parameters.getInt("min_path_vertices");
   options.max_aspect_ratio = parameters.getFloat("max_aspect_ratio");
+  options.round_to_float = kHostStoresFloat;  // store what this MeshLab stores
   options.check_intersections = parameters.getBool("check_intersections");
   if (!(options.merge_tolerance >= 0) || !(options.max_gap >= 0) ||
       !(options.local_gap_factor >= 0) || !(options.max_aspect_ratio >= 0))

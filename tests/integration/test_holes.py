@@ -31,7 +31,7 @@ def test_holes_within_the_limits_are_closed(tmp_path, name):
     assert all("wider than the limit" in h["reason"] for h in r["skipped"]), r["skipped"]
     assert after["non_manifold_edges"] == before["non_manifold_edges"] == 0
     assert after["self_intersecting_pairs"] == before["self_intersecting_pairs"]
-    assert r["remaining_intersecting_pairs"] == 0
+    assert r["new_intersecting_pairs"] == 0
     assert after["consistently_oriented"]
     assert after["faces"] == before["faces"] + r["faces_added"] + r["edges_split"]
     for key in ("holes_found", "holes_filled", "holes_skipped", "faces_added", "time_ms"):

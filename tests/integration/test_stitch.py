@@ -253,7 +253,7 @@ def test_stitch_two_open_sheets_across_a_gap(tmp_path):
     assert r["border_edges_after"] == after["border_edges"] == outline(nA, nB)
     assert after["connected_components"] == 1 and after["border_loops"] == 1
     assert after["vertices"] == len(V)  # no new vertex
-    assert r["remaining_intersecting_pairs"] == 0
+    assert r["new_intersecting_pairs"] == 0
     expect_clean(after)
     for key in REPORT_KEYS:
         assert key in r
@@ -351,7 +351,7 @@ def test_stitch_sequence_covers_a_junction(tmp_path):
     assert run.returncode == 0, run.log[-3000:]
     r, after = run.report, meshcheck(out)
     assert len(r["steps"]) == 2 and "concatenated at the junction" in run.log
-    assert r["remaining_intersecting_pairs"] == 0
+    assert r["new_intersecting_pairs"] == 0
     assert after["connected_components"] == 1 and after["border_loops"] == 1
     assert after["border_edges"] == r["border_edges_after"] == 3 * 2 * n + 3
     expect_clean(after)
@@ -558,4 +558,4 @@ def test_two_range_scans_trimmed_and_stitched_into_one_part(tmp_path):
     assert stitched["border_edges_after"] == after["border_edges"]
     assert after["non_manifold_edges"] == 0 and after["orientation_inconsistent_edges"] == 0
     assert after["self_intersecting_pairs"] == 0
-    assert stitched["remaining_intersecting_pairs"] == 0
+    assert stitched["new_intersecting_pairs"] == 0

@@ -542,7 +542,7 @@ def test_stitch_two_borders():
     assert r["faces_added"] == 20 == len(out.new_faces) and len(out.faces) == len(F) + 20
     assert r["border_edges_before"] == before["border_edges"]
     assert r["border_edges_after"] == before["border_edges"] - 20 + 2  # two end rungs
-    assert r["remaining_intersecting_pairs"] == 0 and len(out.new_vertices) == 0
+    assert r["new_intersecting_pairs"] == 0 and len(out.new_vertices) == 0
     after = mm.inspect(out.vertices, out.faces)
     assert after["connected_components"] == 1 and after["consistently_oriented"]
     assert after["border_edges"] == r["border_edges_after"] and after["non_manifold_edges"] == 0
