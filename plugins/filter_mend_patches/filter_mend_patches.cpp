@@ -6,6 +6,8 @@
 
 #include "common/inspect.h"
 #include "common/intersections.h"
+#include "common/output_stage.h"
+#include "common/patch_ops.h"
 #include "common/patches.h"
 #include "common/split.h"
 #include "plugins/bridge/filter_support.h"
@@ -116,23 +118,6 @@ vcg::Color4b colourOf(int id) {
   return vcg::Color4b(c[0], c[1], c[2], 255);
 }
 
-// What a user needs to know about the threshold when a part is open, and
-// about parts taken turned.
-std::vector<std::string> partNotes(const Patches& p) {
-  std::vector<std::string> notes;
-  for (int part = 0; part < p.parts; ++part)
-    if (part < int(p.part_inside_out.size()) && p.part_inside_out[part])
-      notes.push_back("part " + std::to_string(part) +
-                      " is inside out (its faces point inward: a negative volume): it is "
-                      "classified as if turned outward, and the result faces outward");
-    else if (!p.part_closed[part])
-      notes.push_back("part " + std::to_string(part) +
-                      " is open (it has border edges): its winding number is fractional near "
-                      "the holes, and a patch counts as inside it where the winding number "
-                      "exceeds 0.5");
-  return notes;
-}
-
 std::string partsLegend(const Assembly& a) {
   if (a.layers.size() > 1) {
     std::string s;
@@ -141,31 +126,6 @@ std::string partsLegend(const Assembly& a) {
     return "parts: " + s;
   }
   return "parts: the input layers of the intersection, in their order";
-}
-
-// Patch ids from text such as "0, 3, 5-7".
-std::vector<int> parseIds(const std::string& text, std::size_t patches) {
-  std::vector<int> ids;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (item.empty()) continue;
-    int lo = 0, hi = 0;
-    char dash = 0;
-    std::stringstream range(item);
-    if (!(range >> lo)) throw InvalidInputError("'" + item + "' is not a patch id");
-    hi = lo;
-    if (range >> dash && !(dash == '-' && range >> hi))
-      throw InvalidInputError("'" + item + "' is not a patch id or a range like 5-7");
-    if (lo < 0 || hi < lo || std::size_t(hi) >= patches)
-      throw InvalidInputError("patch id '" + item + "' does not exist: the ids run from 0 to " +
-                              std::to_string(patches - 1));
-    for (int id = lo; id <= hi; ++id) ids.push_back(id);
-  }
-  if (ids.empty()) throw InvalidInputError("no patch ids given: write them like 0, 3, 5-7");
-  return ids;
 }
 
 }  // namespace
@@ -398,51 +358,20 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
   reportProgress(progressFrom(cb), 0, "Selecting patches");
   const Assembly a = assemble(md, parameters.getEnum("layers"));
   Patches p = patchesOf(a);
-  const int by = parameters.getEnum("by");
-  std::vector<char> chosen(p.patches.size(), 0);
-  if (by == kByIds) {
-    for (int id : parseIds(toStd(parameters.getString("ids")), p.patches.size())) chosen[id] = 1;
-  } else if (by == kTouchingSelection) {
-    bool any = false;
+  SelectPatchesOptions options;
+  options.by = PatchSelection(parameters.getEnum("by"));
+  options.ids = toStd(parameters.getString("ids"));
+  options.part = parameters.getInt("part");
+  if (options.by == PatchSelection::kTouchingSelection) {
+    options.selected_faces.assign(a.mesh.face.size(), 0);
     for (std::size_t i = 0; i < a.layers.size(); ++i)
-      forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
-        if (face.IsS()) chosen[p.patch_of_face[f]] = 1, any = true;
-      });
-    if (!any)
-      throw InvalidInputError(
-          "no face is selected: select a face of each patch you want "
-          "(e.g. with the selection tool), then run this again");
-  } else {
-    const int part = parameters.getInt("part");
-    if (by == kInsidePart && (part < 0 || part >= p.parts))
-      throw InvalidInputError("there is no part " + std::to_string(part) +
-                              ": the parts run from 0 to " + std::to_string(p.parts - 1));
-    if (by != kUnionInterior && p.parts < 2)
-      throw InvalidInputError(
-          "there is only one part: inside / outside other parts needs the "
-          "merged output of 'Intersect and Split Layers' or several layers");
-    classifyPatches(a.mesh, a.labels, p);
-    for (const std::string& note : partNotes(p)) Log("  note: %s", note.c_str());
-    for (std::size_t id = 0; id < p.patches.size(); ++id) {
-      const Patch& patch = p.patches[id];
-      switch (by) {
-        case kOutsideOthers:
-          chosen[id] = patch.insideAllOthers(false);
-          break;
-        case kInsideAllOthers:
-          chosen[id] = patch.insideAllOthers(true);
-          break;
-        case kInsidePart:
-          chosen[id] = patch.part != part && patch.inside(part);
-          break;
-        default:
-          chosen[id] = !patch.onUnionSurface();
-          break;
-      }
-    }
+      forEachFace(a, i,
+                  [&](std::size_t f, CFaceO& face) { options.selected_faces[f] = face.IsS(); });
   }
-  std::size_t faces = 0, patches = 0;
-  for (char c : chosen) patches += c;
+  const SelectPatchesResult r = selectPatches(a.mesh, a.labels, p, options);
+  for (const std::string& note : r.notes) Log("  note: %s", note.c_str());
+  const std::vector<char>& chosen = r.chosen;
+  std::size_t faces = 0, patches = r.patches_selected;
   for (std::size_t i = 0; i < a.layers.size(); ++i)
     forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
       if (chosen[p.patch_of_face[f]]) {
@@ -467,75 +396,34 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
 
 void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters,
                            vcg::CallBackPos* cb) {
-  const auto start = Clock::now();
-  reportProgress(progressFrom(cb), 0, "Choosing patches");
   const int which = parameters.getEnum("layers");
   const Assembly a = assemble(md, which);
   Patches p = patchesOf(a);
   const int keepMode = parameters.getEnum("keep");
-  PatchChoice choice;
+  RemovePatchesOptions options;
   if (keepMode == kUnselected) {
-    choice.keep.assign(p.patches.size(), 1);
-    bool any = false;
+    options.keep.reset();  // the patches with a selected face go
+    std::vector<char> removed(p.patches.size(), 0);
     for (std::size_t i = 0; i < a.layers.size(); ++i)
       forEachFace(a, i, [&](std::size_t f, CFaceO& face) {
-        if (face.IsS()) choice.keep[p.patch_of_face[f]] = 0, any = true;
+        if (face.IsS()) removed[p.patch_of_face[f]] = 1;
       });
-    if (!any)
-      throw InvalidInputError(
-          "no face is selected: select the patches to remove first (e.g. "
-          "with 'Select Patches'), or choose a boolean preset");
+    for (std::size_t id = 0; id < removed.size(); ++id)
+      if (removed[id]) options.remove.push_back(int(id));
   } else {
-    const BooleanOperation op = operationOf(keepMode);
-    if (op != BooleanOperation::kUnion && p.parts < 2)
-      throw InvalidInputError(
-          "intersection and difference need two parts: use the merged "
-          "output of 'Intersect and Split Layers' of two layers, or two "
-          "visible layers");
-    reportProgress(progressFrom(cb), 20, "Classifying patches");
-    classifyPatches(a.mesh, a.labels, p);
-    for (const std::string& note : partNotes(p)) Log("  note: %s", note.c_str());
-    choice = choosePatches(p, op);
+    options.keep = operationOf(keepMode);
   }
-  std::size_t kept = 0;
-  for (char k : choice.keep) kept += k;
-  if (kept == 0)
-    throw InvalidInputError(
-        "nothing would be left: every patch would be removed. The result is empty "
-        "when the parts' interiors do not overlap (an intersection), or the first "
-        "part lies inside the others (a difference); if the layers cross, run "
-        "'Intersect and Split Layers' first");
-  reportProgress(progressFrom(cb), 60, "Extracting the kept patches");
-  const Mesh result = extractPatches(a.mesh, p, choice.keep, choice.flip);
-  std::vector<char> removedPatches(choice.keep.size());
-  for (std::size_t id = 0; id < choice.keep.size(); ++id) removedPatches[id] = !choice.keep[id];
   const bool toLayer = parameters.getBool("removed_to_layer");
-  Mesh removed;
-  if (toLayer && kept < p.patches.size()) removed = extractPatches(a.mesh, p, removedPatches);
-
-  JsonObject report;
-  report.set("patches", p.patches.size())
-      .set("patches_removed", p.patches.size() - kept)
-      .set("faces_out", std::size_t(result.fn))
-      .set("keep", keepMode == kUnselected ? "unselected" : toString(operationOf(keepMode)));
-  InspectResult check;
-  std::size_t remaining = 0;
-  const bool verify = parameters.getBool("verify");
-  if (verify) {
-    reportProgress(progressFrom(cb), 80, "Checking the result");
-    check = inspect(result);
-    FindIntersectionsOptions o;
-    o.cross = false;
-    remaining = findIntersections({&result}, o).pairs.size();
-    report.set("non_manifold_edges", check.non_manifold_edges)
-        .set("border_edges", check.border_edges)
-        .set("is_closed", check.is_closed)
-        .set("volume", check.volume)
-        .set("remaining_intersecting_pairs", remaining);
-  }
-  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  report.set("time_ms", ms);
-  publishReport(parameters, report);
+  options.removed_mesh = toLayer;
+  options.verify = parameters.getBool("verify");
+  options.scalar = kHostStoresFloat ? Scalar::kFloat : Scalar::kDouble;
+  options.progress = progressFrom(cb);
+  const RemovePatchesResult r = removePatches(a.mesh, a.labels, std::move(p), options);
+  for (const std::string& note : r.notes) Log("  note: %s", note.c_str());
+  const Mesh& result = r.mesh;
+  const Mesh& removed = r.removed;
+  const std::size_t kept = r.patches - r.patches_removed;
+  publishReport(parameters, toJson(r));
 
   // The document changes only from here on.
   std::vector<LayerAttributes> attributes;
@@ -552,11 +440,12 @@ void PatchesPlugin::remove(MeshDocument& md, const RichParameterList& parameters
   }
   if (which == kAllVisible)
     for (MeshModel* m : a.layers) setLayerVisible(*m, false);
-  Log("MeshMend: kept %zu of %zu patches: %d faces (%.0f ms)%s", kept, p.patches.size(), out->cm.fn,
-      ms, toLayer ? "; the removed ones are in layer 'removed patches'" : "");
-  if (verify)
-    Log("  check: %zu intersecting pairs, %zu non-manifold edges, %zu border edges%s", remaining,
-        check.non_manifold_edges, check.border_edges, check.is_closed ? ", closed" : "");
+  Log("MeshMend: kept %zu of %zu patches: %d faces (%.0f ms)%s", kept, r.patches, out->cm.fn,
+      r.time_ms, toLayer ? "; the removed ones are in layer 'removed patches'" : "");
+  if (r.verified)
+    Log("  check: %zu intersecting pairs, %zu non-manifold edges, %zu border edges%s",
+        r.remaining_intersecting_pairs, r.non_manifold_edges, r.border_edges,
+        r.is_closed ? ", closed" : "");
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(PatchesPlugin)

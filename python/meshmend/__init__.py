@@ -162,6 +162,13 @@ class PatchesResult(NamedTuple):
     faces: Any
     face_origin: Any  # per output face: the input face it copies
     report: Dict[str, Any]
+    removed: Optional[Arrays] = None  # the removed patches, welded (removed_mesh=True)
+
+
+class SelectPatchesResult(NamedTuple):
+    selected_faces: Any  # per face: in a chosen patch
+    patch_of_face: Any  # per face: its patch id
+    report: Dict[str, Any]  # patches_selected, faces_selected, selected_ids, notes
 
 
 # ---------------------------------------------------------------- signatures
@@ -388,7 +395,19 @@ def remove_patches(vertices, faces, **options) -> PatchesResult:
     """Removes the patches `remove` (ids), or keeps a boolean result
     (keep='union', 'intersection' or 'difference'), and welds what is left."""
     out = _core.remove_patches(vertices, faces, **options)
-    return PatchesResult(*out["mesh"], out["face_origin"], out["report"])
+    removed = out["removed"]
+    return PatchesResult(*out["mesh"], out["face_origin"], out["report"],
+                         None if removed is None else tuple(removed))
+
+
+@_with_options("select_patches")
+def select_patches(vertices, faces, by=1, ids="", part=1, **options) -> SelectPatchesResult:
+    """Chooses patches as the Select Patches filter does (`by`, in its
+    order): 0 the ids in `ids` ("0, 3, 5-7"), 1 those with a face in
+    selected_faces, 2 outside every other part, 3 inside every other part,
+    4 inside part `part`, 5 not on the outer surface of the union."""
+    out = _core.select_patches(vertices, faces, by, ids, part, **options)
+    return SelectPatchesResult(out["selected_faces"], out["patch_of_face"], out["report"])
 
 
 @_with_options("intersect_and_split", exclude=("separate_meshes",))
@@ -403,6 +422,7 @@ def boolean(vertices1, faces1, vertices2, faces2, operation="union", **options) 
     merged_vertices, merged_faces = split.merged
     result = remove_patches(merged_vertices, merged_faces, part=split.merged_part,
                             curve_edges=split.merged_curve_edges, keep=operation,
+                            round_to_float=options.get("round_to_float", False),
                             progress=options.get("progress"))
     result.report["split"] = split.report
     return result
@@ -469,6 +489,6 @@ __all__ = [
     "intersect_and_split", "intersect_and_split_meshes", "split_self_intersections",
     "remove_self_intersections", "fill_holes", "trim_along_loop", "stitch_boundaries",
     "stitch_sequence", "border_paths", "close_gaps", "measure_clearance", "enforce_clearance",
-    "paint_patches", "remove_patches", "boolean", "read_mesh", "write_mesh", "as_arrays",
+    "paint_patches", "remove_patches", "select_patches", "boolean", "read_mesh", "write_mesh", "as_arrays",
     "from_pymeshlab", "to_pymeshlab", "to_trimesh",
 ]

@@ -159,42 +159,64 @@ py::array_t<std::int32_t> faceOriginsOf(Mesh& mesh) {
   return intArray(faces);
 }
 
-std::vector<int> vertexIndices(py::handle value, const std::string& name, std::size_t vertexCount) {
-  const py::array a = asArray(value, name, "a sequence of vertex indices");
+namespace {
+
+// Indices of `element`s ("vertex", "face") in [0, count).
+std::vector<int> elementIndices(py::handle value, const std::string& name, std::size_t count,
+                                const std::string& element, const std::string& plural) {
+  const std::string what = "a sequence of " + element + " indices";
+  const py::array a = asArray(value, name, what.c_str());
   const char kind = a.dtype().kind();
   // An empty list comes out of NumPy as float64: it is still an empty list of indices.
   if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u'))
-    throw InvalidInputError(name + " must be a 1-D sequence of integer vertex indices (got shape " +
-                            shapeText(a) + ", dtype " + dtypeText(a) + ")");
+    throw InvalidInputError(name + " must be a 1-D sequence of integer " + element +
+                            " indices (got shape " + shapeText(a) + ", dtype " + dtypeText(a) +
+                            ")");
   using Indices = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
   const Indices indices = Indices::ensure(a);
   std::vector<int> out;
   out.reserve(std::size_t(a.size()));
   for (py::ssize_t i = 0; i < a.size(); ++i) {
     const std::int64_t v = indices.data()[i];
-    if (v < 0 || std::uint64_t(v) >= vertexCount)
-      throw InvalidInputError(name + "[" + std::to_string(i) + "] is vertex " + std::to_string(v) +
-                              ", but the mesh has " + std::to_string(vertexCount) +
-                              " vertices (indices 0 to " + std::to_string(vertexCount - 1) + ")");
+    if (v < 0 || std::uint64_t(v) >= count)
+      throw InvalidInputError(name + "[" + std::to_string(i) + "] is " + element + " " +
+                              std::to_string(v) + ", but the mesh has " + std::to_string(count) +
+                              " " + plural + " (indices 0 to " + std::to_string(count - 1) + ")");
     out.push_back(int(v));
   }
   return out;
 }
 
-std::vector<bool> vertexMask(py::handle value, const std::string& name, std::size_t vertexCount) {
-  const py::array a = asArray(value, name, "a boolean mask or vertex indices");
+std::vector<bool> elementMask(py::handle value, const std::string& name, std::size_t count,
+                              const std::string& element, const std::string& plural) {
+  const std::string what = "a boolean mask or " + element + " indices";
+  const py::array a = asArray(value, name, what.c_str());
   if (a.dtype().kind() != 'b') {
-    std::vector<bool> mask(vertexCount, false);
-    for (int v : vertexIndices(a, name, vertexCount)) mask[std::size_t(v)] = true;
+    std::vector<bool> mask(count, false);
+    for (int v : elementIndices(a, name, count, element, plural)) mask[std::size_t(v)] = true;
     return mask;
   }
-  if (a.ndim() != 1 || std::size_t(a.size()) != vertexCount)
+  if (a.ndim() != 1 || std::size_t(a.size()) != count)
     throw InvalidInputError(name + " is a boolean mask of shape " + shapeText(a) +
-                            ": it needs one flag per vertex (" + std::to_string(vertexCount) +
+                            ": it needs one flag per " + element + " (" + std::to_string(count) +
                             ",)");
   using Flags = py::array_t<bool, py::array::c_style | py::array::forcecast>;
   const Flags flags = Flags::ensure(a);
   return std::vector<bool>(flags.data(), flags.data() + flags.size());
+}
+
+}  // namespace
+
+std::vector<int> vertexIndices(py::handle value, const std::string& name, std::size_t vertexCount) {
+  return elementIndices(value, name, vertexCount, "vertex", "vertices");
+}
+
+std::vector<bool> vertexMask(py::handle value, const std::string& name, std::size_t vertexCount) {
+  return elementMask(value, name, vertexCount, "vertex", "vertices");
+}
+
+std::vector<bool> faceMask(py::handle value, const std::string& name, std::size_t faceCount) {
+  return elementMask(value, name, faceCount, "face", "faces");
 }
 
 py::dict dictOf(const JsonObject& report) {

@@ -65,6 +65,8 @@ std::vector<int> vertexIndices(py::handle value, const std::string& name, std::s
 // One flag per vertex (a boolean array of length vertexCount), or vertex
 // indices, as a mask.
 std::vector<bool> vertexMask(py::handle value, const std::string& name, std::size_t vertexCount);
+// The same per face.
+std::vector<bool> faceMask(py::handle value, const std::string& name, std::size_t faceCount);
 
 // A report (the JsonObject the plugins write to report_file) as a dict.
 py::dict dictOf(const JsonObject& report);

@@ -5,6 +5,7 @@
 
 #include "common/inspect.h"
 #include "common/intersections.h"
+#include "common/patch_ops.h"
 #include "common/patches.h"
 #include "common/split.h"
 #include "python/src/bindings.h"
@@ -25,6 +26,7 @@ double msSince(Clock::time_point start) {
 // core FaceLabels once the mesh is known.
 struct LabelArguments {
   py::object part = py::none(), curve_edges = py::none(), colour = py::none();
+  const char* part_name = "part";  // the option's name (addLabelOptions)
 };
 
 // Per-face integers (length = faces), e.g. part numbers or patch ids, >= 0.
@@ -50,7 +52,7 @@ std::vector<int> perFace(py::handle value, const std::string& name, std::size_t 
 FaceLabels labelsOf(const Mesh& mesh, const LabelArguments& given) {
   FaceLabels labels;
   const std::size_t faces = mesh.face.size();
-  if (!given.part.is_none()) labels.part = perFace(given.part, "part", faces);
+  if (!given.part.is_none()) labels.part = perFace(given.part, given.part_name, faces);
   if (!given.curve_edges.is_none()) {
     const py::array a = py::module_::import("numpy").attr("asarray")(given.curve_edges);
     const char kind = a.dtype().kind();
@@ -97,12 +99,16 @@ FaceLabels labelsOf(const Mesh& mesh, const LabelArguments& given) {
   return labels;
 }
 
+// The options that label the faces. The per-face parts are `partName`:
+// "part" where that name is free, another where the function's own `part`
+// is the filter's (Select Patches: the part a patch is inside).
 template <class Call>
-void addLabelOptions(OptionTable<Call>& t) {
+void addLabelOptions(OptionTable<Call>& t, const char* partName = "part") {
   t.addCustom(
-      "part", py::none(),
-      [](Call& c, py::handle v, const Bounds&) {
+      partName, py::none(),
+      [partName](Call& c, py::handle v, const Bounds&) {
         c.labels.part = py::reinterpret_borrow<py::object>(v);
+        c.labels.part_name = partName;
       },
       "per face, the input mesh it came from (merged_part of intersect_and_split); None = one "
       "part");
@@ -185,6 +191,8 @@ struct RemoveCall {
   py::object remove = py::none();
   py::object keep = py::none();
   bool verify = true;
+  bool removed_mesh = false;
+  bool round_to_float = false;
 };
 
 OptionTable<RemoveCall> removeTable() {
@@ -212,8 +220,14 @@ OptionTable<RemoveCall> removeTable() {
       "'difference' (part 0 minus the others)");
   t.add(
       "verify", [](RemoveCall& c) -> bool& { return c.verify; },
-      "check the result: intersecting pairs (exact), non-manifold and border edges, closedness, "
-      "volume");
+      "check the result: intersecting pairs (exact, the rule of meshcheck), non-manifold and "
+      "border edges, closedness, volume");
+  t.add(
+      "removed_mesh", [](RemoveCall& c) -> bool& { return c.removed_mesh; },
+      "also return the removed patches (removed)");
+  t.add(
+      "round_to_float", [](RemoveCall& c) -> bool& { return c.round_to_float; },
+      "the check counts on the coordinates rounded to float (as a float host stores them)");
   return t;
 }
 
@@ -228,6 +242,20 @@ BooleanOperation operationNamed(py::handle keep) {
                           py::repr(keep).cast<std::string>() + ")");
 }
 
+// patch_of_face as given (empty for None), read while the GIL is held.
+std::vector<int> patchIdsGiven(const Mesh& mesh, const py::object& patchOfFace) {
+  if (patchOfFace.is_none()) return {};
+  return perFace(patchOfFace, "patch_of_face", mesh.face.size());
+}
+
+// The patches of `mesh` with the ids given (patchIdsGiven), or painted with
+// the defaults where none were given. Touches no Python object: it runs
+// with the GIL released (CoreCall).
+Patches patchesGiven(const Mesh& mesh, const FaceLabels& labels, const std::vector<int>& ids) {
+  if (ids.empty()) return paintPatches(mesh, labels);
+  return patchesFromIds(mesh, labels, ids);
+}
+
 py::dict removeArrays(py::handle vertices, py::handle faces, py::kwargs kwargs) {
   CoreCall call(takeProgress(kwargs));
   Mesh mesh;
@@ -239,74 +267,111 @@ py::dict removeArrays(py::handle vertices, py::handle faces, py::kwargs kwargs) 
         "give either remove (patch ids to remove) or keep ('union', 'intersection' or "
         "'difference')");
   const FaceLabels labels = labelsOf(mesh, c.labels);
-  const std::vector<int> ids = c.patch_of_face.is_none()
-                                   ? std::vector<int>()
-                                   : perFace(c.patch_of_face, "patch_of_face", mesh.face.size());
-  const auto start = Clock::now();
-  Patches p = call(
-      [&] { return ids.empty() ? paintPatches(mesh, labels) : patchesFromIds(mesh, labels, ids); });
-  PatchChoice choice;
-  std::string keepName = "unselected";
+  RemovePatchesOptions options;
+  options.verify = c.verify;
+  options.removed_mesh = c.removed_mesh;
+  options.scalar = c.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+  options.progress = call.progress();
   if (!c.remove.is_none()) {
+    options.keep.reset();
     const py::array a = py::module_::import("numpy").attr("asarray")(c.remove);
     const char kind = a.dtype().kind();
     if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u'))
       throw InvalidInputError("remove must be a sequence of patch ids");
+    if (a.size() == 0) throw InvalidInputError("remove is empty: name the patches to remove");
     using Ints = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
     const Ints given = Ints::ensure(a);
-    if (a.size() == 0) throw InvalidInputError("remove is empty: name the patches to remove");
-    choice.keep.assign(p.patches.size(), 1);
     for (py::ssize_t i = 0; i < a.size(); ++i) {
       const std::int64_t id = given.data()[i];
-      if (id < 0 || std::uint64_t(id) >= p.patches.size())
-        throw InvalidInputError("patch id " + std::to_string(id) +
-                                " does not exist: the ids run "
-                                "from 0 to " +
-                                std::to_string(p.patches.size() - 1));
-      choice.keep[std::size_t(id)] = 0;
+      options.remove.push_back(id < 0 || id > INT_MAX ? -1 : int(id));
     }
   } else {
-    const BooleanOperation op = operationNamed(c.keep);
-    if (op != BooleanOperation::kUnion && p.parts < 2)
-      throw InvalidInputError(
-          "intersection and difference need two parts: pass part (merged_part of "
-          "intersect_and_split)");
-    call([&] { classifyPatches(mesh, labels, p); });
-    choice = choosePatches(p, op);
-    keepName = toString(op);
+    options.keep = operationNamed(c.keep);
   }
-  std::size_t kept = 0;
-  for (char k : choice.keep) kept += k != 0;
-  if (kept == 0)
-    throw InvalidInputError(
-        "nothing would be left: every patch would be removed. The result is empty when the "
-        "parts' interiors do not overlap (an intersection), or the first part lies inside the "
-        "others (a difference); if the meshes cross, intersect_and_split them first");
-  const Mesh result = call([&] { return extractPatches(mesh, p, choice.keep, choice.flip); });
+  const std::vector<int> ids = patchIdsGiven(mesh, c.patch_of_face);
+  const RemovePatchesResult r =
+      call([&] { return removePatches(mesh, labels, patchesGiven(mesh, labels, ids), options); });
+  py::dict out;
+  out["mesh"] = meshTuple(r.mesh);
+  out["face_origin"] = faceOriginsOf(const_cast<Mesh&>(r.mesh));
+  out["removed"] = c.removed_mesh ? py::object(meshTuple(r.removed)) : py::none();
+  JsonObject report = toJson(r);
+  py::dict d = dictOf(report);
+  if (!r.notes.empty()) d["notes"] = py::cast(r.notes);
+  out["report"] = d;
+  return out;
+}
 
+// ---------------------------------------------------------------- select
+
+struct SelectCall {
+  SelectPatchesOptions select;
+  LabelArguments labels;
+  py::object patch_of_face = py::none();
+  py::object selected_faces = py::none();
+};
+
+OptionTable<SelectCall> selectTable() {
+  OptionTable<SelectCall> t;
+  addLabelOptions(t, "face_part");
+  t.addCustom(
+      "patch_of_face", py::none(),
+      [](SelectCall& c, py::handle v, const Bounds&) {
+        c.patch_of_face = py::reinterpret_borrow<py::object>(v);
+      },
+      "the patches as painted (paint_patches' patch_of_face); None = painted now with the "
+      "defaults");
+  t.addCustom(
+      "selected_faces", py::none(),
+      [](SelectCall& c, py::handle v, const Bounds&) {
+        c.selected_faces = py::reinterpret_borrow<py::object>(v);
+      },
+      "per face, selected or not (a boolean mask or face indices), for by=1");
+  return t;
+}
+
+py::dict selectArrays(py::handle vertices, py::handle faces, int by, const std::string& ids,
+                      int part, py::kwargs kwargs) {
+  CoreCall call(takeProgress(kwargs));
+  Mesh mesh;
+  readArrays(mesh, vertices, faces, kOneMesh);
+  SelectCall c =
+      selectTable().parse("select_patches", kwargs, {mesh.vert.size(), mesh.face.size()});
+  if (by < 0 || by > int(PatchSelection::kUnionInterior))
+    throw InvalidInputError(
+        "by must be 0 (ids), 1 (touching the selected faces), 2 (outside all "
+        "other parts), 3 (inside all other parts), 4 (inside one part) or 5 "
+        "(inside the union)");
+  c.select.by = PatchSelection(by);
+  c.select.ids = ids;
+  c.select.part = part;
+  if (!c.selected_faces.is_none()) {
+    const std::vector<bool> mask = faceMask(c.selected_faces, "selected_faces", mesh.face.size());
+    c.select.selected_faces.assign(mask.begin(), mask.end());
+  }
+  const FaceLabels labels = labelsOf(mesh, c.labels);
+  const auto start = Clock::now();
+  const std::vector<int> patchIds = patchIdsGiven(mesh, c.patch_of_face);
+  Patches p = call([&] { return patchesGiven(mesh, labels, patchIds); });
+  const SelectPatchesResult r = call([&] { return selectPatches(mesh, labels, p, c.select); });
+  std::vector<std::uint8_t> selected(mesh.face.size(), 0);
+  std::vector<double> chosenIds;
+  for (std::size_t f = 0; f < selected.size(); ++f) selected[f] = r.chosen[p.patch_of_face[f]];
+  for (std::size_t id = 0; id < r.chosen.size(); ++id)
+    if (r.chosen[id]) chosenIds.push_back(double(id));
   JsonObject report;
   report.set("patches", p.patches.size())
-      .set("patches_removed", p.patches.size() - kept)
-      .set("faces_out", std::size_t(result.fn))
-      .set("keep", keepName);
-  if (c.verify) {
-    const InspectResult check = call([&] { return inspect(result); });
-    const std::size_t remaining = call([&] {
-      FindIntersectionsOptions o;
-      o.cross = false;
-      return findIntersections({&result}, o).pairs.size();
-    });
-    report.set("non_manifold_edges", check.non_manifold_edges)
-        .set("border_edges", check.border_edges)
-        .set("is_closed", check.is_closed)
-        .set("volume", check.volume)
-        .set("remaining_intersecting_pairs", remaining);
-  }
-  report.set("time_ms", msSince(start));
+      .set("patches_selected", r.patches_selected)
+      .set("faces_selected", r.faces_selected)
+      .set("selected_ids", chosenIds)
+      .set("time_ms", msSince(start));
   py::dict out;
-  out["mesh"] = meshTuple(result);
-  out["face_origin"] = faceOriginsOf(const_cast<Mesh&>(result));
-  out["report"] = dictOf(report);
+  out["selected_faces"] =
+      py::array_t<bool>(py::ssize_t(selected.size()), reinterpret_cast<bool*>(selected.data()));
+  out["patch_of_face"] = intArray(p.patch_of_face);
+  py::dict d = dictOf(report);
+  if (!r.notes.empty()) d["notes"] = py::cast(r.notes);
+  out["report"] = d;
   return out;
 }
 
@@ -320,6 +385,10 @@ void bindPatches(py::module_& m) {
   m.def("remove_patches", &removeArrays, py::arg("vertices"), py::arg("faces"),
         "Removes patches by id, or keeps a boolean result; welds what is left.");
   registerOptions(m, "remove_patches", removeTable().describe());
+  m.def("select_patches", &selectArrays, py::arg("vertices"), py::arg("faces"), py::arg("by"),
+        py::arg("ids"), py::arg("part"),
+        "Chooses patches: by ids, touching selected faces, or by classification.");
+  registerOptions(m, "select_patches", selectTable().describe());
 }
 
 }  // namespace meshmend::python

@@ -728,6 +728,53 @@ def test_paint_classify_and_keep_booleans(two_spheres, tmp_path):
     with pytest.raises(mm.InvalidInputError, match="nothing would be left"):
         mm.remove_patches(MV, MF, remove=list(range(4)), **kw)
 
+    # The removed patches come back too when asked: with the kept ones they
+    # hold every face of the merged mesh once.
+    both = mm.remove_patches(MV, MF, remove=inside, patch_of_face=painted.patch_of_face,
+                             removed_mesh=True, **kw)
+    assert both.removed is not None and by_id.removed is None
+    assert len(both.faces) + len(both.removed[1]) == len(MF)
+    assert np.isin(np.arange(len(MF)), both.face_origin).sum() == len(both.faces)
+
+
+def test_select_patches_as_the_filter_chooses(two_spheres):
+    (V1, F1), (V2, F2) = two_spheres
+    split = mm.intersect_and_split(V1, F1, V2, F2)
+    MV, MF = split.merged
+    painted = mm.paint_patches(MV, MF, part=split.merged_part, curve_edges=split.merged_curve_edges)
+    # The filter's `part` (by=4) is the part a patch lies inside: the
+    # per-face parts are face_part here.
+    kw = dict(face_part=split.merged_part, curve_edges=split.merged_curve_edges)
+    patch_list = painted.report["patch_list"]
+    inner = sorted(p["id"] for p in patch_list if "outer" not in p["status"])
+    assert len(inner) == 2
+    # 5: not on the outer surface of the union = the two patches inside the other sphere.
+    union_interior = mm.select_patches(MV, MF, by=5, **kw)
+    assert union_interior.report["selected_ids"] == inner
+    chosen = union_interior.selected_faces
+    assert chosen.dtype == bool and len(chosen) == len(MF)
+    assert chosen.sum() == union_interior.report["faces_selected"]
+    assert set(union_interior.patch_of_face[chosen]) == set(inner)
+    # 3: inside every other part is the same here (two parts); 2: the rest.
+    assert mm.select_patches(MV, MF, by=3, **kw).report["selected_ids"] == inner
+    outside = mm.select_patches(MV, MF, by=2, **kw)
+    assert sorted(outside.report["selected_ids"]) == sorted(
+        p["id"] for p in patch_list if p["id"] not in inner)
+    # 0: by ids; 1: the patches of the selected faces (a mask or face indices).
+    assert mm.select_patches(MV, MF, by=0, ids=f"{inner[0]}", **kw).report["selected_ids"] == [inner[0]]
+    face = int(np.flatnonzero(painted.patch_of_face == inner[1])[0])
+    touched = mm.select_patches(MV, MF, by=1, selected_faces=[face],
+                                patch_of_face=painted.patch_of_face, **kw)
+    assert touched.report["selected_ids"] == [inner[1]]
+    with pytest.raises(mm.InvalidInputError, match="no face is selected"):
+        mm.select_patches(MV, MF, by=1, **kw)
+    assert mm.select_patches(MV, MF, by=4, part=1, **kw).report["selected_ids"] == sorted(
+        p["id"] for p in patch_list if p["id"] in inner and p["part"] == 0)
+    with pytest.raises(mm.InvalidInputError, match="there is no part 7"):
+        mm.select_patches(MV, MF, by=4, part=7, **kw)
+    with pytest.raises(mm.InvalidInputError, match="is face 999999"):
+        mm.select_patches(MV, MF, by=1, selected_faces=[999999], **kw)
+
 
 # ---------------------------------------------------------------- files and other libraries
 
