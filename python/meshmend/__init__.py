@@ -410,13 +410,16 @@ def select_patches(vertices, faces, by=1, ids="", part=1, **options) -> SelectPa
     return SelectPatchesResult(out["selected_faces"], out["patch_of_face"], out["report"])
 
 
-@_with_options("intersect_and_split", exclude=("separate_meshes",))
+@_with_options("intersect_and_split", exclude=("separate_meshes", "overlaps_once"))
 def boolean(vertices1, faces1, vertices2, faces2, operation="union", **options) -> PatchesResult:
     """The union, intersection or difference (first minus second) of two
     closed meshes: intersect_and_split (merged; its options), then
     remove_patches(keep=operation). report['split'] holds the split's report.
     Meshes that intersect themselves need self=True (scans: also
     weld_duplicates=True, remove_duplicate_faces=True)."""
+    for name in ("separate_meshes", "overlaps_once"):
+        if name in options:  # the classification needs both sides of a planar overlap
+            raise TypeError(f"boolean() sets {name} itself")
     split = intersect_and_split(vertices1, faces1, vertices2, faces2,
                                 **dict(options, separate_meshes=False))
     merged_vertices, merged_faces = split.merged

@@ -125,6 +125,11 @@ OptionTable<SplitCall> splitTable() {
       "remove_duplicate_faces", [](SplitCall& c) -> bool& { return c.core.remove_duplicate_faces; },
       "first remove faces with the same three vertices as another face of their mesh");
   t.add(
+      "overlaps_once", [](SplitCall& c) -> bool& { return c.core.overlaps_once; },
+      "where meshes (or a mesh and itself) overlap in a plane, keep each coinciding face once "
+      "in the merged output, so that it is free of duplicate faces (a repaired result); off, it "
+      "keeps both, so that each input stays a whole surface there, as boolean() needs");
+  t.add(
       "separate_meshes", [](SplitCall& c) -> bool& { return c.core.separate_meshes; },
       "also return each mesh with the curves inserted (else the merged mesh only)");
   t.add(
