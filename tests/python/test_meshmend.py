@@ -28,6 +28,7 @@ sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared wit
 import meshmend as mm  # noqa: E402
 from environment import MESHCHECK, Host, need, require_meshcheck  # noqa: E402
 from shapes import tube  # noqa: E402
+import cad_cases  # noqa: E402
 
 
 def test_the_module_under_test_is_the_build_s():
@@ -774,6 +775,75 @@ def test_select_patches_as_the_filter_chooses(two_spheres):
         mm.select_patches(MV, MF, by=4, part=7, **kw)
     with pytest.raises(mm.InvalidInputError, match="is face 999999"):
         mm.select_patches(MV, MF, by=1, selected_faces=[999999], **kw)
+
+
+# ---------------------------------------------------------------- CAD-like cases (tests/cad_cases.py)
+
+
+def stored_check(tmp_path, name, V, F, in_float):
+    """meshcheck on the arrays as written; in float, the values must be
+    float values already (what a float host or file stores)."""
+    if in_float:
+        assert np.array_equal(V.astype(np.float32).astype(np.float64), V), name
+    return meshcheck(write_off(tmp_path / f"{name}.off", V, F))
+
+
+@pytest.mark.parametrize("in_float", [False, True], ids=["double", "float"])
+@pytest.mark.parametrize("case", sorted(cad_cases.CASES))
+def test_cad_case_is_exact_once_stored(tmp_path, case, in_float):
+    """Intersect and split of CAD-like parts (offsets of 1e-12 relative,
+    coincident and shared faces, faces at 1e-10 degrees, coordinates up to
+    1e30 and near FLT_MAX) with the options of the filter's merged output
+    that repairs (overlaps_once): the stored result has 0 intersecting
+    pairs and 0 degenerate faces by meshcheck, and the report's
+    remaining_intersecting_pairs is meshcheck's count; or, in float, a
+    refusal (all_or_nothing) saying what would be left."""
+    parts = cad_cases.CASES[case]()
+    try:
+        out = mm.intersect_and_split_meshes(parts, separate_meshes=False, overlaps_once=True,
+                                            round_to_float=in_float)
+    except mm.InvalidInputError as e:
+        # A refusal is the contract only where float cannot hold the result.
+        assert in_float and "all_or_nothing" in str(e) and "float" in str(e), str(e)
+        return
+    V, F = out.merged
+    r = out.report
+    check = stored_check(tmp_path, case, V, F, in_float)
+    assert r["remaining_intersecting_pairs"] == check["self_intersecting_pairs"] == 0, r
+    assert r["degenerate_new_faces"] == 0 and check["degenerate_faces"] == 0, r
+    # Welded along the curves, the merged output is non-manifold there and
+    # nowhere else: every non-manifold edge is a curve edge.
+    assert check["non_manifold_edges"] <= len(out.merged_curve_edges), check
+
+
+def chain(first, others, operation, in_float, tmp_path):
+    """`first` combined with each of `others` in turn by `operation`, every
+    intermediate result checked by meshcheck as stored."""
+    current = first
+    for step, other in enumerate(others):
+        result = mm.boolean(*current, *other, operation, round_to_float=in_float)
+        current = (result.vertices, result.faces)
+        check = stored_check(tmp_path, f"{operation}{step}", *current, in_float)
+        assert check["is_closed"] and check["non_manifold_edges"] == 0, (step, check)
+        assert check["self_intersecting_pairs"] == 0 == result.report["remaining_intersecting_pairs"], step
+        assert check["degenerate_faces"] == 0, (step, check)
+    return current
+
+
+@pytest.mark.parametrize("in_float", [False, True], ids=["double", "float"])
+def test_ten_chained_unions_and_differences_stay_valid_inputs(tmp_path, in_float):
+    """Closure under repetition: ten unions of a tile with copies moved by
+    a fraction of its size, and ten holes drilled one after another; each
+    result is the next operation's input."""
+    tile, copies = cad_cases.union_tiles(10)
+    V, F = chain(tile, copies, "union", in_float, tmp_path)
+    assert volume(V, F) > volume(*tile)
+    plate, drills = cad_cases.drill_holes(10)
+    V, F = chain(plate, drills, "difference", in_float, tmp_path)
+    assert volume(V, F) < volume(*plate)
+    drilled = meshcheck(write_off(tmp_path / "drilled.off", V, F))
+    euler = drilled["vertices"] - drilled["edges"] + drilled["faces"]
+    assert drilled["connected_components"] == 1 and euler == 2 - 2 * 10  # ten through holes
 
 
 # ---------------------------------------------------------------- files and other libraries
