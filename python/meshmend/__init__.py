@@ -3,9 +3,12 @@
 Every function takes a mesh as ``vertices`` (an ``(n, 3)`` array of real
 coordinates) and ``faces`` (an ``(m, 3)`` array of integer vertex indices),
 and returns new arrays plus ``report``: a dict with the keys the MeshLab
-filters write to their ``report_file``. Options are keyword arguments named
-as the fields of the core's ``XxxOptions`` structs, with the same defaults
-(``help(meshmend.fill_holes)`` lists them). The inputs are never modified.
+filters write to their ``report_file``. Options are keyword arguments: every
+parameter of the matching MeshLab filter under its name and with its default
+(apart from those naming layers or the selection of a MeshLab document,
+which are array arguments here), ``report_file``, and the further options of
+the core's ``XxxOptions`` structs (``help(meshmend.fill_holes)`` lists them).
+The inputs are never modified.
 
 Bad input raises ``InvalidInputError`` (a ``ValueError``) or
 ``TopologyError`` (also a ``ValueError``) with a message saying what to fix;
@@ -18,7 +21,9 @@ Output arrays: vertices float64 ``(n, 3)``, faces and indices int32.
 
 import importlib.machinery
 import importlib.util
+import functools
 import inspect as _inspect
+import json
 import os
 import sys
 from typing import Any, Dict, List, NamedTuple, Optional, Tuple
@@ -174,26 +179,186 @@ class SelectPatchesResult(NamedTuple):
 # ---------------------------------------------------------------- signatures
 
 
+# ---------------------------------------------------------------- the filters' parameters
+#
+# Every parameter of a MeshMend filter is an option of the matching function
+# here, under the same name and with the same default (tests/python/
+# test_parity.py compares them with what the plugins declare), apart from
+# those that name things of a MeshLab document (layers, the selection).
+# Where the core's option has another name, the filter's name is taken too;
+# an enum parameter takes the filter's index (a script's value) as well as
+# the name; a distance takes mesh units or a percentage of the bounding box
+# diagonal ("1%"), as the filter's does.
+
+# Per function, per enum option: the choices' names in the filter's order.
+FILTER_CHOICES: Dict[str, Dict[str, Tuple[str, ...]]] = {
+    "fill_holes": {"fairing": ("laplacian_regression", "biharmonic", "harmonic", "flat")},
+    "measure_clearance": {"scope": ("within_layers", "between_layers", "both")},
+    "enforce_clearance": {"scope": ("within_layers", "between_layers", "both")},
+    "remove_patches": {"keep": ("unselected", "union", "intersection", "difference")},
+}
+
+
+class _Alias(NamedTuple):
+    """A filter parameter the core's option `core` takes, with the
+    filter's default."""
+    core: str
+    default: Any
+    doc: str
+
+
+_ALIASES: Dict[str, Dict[str, _Alias]] = {
+    "intersect_and_split": {
+        "split_self_intersections": _Alias("self", False, "the filter's name of self"),
+        "weld_duplicate_vertices": _Alias(
+            "weld_duplicates", False, "the filter's name of weld_duplicates"),
+    },
+    "remove_self_intersections": {
+        "removed_to_layer": _Alias("keep_removed", False, "the filter's name of keep_removed"),
+    },
+    "remove_patches": {
+        "removed_to_layer": _Alias("removed_mesh", False, "the filter's name of removed_mesh"),
+    },
+    "paint_patches": {
+        "crease_angle": _Alias("crease_angle_deg", 0.0, "the filter's name of crease_angle_deg"),
+    },
+}
+
+# The filter's defaults where the core's option has another: the module's
+# defaults give what the filter's give.
+_DEFAULTS: Dict[str, Dict[str, Any]] = {
+    "inspect": {"self_intersections": True},
+    "intersect_and_split": {"remove_duplicate_faces": True},
+    "fill_holes": {"max_diameter": 0.5},
+    "measure_clearance": {"tau": "1%", "scope": "within_layers"},
+    "enforce_clearance": {"tau": "1%", "scope": "within_layers", "max_displacement": "0%"},
+    "remove_patches": {"keep": "union"},
+}
+
+# Options that are distances: mesh units, or a percentage of the diagonal
+# of the bounding box of all the meshes given.
+_DISTANCES: Dict[str, Tuple[str, ...]] = {
+    "measure_clearance": ("tau",),
+    "enforce_clearance": ("tau", "max_displacement"),
+}
+
+
+_VERTEX_ARGUMENTS = ("vertices", "vertices1", "vertices2")
+
+
+def _diagonal(arguments) -> float:
+    """The diagonal of the bounding box of the vertex arrays given (1 where
+    there are none, as the filter's for an empty document)."""
+    lo = hi = None
+    for value in arguments:
+        a = np.asarray(value, dtype=float) if value is not None else None
+        if a is None or a.ndim != 2 or a.shape[1:] != (3,) or not len(a):
+            continue
+        lo = a.min(axis=0) if lo is None else np.minimum(lo, a.min(axis=0))
+        hi = a.max(axis=0) if hi is None else np.maximum(hi, a.max(axis=0))
+    return 1.0 if lo is None else float(np.linalg.norm(hi - lo))
+
+
+def _distance(name: str, value, arguments):
+    if not isinstance(value, str):
+        return value
+    text = value.strip()
+    try:
+        if not text.endswith("%"):
+            raise ValueError
+        percent = float(text[:-1])
+    except ValueError:
+        raise InvalidInputError(
+            f"{name} must be a distance in mesh units or a percentage of the bounding box "
+            f"diagonal such as '1%' (got {value!r})") from None
+    return percent / 100 * _diagonal(arguments)
+
+
+def _translate(core_name: str, function_name: str, arguments, options: Dict[str, Any]) -> None:
+    """The filter-named options turned into the core's, in place."""
+    for name, alias in _ALIASES.get(core_name, {}).items():
+        if name in options:
+            if alias.core in options:
+                raise TypeError(f"{function_name}() got both {name} and {alias.core} (the same "
+                                f"option)")
+            options[alias.core] = options.pop(name)
+    for name, value in _DEFAULTS.get(core_name, {}).items():
+        if not (core_name == "remove_patches" and name == "keep" and "remove" in options):
+            options.setdefault(name, value)  # (patch ids to remove leave keep unset)
+    for name, choices in FILTER_CHOICES.get(core_name, {}).items():
+        value = options.get(name)
+        if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+            if not 0 <= value < len(choices):
+                raise InvalidInputError(
+                    f"{name} must be one of {', '.join(map(repr, choices))} or their index 0 to "
+                    f"{len(choices) - 1} (got {value})")
+            options[name] = choices[value]
+    for name in _DISTANCES.get(core_name, ()):
+        if name in options:
+            options[name] = _distance(name, options[name], arguments)
+
+
+def _write_report(path, result) -> None:
+    report = result if isinstance(result, dict) else getattr(result, "report", None)
+    with open(path, "w") as f:
+        json.dump(report, f, indent=1, default=_json_value)
+        f.write("\n")
+
+
+def _json_value(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
 def _with_options(core_name: str, exclude: Tuple[str, ...] = ()):
     """Gives a function the keyword options of the core function `core_name`
-    (names, defaults and descriptions from _core.OPTIONS) in its signature
-    and docstring."""
+    (names, defaults and descriptions from _core.OPTIONS, with the filter's
+    names and defaults where they differ), report_file and progress, in its
+    signature and docstring; the call translates the filter's names and
+    values to the core's and writes the report where report_file says."""
 
     def decorate(function):
         signature = _inspect.signature(function)
         fixed = [p for p in signature.parameters.values() if p.kind != p.VAR_KEYWORD]
-        options = [o for o in _core.OPTIONS[core_name] if o[0] not in exclude]
+        taken = {p.name for p in fixed}
+        defaults = _DEFAULTS.get(core_name, {})
+        options = [(name, defaults.get(name, default), doc)
+                   for name, default, doc in _core.OPTIONS[core_name]
+                   if name not in exclude and name not in taken]
+        options += [(name, alias.default, alias.doc)
+                    for name, alias in _ALIASES.get(core_name, {}).items()
+                    if alias.core not in exclude]
+        options.append(("report_file", "", "when not empty, the report is also written to this "
+                                           "path as one JSON object (as the filter's)"))
         parameters = fixed + [
             _inspect.Parameter(name, _inspect.Parameter.KEYWORD_ONLY, default=default)
             for name, default, _ in options
         ]
         parameters.append(
             _inspect.Parameter("progress", _inspect.Parameter.KEYWORD_ONLY, default=None))
-        function.__signature__ = signature.replace(parameters=parameters)
+
+        @functools.wraps(function)
+        def call(*args, **kwargs):
+            report_file = kwargs.pop("report_file", "")
+            for name in exclude:
+                if name in kwargs:
+                    raise TypeError(f"{function.__name__}() sets {name} itself")
+            given = signature.bind_partial(*args, **kwargs).arguments
+            vertices = [given[n] for n in _VERTEX_ARGUMENTS if n in given]
+            _translate(core_name, function.__name__, vertices, kwargs)
+            result = function(*args, **kwargs)
+            if report_file:
+                _write_report(report_file, result)
+            return result
+
+        call.__signature__ = signature.replace(parameters=parameters)
         lines = [f"    {name} = {default!r}: {doc}" for name, default, doc in options]
         lines.append("    progress = None: callable(percent, stage); returning False stops")
-        function.__doc__ = (function.__doc__ or "").rstrip() + "\n\n    Options:\n" + "\n".join(lines)
-        return function
+        call.__doc__ = (function.__doc__ or "").rstrip() + "\n\n    Options:\n" + "\n".join(lines)
+        return call
 
     return decorate
 
@@ -393,7 +558,10 @@ def paint_patches(vertices, faces, **options) -> PaintResult:
 @_with_options("remove_patches")
 def remove_patches(vertices, faces, **options) -> PatchesResult:
     """Removes the patches `remove` (ids), or keeps a boolean result
-    (keep='union', 'intersection' or 'difference'), and welds what is left."""
+    (keep='union', the default, 'intersection' or 'difference'), and welds
+    what is left. removed_mesh=True also returns the removed patches."""
+    if options.get("keep") == "unselected":  # the filter's first choice: the ids in remove
+        options["keep"] = None
     out = _core.remove_patches(vertices, faces, **options)
     removed = out["removed"]
     return PatchesResult(*out["mesh"], out["face_origin"], out["report"],

@@ -639,13 +639,13 @@ def test_measure_clearance_between_nested_spheres(nested_spheres):
 def test_enforce_clearance_reaches_tau(nested_spheres, tmp_path):
     (V1, F1), (V2, F2) = nested_spheres
     tau = 0.1
-    out = mm.enforce_clearance(V1, F1, V2, F2, tau=tau)
+    out = mm.enforce_clearance(V1, F1, V2, F2, tau=tau, scope="both")
     r = out.report
     assert r["reached"] and r["stop_reason"] == "reached" and r["violating_pairs_after"] == 0
     assert r["min_distance_after"] >= tau and r["min_distance_before"] < tau
     (W1, G1), (W2, G2) = out.meshes
     assert np.array_equal(G1, F1) and np.array_equal(G2, F2)  # faces never change
-    again = mm.measure_clearance(W1, G1, W2, G2, tau=tau).report
+    again = mm.measure_clearance(W1, G1, W2, G2, tau=tau, scope="both").report
     assert again["min_distance"] >= tau and again["violating_pairs"] == 0
     moved = max(np.linalg.norm(W1 - V1, axis=1).max(), np.linalg.norm(W2 - V2, axis=1).max())
     assert moved == pytest.approx(r["max_displacement"])
@@ -657,11 +657,11 @@ def test_enforce_clearance_reaches_tau(nested_spheres, tmp_path):
 
 def test_enforce_clearance_with_locked_vertices_and_a_cap(nested_spheres):
     (V1, F1), (V2, F2) = nested_spheres
-    locked = mm.enforce_clearance(V1, F1, V2, F2, tau=0.1, locked=[np.ones(len(V1), bool), None])
+    locked = mm.enforce_clearance(V1, F1, V2, F2, tau=0.1, scope="both", locked=[np.ones(len(V1), bool), None])
     assert locked.report["reached"] and locked.report["locked_vertices"] == len(V1)
     assert np.array_equal(locked.meshes[0][0], V1)  # bit for bit
     cap = 1e-3
-    capped = mm.enforce_clearance(V1, F1, V2, F2, tau=0.1, max_displacement=cap)
+    capped = mm.enforce_clearance(V1, F1, V2, F2, tau=0.1, scope="both", max_displacement=cap)
     assert not capped.report["reached"] and capped.report["stop_reason"] in ("stalled", "locked")
     for (W, _), V in zip(capped.meshes, (V1, V2)):
         assert np.linalg.norm(W - V, axis=1).max() <= cap * (1 + 1e-9)
@@ -671,7 +671,7 @@ def test_enforce_clearance_with_locked_vertices_and_a_cap(nested_spheres):
 def test_enforce_clearance_refuses_intersecting_meshes_and_tau_0(two_spheres, nested_spheres):
     (V1, F1), (V2, F2) = two_spheres
     with pytest.raises(mm.TopologyError, match="intersect"):
-        mm.enforce_clearance(V1, F1, V2, F2, tau=0.01)
+        mm.enforce_clearance(V1, F1, V2, F2, tau=0.01, scope="both")
     with pytest.raises(mm.InvalidInputError, match="tau"):
         mm.enforce_clearance(*nested_spheres[0], tau=0)
     with pytest.raises(mm.InvalidInputError, match="one entry"):
@@ -720,8 +720,11 @@ def test_paint_classify_and_keep_booleans(two_spheres, tmp_path):
     by_id = mm.remove_patches(MV, MF, remove=inside, patch_of_face=painted.patch_of_face, **kw)
     assert by_id.report["volume"] == pytest.approx(vu, rel=1e-9)
     assert np.all(~np.isin(painted.patch_of_face[by_id.face_origin], inside))
+    # The filter's default: the union.
+    default = mm.remove_patches(MV, MF, **kw)
+    assert default.report["keep"] == results["union"].report["keep"] and default.report["volume"] == pytest.approx(vu, rel=1e-9)
     with pytest.raises(mm.InvalidInputError, match="either remove"):
-        mm.remove_patches(MV, MF, **kw)
+        mm.remove_patches(MV, MF, keep="unselected", **kw)
     with pytest.raises(mm.InvalidInputError, match="patch id 9 does not exist"):
         mm.remove_patches(MV, MF, remove=[9], **kw)
     with pytest.raises(mm.InvalidInputError, match="keep must be"):
@@ -915,9 +918,12 @@ def test_help_lists_the_core_options_with_their_defaults():
 
     parameters = inspect.signature(mm.fill_holes).parameters
     listed = mm._core.OPTIONS["fill_holes"]
-    assert [name for name, _, _ in listed] == list(parameters)[2:-1]  # after (vertices, faces)
+    # After (vertices, faces): the core's options, then report_file and progress.
+    assert [name for name, _, _ in listed] + ["report_file"] == list(parameters)[2:-1]
     for name, default, doc in listed:
-        assert parameters[name].default == default and doc and doc in mm.fill_holes.__doc__
+        # The filter's default where it differs from the core's (test_parity.py).
+        expected = 0.5 if name == "max_diameter" else default
+        assert parameters[name].default == expected and doc and doc in mm.fill_holes.__doc__
     assert parameters["fairing"].default in ("laplacian_regression", "biharmonic", "harmonic", "flat")
     assert isinstance(parameters["verify"].default, bool)
     assert isinstance(parameters["regression_rings"].default, int)
