@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -263,6 +264,7 @@ class Inspector {
       const double dx = r_.bbox[3] - r_.bbox[0], dy = r_.bbox[4] - r_.bbox[1],
                    dz = r_.bbox[5] - r_.bbox[2];
       r_.bbox_diagonal = std::sqrt(dx * dx + dy * dy + dz * dz);
+      for (double c : r_.bbox) r_.max_abs_coordinate = std::max(r_.max_abs_coordinate, std::abs(c));
     }
     const Point3 center((r_.bbox[0] + r_.bbox[3]) / 2, (r_.bbox[1] + r_.bbox[4]) / 2,
                         (r_.bbox[2] + r_.bbox[5]) / 2);
@@ -284,12 +286,30 @@ class Inspector {
         markFace(f, kFaceDegenerate);
       }
       if (a == b || b == c || c == a) continue;  // angles undefined
+      const double shortest = std::sqrt(
+          std::min({(b - a).SquaredNorm(), (c - b).SquaredNorm(), (a - c).SquaredNorm()}));
+      if (shortest > 0 && (r_.shortest_edge == 0 || shortest < r_.shortest_edge))
+        r_.shortest_edge = shortest;
       const double m = std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
       r_.min_angle_deg = std::min(r_.min_angle_deg, m);
       sumMinAngle += m;
       ++angleCount;
     }
     if (angleCount == 0) r_.min_angle_deg = 0;
+    if (r_.shortest_edge > 0) {
+      // The spacing of each scalar's values at the largest coordinate (past
+      // FLT_MAX float holds none of them: 0 steps).
+      const double m = r_.max_abs_coordinate;
+      if (m <= double(std::numeric_limits<float>::max())) {
+        const float f = std::max(float(m), std::numeric_limits<float>::denorm_min());
+        const double step =
+            double(std::nextafter(f, std::numeric_limits<float>::infinity())) - double(f);
+        r_.float_steps_in_shortest_edge = std::isfinite(step) ? r_.shortest_edge / step : 0;
+      }
+      const double d = std::max(m, std::numeric_limits<double>::denorm_min());
+      const double step = std::nextafter(d, std::numeric_limits<double>::infinity()) - d;
+      r_.double_steps_in_shortest_edge = std::isfinite(step) ? r_.shortest_edge / step : 0;
+    }
     r_.mean_min_angle_deg = angleCount ? sumMinAngle / double(angleCount) : 0;
     const bool edgeManifoldOriented =
         r_.is_closed && r_.consistently_oriented && r_.non_manifold_edges == 0;
@@ -362,8 +382,27 @@ JsonObject toJson(const InspectResult& r) {
       .set("bbox_diagonal", r.bbox_diagonal)
       .set("min_angle_deg", r.min_angle_deg)
       .set("mean_min_angle_deg", r.mean_min_angle_deg)
-      .set("time_ms", r.time_ms);
+      .set("max_abs_coordinate", r.max_abs_coordinate)
+      .set("shortest_edge", r.shortest_edge)
+      .set("float_steps_in_shortest_edge", r.float_steps_in_shortest_edge)
+      .set("double_steps_in_shortest_edge", r.double_steps_in_shortest_edge);
+  const std::string precision = precisionNote(r);
+  if (!precision.empty()) j.set("precision_note", precision);
+  j.set("time_ms", r.time_ms);
   return j;
+}
+
+std::string precisionNote(const InspectResult& r) {
+  if (r.shortest_edge <= 0 || r.float_steps_in_shortest_edge >= kFewFloatSteps) return {};
+  std::ostringstream s;
+  s.precision(3);
+  s << "the shortest edge (" << r.shortest_edge << ") spans only " << r.float_steps_in_shortest_edge
+    << " float steps at coordinates up to " << r.max_abs_coordinate
+    << ": stored in float (MeshLab's float builds, float PLY/STL/OBJ files) the faces can "
+       "cross or collapse where they do not in the file; use a double host (MeshLab 2025.07d, "
+       "pymeshlab, the meshmend Python module), where it spans "
+    << r.double_steps_in_shortest_edge << " steps";
+  return s.str();
 }
 
 std::string summarize(const InspectResult& r) {
@@ -393,6 +432,8 @@ std::string summarize(const InspectResult& r) {
   s << (r.is_closed ? "; closed" : "; open");
   if (r.volume) s << ", volume " << *r.volume;
   if (r.genus) s << ", genus " << *r.genus;
+  const std::string precision = precisionNote(r);
+  if (!precision.empty()) s << ". Precision: " << precision;
   return s.str();
 }
 

@@ -63,6 +63,17 @@ struct InspectResult {
   double bbox_diagonal = 0;
   double min_angle_deg = 180;     // smallest interior angle
   double mean_min_angle_deg = 0;  // mean over triangles of their smallest angle
+  // Whether the host's scalar can hold the detail: the largest |coordinate|
+  // (finite vertices), the shortest edge of a face between two distinct
+  // points, and how many steps of float and of double (the spacing of the
+  // scalar's values at the largest coordinate) that edge spans. A float host
+  // (MeshLab's float builds) moves each coordinate by up to half a step when
+  // it stores it: below a few steps, storing can make faces cross or
+  // collapse (precision_note says so).
+  double max_abs_coordinate = 0;
+  double shortest_edge = 0;
+  double float_steps_in_shortest_edge = 0;
+  double double_steps_in_shortest_edge = 0;
   // With the self_intersections option (the rule of CGAL's self_intersections,
   // as in intersections.h); empty otherwise or with non-finite coordinates.
   std::optional<std::size_t> self_intersecting_pairs;
@@ -71,6 +82,14 @@ struct InspectResult {
   std::vector<std::uint8_t> face_defects;    // per face FaceDefect bits (mark_defects)
   std::vector<std::uint8_t> vertex_defects;  // per vertex VertexDefect bits (mark_defects)
 };
+
+// Below this many float steps in the shortest edge, Inspect warns that
+// float storage is not enough for the mesh (precisionNote).
+inline constexpr double kFewFloatSteps = 64;
+
+// A sentence for the log and the report when the shortest edge spans fewer
+// than kFewFloatSteps float steps (pointing to a double host), else empty.
+std::string precisionNote(const InspectResult& result);
 
 // Inspects a compact mesh (no deleted elements). Never throws on defects: they
 // are what it measures. Throws InvalidInputError if the mesh is not compact.

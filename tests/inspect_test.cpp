@@ -32,6 +32,33 @@ TEST(Inspect, ClosedTetrahedronHasNoDefects) {
   EXPECT_EQ(r.euler_characteristic, 2);
 }
 
+TEST(Inspect, DetailOfAFewFloatStepsIsNamed) {
+  // The unit tetrahedron: its shortest edge, 1, spans 2^23 float steps (and
+  // 2^52 double steps) at coordinates up to 1.
+  const InspectResult unit = inspect(tetrahedron());
+  EXPECT_EQ(unit.max_abs_coordinate, 1.0);
+  EXPECT_EQ(unit.shortest_edge, 1.0);
+  EXPECT_EQ(unit.float_steps_in_shortest_edge, 8388608.0);
+  EXPECT_EQ(unit.double_steps_in_shortest_edge, 4503599627370496.0);
+  EXPECT_TRUE(precisionNote(unit).empty());
+  EXPECT_EQ(toJson(unit).str().find("precision_note"), std::string::npos);
+  // Shrunk to 1e-3 and moved to 1e4: a float step there is 2^-10, so the
+  // edge spans about one step; a double step is 2^-39 (5.5e8 of them).
+  std::vector<Point3> p = positionsOf(tetrahedron());
+  for (Point3& q : p) q = q * 1e-3 + Point3(1e4, 1e4, 1e4);
+  const InspectResult far = inspect(makeMesh(p, trianglesOf(tetrahedron())));
+  EXPECT_NEAR(far.shortest_edge, 1e-3, 1e-12);
+  EXPECT_NEAR(far.float_steps_in_shortest_edge, 1e-3 * 1024, 1e-6);
+  EXPECT_NEAR(far.double_steps_in_shortest_edge, 1e-3 * 549755813888.0, 1);
+  const std::string note = precisionNote(far);
+  EXPECT_NE(note.find("double host"), std::string::npos) << note;
+  EXPECT_NE(summarize(far).find(note), std::string::npos);
+  EXPECT_NE(toJson(far).str().find("\"precision_note\": "), std::string::npos);
+  // Past FLT_MAX a float holds no coordinate at all: 0 steps.
+  for (Point3& q : p) q = q * 1e35;
+  EXPECT_EQ(inspect(makeMesh(p, trianglesOf(tetrahedron()))).float_steps_in_shortest_edge, 0.0);
+}
+
 TEST(Inspect, SphereVolumeAndGenus) {
   const InspectResult r = inspect(uvSphere(24, 48));
   EXPECT_TRUE(r.is_closed);
