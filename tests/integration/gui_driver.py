@@ -54,14 +54,16 @@ class MeshLabGui:
     """One MeshLab GUI process on its own Xvfb display, in `workdir` (where
     MeshLab's render plugin writes shaders.log when a shader fails)."""
 
-    def __init__(self, workdir, files=(), geometry=SCREEN, prefix=PREFIX, host=None):
+    def __init__(self, workdir, files=(), geometry=SCREEN, prefix=PREFIX, host=None, executable=None):
         """MeshLab 2020.09 from `prefix`, or the GUI of a scripts/hosts `host`
-        (environment.Host) in a HOME of its own."""
+        (environment.Host) in a HOME of its own; `executable` another copy of
+        that host's MeshLab."""
         require_tools()
-        executable = Path(prefix) / "bin" / "meshlab"
-        if host is not None:
-            host.require_gui()
-            executable = host.gui
+        if executable is None:
+            executable = Path(prefix) / "bin" / "meshlab"
+            if host is not None:
+                host.require_gui()
+                executable = host.gui
         assert executable.exists(), f"no MeshLab at {executable}: run scripts/setup or scripts/hosts build"
         self.workdir = Path(workdir)
         self.workdir.mkdir(parents=True, exist_ok=True)
