@@ -163,7 +163,7 @@ class MeshLabGui:
         return path
 
     # ---- reading the screen ------------------------------------------------------
-    def words(self, png=None, region=None):
+    def words(self, png=None, region=None, readings=([], ["-negate"])):
         """The words tesseract reads on the screen (or in `png`; only within
         region = (x0, y0, x1, y1) when given), with their boxes in screen
         pixels (read at twice the size for small GUI fonts)."""
@@ -178,7 +178,7 @@ class MeshLabGui:
         found = []
         # Read twice: as shown, and negated, for light text on highlighted
         # (dark) menu entries and title bars.
-        for negate in ([], ["-negate"]):
+        for negate in readings:
             big = png.with_name(png.stem + "_x2.png")
             subprocess.run(["convert", str(png), "-colorspace", "gray", *negate, "-resize", "200%",
                             str(big)], check=True)
@@ -203,9 +203,16 @@ class MeshLabGui:
         end = time.time() + timeout
         wanted = phrase.split()
         while True:
-            words = self.words(png, region)
-            hits = [words[i] for i in range(len(words) - len(wanted) + 1)
-                    if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted)))]
+            shot = Path(png) if png else self.screenshot(self.workdir / "ocr.png")
+            # The first match is looked for as shown, then negated (light text
+            # on dark); the lowest one needs both readings at once.
+            hits = []
+            for readings in ([[], ["-negate"]],) if last else ([[]], [["-negate"]]):
+                words = self.words(shot, region, readings=readings)
+                hits = [words[i] for i in range(len(words) - len(wanted) + 1)
+                        if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted)))]
+                if hits:
+                    break
             if hits:
                 return max(hits, key=lambda w: w.top) if last else hits[0]
             if time.time() >= end or png:
@@ -243,6 +250,38 @@ class MeshLabGui:
         text = log.read_text() if log.exists() else ""
         compiled = bool(dialog) and not error_box and not text
         return compiled, text
+
+    def run_script(self, script, reports, timeout=600):
+        """Runs a filter script as a user of MeshLab 2022 and later does:
+        Filters > Show current filter script, Open Script (`script`, in the
+        working folder), Apply Script. Waits until every file of `reports`
+        exists (each filter writes its report_file when it has run)."""
+        self.open_menu("Filters", "Show current filter script")
+        window = self.wait_for_window("^Dialog$")
+        time.sleep(0.8)
+        shape = self.xdotool("getwindowgeometry", window)
+        x, y = map(int, re.search(r"Position: (\d+),(\d+)", shape).groups())
+        w, h = map(int, re.search(r"Geometry: (\d+)x(\d+)", shape).groups())
+        box = (x, y, x + w, y + h)
+        button = self.find("Open Script", region=box, timeout=5)
+        assert button, "no Open Script button in the filter script dialog"
+        self.click(*button.center)
+        self.wait_for_window("^Open Filter Script File$")
+        time.sleep(0.8)
+        self.type(Path(script).name)
+        self.key("Return")
+        time.sleep(1.0)
+        button = self.find("Apply Script", region=box, timeout=5)
+        assert button, "no Apply Script button in the filter script dialog"
+        self.click(*button.center)
+        end = time.time() + timeout
+        while not all(Path(r).exists() for r in reports):
+            assert self.alive(), "MeshLab exited: " + self.log_path.read_text()[-2000:]
+            failed = self.windows("^Filter Failure|^Error|^Warning")
+            assert not failed, "the script failed: " + self.log_path.read_text()[-2000:]
+            assert time.time() < end, "the script did not finish: " + self.log_path.read_text()[-2000:]
+            time.sleep(0.5)
+        time.sleep(1.0)
 
     def close(self):
         if self.alive():
