@@ -605,15 +605,13 @@ TEST(HoleInput, NonFiniteCoordinateIsRefusedAndTheMeshKept) {
   EXPECT_EQ(std::size_t(m.fn), faces);
 }
 
-TEST(HoleInput, InfiniteCoordinateIsRefusedBeforeBadOptions) {
+TEST(HoleInput, InfiniteCoordinateIsRefusedNamingTheVertex) {
   for (int axis = 0; axis < 3; ++axis) {
     Mesh m = sphereWithCap();
     m.vert[m.vert.size() - 1].P()[axis] = axis == 1 ? -INFINITY : INFINITY;
     const std::vector<Triangle> t = trianglesOf(m);
-    HoleFillOptions o;
-    o.long_edge_factor = 0.5;  // also bad: the coordinate is named first
     try {
-      fillHoles(m, o);
+      fillHoles(m);
       FAIL() << "no error";
     } catch (const InvalidInputError& e) {
       EXPECT_NE(std::string(e.what()).find("vertex " + std::to_string(m.vert.size() - 1) +
@@ -623,6 +621,30 @@ TEST(HoleInput, InfiniteCoordinateIsRefusedBeforeBadOptions) {
     }
     EXPECT_EQ(trianglesOf(m), t);
   }
+}
+
+// Options are checked before anything is read from the mesh (the cheap
+// checks first): a bad option is named even when a coordinate is bad too.
+TEST(HoleInput, BadOptionsAreRefusedBeforeTheMeshIsRead) {
+  Mesh m = sphereWithCap();
+  m.vert[0].P()[0] = INFINITY;
+  HoleFillOptions o;
+  o.long_edge_factor = 0.5;
+  try {
+    fillHoles(m, o);
+    FAIL() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("long_edge_factor"), std::string::npos) << e.what();
+  }
+}
+
+// Where nothing is filled, nothing is read but the faces: a closed mesh with
+// a non-finite coordinate is left as it is, with no hole found.
+TEST(HoleInput, ClosedMeshIsNotReadFurther) {
+  Mesh m = icosphere(2);
+  m.vert[3].P()[2] = std::nan("");
+  const HoleFillResult r = fillHoles(m);
+  EXPECT_EQ(r.holes_found, 0u);
 }
 
 TEST(HoleInput, DeletedElementsAreRefused) {
