@@ -179,10 +179,7 @@ struct Fairing::System {
   Eigen::MatrixXd fixedPart;      // rows x 3: the fixed vertices' contribution
   Eigen::VectorXd rowWeight;      // 1 / (2 sqrt(A_r))
   std::vector<double> rowLength;  // sum_j |omega_rj|: turns a row's residual into a length
-  // The factorisation: of `normal`, or (exact false) of the same pattern
-  // with the first weights, which then preconditions conjugate gradients.
-  Solver solver;
-  bool exact = true;
+  Solver solver;                  // its ordering and symbolic analysis are the pattern's: made once
 };
 
 Fairing::Fairing(const Patch& patch, const Rim& rim) : patch_(patch), rim_(rim) {
@@ -297,57 +294,12 @@ Eigen::MatrixXd Fairing::rightHandSide(const Eigen::MatrixXd& delta) const {
   return rhs;
 }
 
-// Solves the normal equations for the right-hand sides `rhs`, starting
-// from `guess`: directly when the factorisation is of the system's own
-// matrix, else by conjugate gradients preconditioned with it (the matrix
-// of the first weights is close to this one: a few iterations). Empty when
-// it does not converge.
-Eigen::MatrixXd Fairing::solveNormal(const Eigen::MatrixXd& rhs,
-                                     const Eigen::MatrixXd& guess) const {
-  const System& sys = *system_;
-  if (sys.exact) {
-    Eigen::MatrixXd sol = sys.solver.solve(rhs);
-    if (sys.solver.info() != Eigen::Success || !sol.allFinite()) return {};
-    return sol;
-  }
-  const auto A = sys.normal.selfadjointView<Eigen::Lower>();
-  Eigen::MatrixXd sol = guess;
-  for (Eigen::Index d = 0; d < rhs.cols(); ++d) {
-    Eigen::VectorXd x = guess.col(d);
-    Eigen::VectorXd r = rhs.col(d) - A * x;
-    const double stop = 1e-24 * std::max(rhs.col(d).squaredNorm(), 1e-300);
-    Eigen::VectorXd z = sys.solver.solve(r);
-    Eigen::VectorXd p = z;
-    double rz = r.dot(z);
-    bool converged = r.squaredNorm() <= stop;
-    for (int iteration = 0; iteration < kMostIterations && !converged; ++iteration) {
-      const Eigen::VectorXd q = A * p;
-      const double pq = p.dot(q);
-      if (!(pq > 0)) break;
-      const double alpha = rz / pq;
-      x += alpha * p;
-      r -= alpha * q;
-      converged = r.squaredNorm() <= stop;
-      z = sys.solver.solve(r);
-      const double next = r.dot(z);
-      p = z + (next / rz) * p;
-      rz = next;
-    }
-    if (!converged || !x.allFinite()) return {};
-    sol.col(d) = x;
-  }
-  return sol;
-}
-
 double Fairing::solve(const Eigen::MatrixXd& delta, std::vector<Point3>& x) const {
   const System& sys = *system_;
   const int first = int(patch_.n);
   const std::size_t unknowns = patch_.size() - patch_.n;
-  Eigen::MatrixXd guess(Eigen::Index(unknowns), 3);
-  for (std::size_t v = 0; v < unknowns; ++v)
-    for (int d = 0; d < 3; ++d) guess(Eigen::Index(v), d) = x[patch_.n + v][d];
-  const Eigen::MatrixXd sol = solveNormal(rightHandSide(delta), guess);
-  if (sol.rows() == 0) return -1;
+  const Eigen::MatrixXd sol = sys.solver.solve(rightHandSide(delta));
+  if (sys.solver.info() != Eigen::Success || !sol.allFinite()) return -1;
   for (std::size_t v = 0; v < unknowns; ++v)
     for (int d = 0; d < 3; ++d) x[patch_.n + v][d] = sol(Eigen::Index(v), d);
   // The RMS residual of the rows, as a length.
@@ -374,19 +326,20 @@ bool Fairing::biharmonic(std::vector<Point3>& x, double& residual, bool fromShap
     inDomain[v] = Point3(patch_.uv[v].x, patch_.uv[v].y, 0);
   system_ = std::make_unique<System>();
   assemble(x, weightsAt(fromShape ? x : inDomain));
-  system_->solver.compute(system_->normal);
-  if (system_->solver.info() != Eigen::Success || solve(zero, x) < 0) return false;
-  // Then the weights of that shape, the same factorisation preconditioning.
-  assemble(x, weightsAt(x));
-  system_->exact = false;
-  residual = solve(zero, x);
-  if (residual < 0) {  // not converged: the new weights factorised after all
-    system_->solver.compute(system_->normal);
-    system_->exact = true;
-    if (system_->solver.info() != Eigen::Success) return false;
+  System& sys = *system_;
+  sys.solver.analyzePattern(sys.normal);
+  sys.solver.factorize(sys.normal);
+  if (sys.solver.info() != Eigen::Success || solve(zero, x) < 0) return false;
+  // Then the weights of each shape in turn: the same pattern and ordering,
+  // the numbers factorised again.
+  for (int pass = 0; pass < kReweightings; ++pass) {
+    assemble(x, weightsAt(x));
+    sys.solver.factorize(sys.normal);
+    if (sys.solver.info() != Eigen::Success) return false;
     residual = solve(zero, x);
+    if (residual < 0) return false;
   }
-  return residual >= 0;
+  return true;
 }
 
 std::pair<Point3, double> Fairing::normalAndArea(int v, const std::vector<Point3>& x) const {

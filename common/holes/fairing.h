@@ -6,11 +6,15 @@
 // regression: the paper's targets, learnt from the surface around the hole;
 // harmonic: the membrane L x = 0 over the new vertices alone.
 //
-// Each system is factorised once per patch (Eigen's sparse LDL^T, AMD
-// ordering): its weights are the cotangents of the patch at the positions
-// it is given (the flat placement, which already rises and falls with the
-// border), and the regression's targets are further right-hand sides of the
-// biharmonic system.
+// Each system's ordering and symbolic factorisation are made once per patch
+// (Eigen's sparse LDL^T, AMD ordering); the biharmonic system is factorised
+// with the weights of the patch in its domain, then with those of the
+// shapes that gives (the cotangent weights of a flat or membrane placement
+// leave the shape further from the removed surface, and conjugate
+// gradients preconditioned with the first factorisation took 10 to 60
+// iterations, each as costly as a factorisation of a small patch); the
+// regression's targets are further right-hand sides of the last
+// factorisation.
 #pragma once
 
 #include <Eigen/Core>
@@ -115,9 +119,9 @@ class Fairing {
   Fairing& operator=(const Fairing&) = delete;
 
   // Minimal curvature: target Laplacians 0. Solved with the weights of the
-  // patch in its domain (or, `fromShape`, where x has it), then with those
-  // of the shape that gives, by conjugate gradients preconditioned with
-  // the first factorisation.
+  // patch in its domain (or, `fromShape`, where x has it), then twice with
+  // those of the shape the last solve gave (kReweightings): one ordering
+  // and symbolic analysis, the numbers factorised for each weight set.
   bool biharmonic(std::vector<Point3>& x, double& residual, bool fromShape = false);
   // The paper's: the Laplacians the model predicts at each row's vertex
   // (-4 A H n), a few rounds (normals and areas from the last shape); the
@@ -144,7 +148,6 @@ class Fairing {
   // first time), fixed positions from x; the normal matrix refilled.
   void assemble(const std::vector<Point3>& x, const std::vector<TriangleWeights>& weights);
   Eigen::MatrixXd rightHandSide(const Eigen::MatrixXd& delta) const;
-  Eigen::MatrixXd solveNormal(const Eigen::MatrixXd& rhs, const Eigen::MatrixXd& guess) const;
   // Solves for the new vertices given the target Laplacians delta (rows x
   // 3), starting from x; returns the RMS residual as a length, or -1.
   double solve(const Eigen::MatrixXd& delta, std::vector<Point3>& x) const;
@@ -153,7 +156,11 @@ class Fairing {
   const Patch& patch_;
   const Rim& rim_;
   std::vector<int> rows_;  // the least-squares rows: new vertices, then boundary ones
-  static constexpr int kMostIterations = 60;  // of conjugate gradients, per coordinate
+  // Solves with the weights of the last shape after the first: the
+  // discrete Laplacian then measures the shape it describes. One more
+  // made the mean distance to the removed surface of the fidelity set
+  // smaller on 12 of 22 holes and larger on 7 (docs/BENCHMARKS.md).
+  static constexpr int kReweightings = 2;
   std::unique_ptr<System> system_;
 };
 

@@ -23,10 +23,6 @@ double msSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// Mean |cos| between the border's faces and the hole's plane below which
-// the disk is tried first: 45 degrees, where projecting onto the plane
-// shortens the patch's first layer by more than a factor 1 / sqrt(2).
-constexpr double kSteepCosine = 0.70710678118654752;
 // Patch edges that a placement stretches beyond this factor of their length
 // in the domain are split (refineStretched): twice the size the front meant.
 constexpr double kMaxStretch = 2;
@@ -88,10 +84,7 @@ class HoleFiller {
     Candidate* disk = &candidates.back();
     Candidate* plane = candidates.size() > 1 ? &candidates.front() : nullptr;
     std::string failed;
-    // Where the surface along the border turns steeply away from the plane,
-    // the disk's patch first, in the first shape.
-    if (steep_ && tryAs(*disk, modes[0], failed)) return done(modes[0], candidates, failed);
-    // Else the plane's, then the disk's: first the rounder of the two in
+    // The plane's patch, then the disk's: first the rounder of the two in
     // space (the disk's is made only when the plane's is not round).
     std::vector<Candidate*> order;
     if (plane) {
@@ -114,7 +107,6 @@ class HoleFiller {
     // A smoother shape over any domain before a flatter one.
     for (HoleFairing mode : modes)
       for (Candidate* c : order) {
-        if (steep_ && c == disk && mode == modes[0]) continue;  // tried above
         if (c == dense && !denseDiffers(*disk)) continue;
         if (tryAs(*c, mode, failed)) return done(mode, candidates, failed);
       }
@@ -164,13 +156,11 @@ class HoleFiller {
             chords_.insert(edgeKey(int(k), it->second));
           }
         }
-    // Along the border: the faces' mean normal (for the plane) and each unit normal (steepness).
+    // Along the border: the faces' mean normal (one of the planes tried).
     for (std::size_t k = 0; k < n_; ++k) {
       const int f = s_.borderFace(front_[(k + 1) % n_], front_[k]);
       if (f < 0) continue;
-      const Point3 normal = faceNormal(f);
-      faceNormals_ += normal;
-      if (normal.Norm() > 0) borderNormals_.push_back(normal / normal.Norm());
+      faceNormals_ += faceNormal(f);
     }
     readRim();
     return true;
@@ -230,19 +220,14 @@ class HoleFiller {
   }
 
   // The hole's plane, if the border projects onto one, then the disk, which
-  // any border maps to. Where the surface along the border turns more than
-  // 45 degrees away from the plane on average (a cap, a tube's end), the
-  // plane squeezes the patch next to the border: `steep`.
-  std::vector<Candidate> domainsToTry() {
+  // any border maps to.
+  std::vector<Candidate> domainsToTry() const {
     std::vector<Candidate> out;
     out.reserve(3);  // never moved: a candidate's fairing refers to its patch
     out.emplace_back();
     out[0].domain = diskDomain(boundary_);
     Domain plane;
     if (!planeDomain(boundary_, faceNormals_, plane)) return out;
-    double cosine = 0;
-    for (const Point3& n : borderNormals_) cosine += std::abs(n * plane.N);
-    steep_ = !borderNormals_.empty() && cosine < kSteepCosine * double(borderNormals_.size());
     out.insert(out.begin(), Candidate{});
     out[0].domain = std::move(plane);
     return out;
@@ -624,11 +609,9 @@ class HoleFiller {
   std::vector<std::pair<int, int>> existing_;  // border vertices joined by a mesh edge
   std::unordered_set<std::uint64_t> chords_;   // the same, as keys
   Point3 faceNormals_{0, 0, 0};
-  std::vector<Point3> borderNormals_;
   Rim rim_;
   CurvatureModel model_;
   int learnt_ = -1;  // the curvature model: -1 not tried, 0 failed, 1 learnt
-  bool steep_ = false;
 };
 
 }  // namespace

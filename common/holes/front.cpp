@@ -122,6 +122,14 @@ class AdvancingFront {
     const Node& node = nodes_[r.node];
     return node.alive && node.vertex == r.from && nodes_[node.next].vertex == r.to;
   }
+  // Whether a grid entry still names a front edge / node (once gone, they
+  // never come back: a node's edge that changes gets a new record).
+  auto liveRecord() const {
+    return [this](int id) { return liveEdge(edgeRecords_[std::size_t(id)]); };
+  }
+  auto liveNode() const {
+    return [this](int n) { return nodes_[std::size_t(n)].alive; };
+  }
 
   void kill(int n) {
     if (!nodes_[n].alive) return;
@@ -140,10 +148,9 @@ class AdvancingFront {
   bool edgeIsClear(int a, int b) const {
     const Vec2 pa = uv[a], pb = uv[b];
     bool clear = true;
-    edgeGrid_->query(boxLo(pa, pb), boxHi(pa, pb), [&](int id) {
+    edgeGrid_->queryLive(boxLo(pa, pb), boxHi(pa, pb), liveRecord(), [&](int id) {
       if (!clear) return;
-      const EdgeRecord& r = edgeRecords_[id];
-      if (!liveEdge(r)) return;
+      const EdgeRecord& r = edgeRecords_[std::size_t(id)];
       const int c = r.from, d = r.to;
       const Vec2 pc = uv[c], pd = uv[d];
       if (c == a && d == b) return;
@@ -164,8 +171,8 @@ class AdvancingFront {
     const Vec2 pa = uv[a], pb = uv[b], pc = uv[c];
     const Vec2 lo = boxLo(boxLo(pa, pb), pc), hi = boxHi(boxHi(pa, pb), pc);
     bool empty = true;
-    points_->query(lo, hi, [&](int n) {
-      if (!empty || !nodes_[n].alive) return;
+    points_->queryLive(lo, hi, liveNode(), [&](int n) {
+      if (!empty) return;
       const int v = nodes_[n].vertex;
       if (v == a || v == b || v == c) return;
       const Vec2 p = uv[v];
@@ -184,8 +191,8 @@ class AdvancingFront {
     if (orient(uv[a], uv[b], uv[c]) <= 0) return -1;
     const bool closesNext = nc >= 0 && nc == nodes_[nb].next;
     const bool closesPrev = nc >= 0 && nc == nodes_[na].prev;
-    if (!closesNext && (edges_.count(edgeKey(b, c)) || !edgeIsClear(b, c))) return -1;
-    if (!closesPrev && (edges_.count(edgeKey(c, a)) || !edgeIsClear(c, a))) return -1;
+    if (!closesNext && (edges_.contains(edgeKey(b, c)) || !edgeIsClear(b, c))) return -1;
+    if (!closesPrev && (edges_.contains(edgeKey(c, a)) || !edgeIsClear(c, a))) return -1;
     if (!triangleIsEmpty(a, b, c)) return -1;
 
     triangles.push_back({a, b, c});
@@ -260,8 +267,7 @@ class AdvancingFront {
   // Front nodes (not at the excluded vertices) within `radius` of p, nearest first.
   std::vector<int> nodesNear(Vec2 p, double radius, std::initializer_list<int> exclude) const {
     std::vector<std::pair<double, int>> found;
-    points_->query(p - Vec2{radius, radius}, p + Vec2{radius, radius}, [&](int n) {
-      if (!nodes_[n].alive) return;
+    points_->queryLive(p - Vec2{radius, radius}, p + Vec2{radius, radius}, liveNode(), [&](int n) {
       const int v = nodes_[n].vertex;
       for (int x : exclude)
         if (v == x) return;
@@ -280,10 +286,9 @@ class AdvancingFront {
   bool crowded(Vec2 p, double s, int pv, int iv, int qv) const {
     const double limit = 0.35 * s;
     bool near = false;
-    edgeGrid_->query(p - Vec2{limit, limit}, p + Vec2{limit, limit}, [&](int id) {
+    edgeGrid_->queryLive(p - Vec2{limit, limit}, p + Vec2{limit, limit}, liveRecord(), [&](int id) {
       if (near) return;
-      const EdgeRecord& r = edgeRecords_[id];
-      if (!liveEdge(r)) return;
+      const EdgeRecord& r = edgeRecords_[std::size_t(id)];
       for (int x : {pv, iv, qv})
         if (r.from == x || r.to == x) return;
       near = pointSegmentDistance(p, uv[r.from], uv[r.to]) < limit;
@@ -392,7 +397,7 @@ class AdvancingFront {
   double minSize_ = 0;
   std::vector<Node> nodes_;
   std::vector<EdgeRecord> edgeRecords_;
-  std::unordered_set<std::uint64_t> edges_;
+  EdgeSet edges_;
   std::unique_ptr<Grid> points_, edgeGrid_;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap_;
 };

@@ -83,6 +83,25 @@ class Grid {
              e = entries_[std::size_t(e)].next)
           visit(entries_[std::size_t(e)].id);
   }
+  // The same, taking out of the grid, as it passes them, the ids that
+  // `live` says are gone for good: the cells a moving front crossed keep
+  // only what is still there.
+  template <class Live, class Visit>
+  void queryLive(Vec2 lo, Vec2 hi, Live&& live, Visit&& visit) {
+    const auto [x0, y0] = cellOf(lo);
+    const auto [x1, y1] = cellOf(hi);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        for (int* link = &head_[std::size_t(y) * std::size_t(nx_) + std::size_t(x)]; *link >= 0;) {
+          Entry& entry = entries_[std::size_t(*link)];
+          if (!live(entry.id)) {
+            *link = entry.next;
+            continue;
+          }
+          visit(entry.id);
+          link = &entry.next;
+        }
+  }
 
  private:
   struct Entry {
@@ -105,5 +124,43 @@ class Grid {
 std::pair<Point3, Point3> tangentFrame(const Point3& n);
 
 std::uint64_t edgeKey(int a, int b);  // an undirected edge, as one number
+
+// A set of edge keys (never 0 nor ~0: edgeKey of two vertices >= 0 is
+// neither unless both are 0), open addressing with linear probing.
+class EdgeSet {
+ public:
+  explicit EdgeSet(std::size_t expected = 16) {
+    std::size_t size = 16;
+    while (size < 2 * expected) size *= 2;
+    slots_.assign(size, kEmpty);
+  }
+  bool contains(std::uint64_t key) const {
+    for (std::size_t i = slot(key);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i] == key) return true;
+      if (slots_[i] == kEmpty) return false;
+    }
+  }
+  void insert(std::uint64_t key) {
+    if (2 * (count_ + 1) > slots_.size()) grow();
+    std::size_t i = slot(key);
+    while (slots_[i] != kEmpty && slots_[i] != key) i = (i + 1) & (slots_.size() - 1);
+    if (slots_[i] == kEmpty) slots_[i] = key, ++count_;
+  }
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+  std::size_t slot(std::uint64_t key) const {
+    return std::size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1);
+  }
+  void grow() {
+    std::vector<std::uint64_t> old(2 * slots_.size(), kEmpty);
+    old.swap(slots_);
+    count_ = 0;
+    for (std::uint64_t key : old)
+      if (key != kEmpty) insert(key);
+  }
+  std::vector<std::uint64_t> slots_;
+  std::size_t count_ = 0;
+};
 
 }  // namespace meshmend::holes
