@@ -12,7 +12,7 @@ namespace meshmend::holes {
 
 std::size_t patchIntersections(const Surface& s, const std::vector<Triangle>& patch,
                                const std::vector<Point3>& newPoints, const std::vector<int>& own,
-                               const std::vector<int>& near) {
+                               const std::vector<int>& near, std::size_t enough) {
   const std::size_t existing = s.vertexCount();
   auto point = [&](int v) -> const Point3& {
     return std::size_t(v) < existing ? s.point(v) : newPoints[std::size_t(v) - existing];
@@ -47,18 +47,19 @@ std::size_t patchIntersections(const Surface& s, const std::vector<Triangle>& pa
   const BoxTree tree(boxes);
   std::atomic<std::size_t> pairs{0};
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
-    if (facesIntersect(checked[i].corners, checked[i].points, checked[j].corners,
-                       checked[j].points))
+    if (pairs < enough && facesIntersect(checked[i].corners, checked[i].points, checked[j].corners,
+                                         checked[j].points))
       ++pairs;
   });
   for (int f : near) {
+    if (pairs >= enough) break;
     if (ownSet.count(f)) continue;
     const Triangle t = s.corners(f);
     const TrianglePoints p{point(t[0]), point(t[1]), point(t[2])};
     const Box box = boxOf(p[0], p[1], p[2]);
     if (!overlap(box, bounds)) continue;
     tree.query(box, 0, [&](std::uint32_t i, unsigned) {
-      if (facesIntersect(checked[i].corners, checked[i].points, t, p)) ++pairs;
+      if (pairs < enough && facesIntersect(checked[i].corners, checked[i].points, t, p)) ++pairs;
     });
   }
   return pairs;

@@ -16,9 +16,10 @@ namespace meshmend::holes {
 // are skipped): every face of the surface that may meet the patch must be
 // in `own` or `near`. Patch corners from s.vertexCount() on are new
 // vertices, at newPoints[corner - s.vertexCount()]. A patch face without
-// area counts as a pair.
+// area counts as a pair. The count stops at `enough` (a patch that fails
+// is not looked at further).
 std::size_t patchIntersections(const Surface& s, const std::vector<Triangle>& patch,
                                const std::vector<Point3>& newPoints, const std::vector<int>& own,
-                               const std::vector<int>& near);
+                               const std::vector<int>& near, std::size_t enough);
 
 }  // namespace meshmend::holes

@@ -271,10 +271,8 @@ class HoleFiller {
       failed += (failed.empty() ? "" : "; ") + name + ": " + why;
       return false;
     }
-    const std::size_t pairs = check(c, x);
-    if (pairs > 0) {
-      failed += (failed.empty() ? "" : "; ") + name +
-                " patch would intersect itself or the mesh (" + std::to_string(pairs) + " pairs)";
+    if (check(c, x) > 0) {
+      failed += (failed.empty() ? "" : "; ") + name + " patch would intersect itself or the mesh";
       return false;
     }
     commit(c, x, shaped, residual);
@@ -545,8 +543,9 @@ class HoleFiller {
     return out;
   }
 
-  // Rounds the new vertices as they will be stored, and counts the pairs of
-  // faces the patch would make intersect (0 when the check is off).
+  // Rounds the new vertices as they will be stored; 1 if the patch would
+  // make a pair of faces intersect (the check stops there), else 0 (and 0
+  // when the check is off).
   std::size_t check(const Candidate& c, std::vector<Point3>& x) {
     for (std::size_t v = n_; v < x.size(); ++v) x[v] = s_.stored(x[v]);
     if (!options_.check_intersections) return 0;
@@ -556,7 +555,7 @@ class HoleFiller {
     for (int f : splitFaces_) bounds.add(s_.boundsOf(f));
     const std::vector<Point3> added(x.begin() + std::ptrdiff_t(n_), x.end());
     const std::size_t pairs = patchIntersections(s_, meshTriangles(c.patch), added, splitFaces_,
-                                                 context_.facesNear(bounds));
+                                                 context_.facesNear(bounds), 1);
     context_.times.check += msSince(clock);
     return pairs;
   }
