@@ -521,6 +521,30 @@ TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
   EXPECT_EQ(selfIntersectingPairs(m), 0u);
 }
 
+// The faces a patch is checked against are gathered around the hole before
+// it is shaped, other parts of the mesh among them: a plate above a tube's
+// open end, which the biharmonic dome would cross, makes it fall back.
+TEST(HoleChecks, PlateAboveATubesEndMakesTheDomeFallBack) {
+  const Mesh tube = openTube(24, 30, 1, 4);
+  const Mesh plate =
+      makeMesh({{-0.1, -0.1, 4.5}, {0.1, -0.1, 4.5}, {0.1, 0.1, 4.5}, {-0.1, 0.1, 4.5}},
+               {{0, 1, 2}, {0, 2, 3}});
+  Mesh m = appended(tube, plate);
+  const std::vector<Point3> before = positionsOf(m);
+  HoleFillOptions o;
+  o.verify = true;
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_found, 3u);  // the tube's two ends and the plate's outline
+  const HoleReport& top = *std::find_if(r.holes.begin(), r.holes.end(), [&](const HoleReport& h) {
+    return h.boundary.size() == 24 && before[std::size_t(h.boundary[0])][2] > 3.9;
+  });
+  ASSERT_TRUE(top.filled) << top.reason;
+  std::cout << "tube end under a plate: " << toString(top.fairing) << ", " << top.reason << "\n";
+  EXPECT_NE(top.reason.find("biharmonic patch would intersect"), std::string::npos) << top.reason;
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(selfIntersectingPairs(m), 0u);
+}
+
 TEST(HoleChecks, VerificationCountsWhatAnUncheckedPatchCrosses) {
   // The same plate through the opening, with the check off: the hole is
   // filled through the plate and the independent recount sees it.
