@@ -15,6 +15,11 @@ tables to build/benchmarks-smoke.md instead of docs/BENCHMARKS.md: it proves
 that the runners build, run and agree with their peers (it fails on a failed
 or disagreeing method), and asserts no speed. The full test tier runs it.
 
+Every benchmark takes --threads N: the threads MeshMend's runners use (it sets
+MESHMEND_THREADS; 0, the default, leaves every CPU). The peers run on one
+thread. The hole-filling comparison runs ours on 1 thread whatever it says,
+and on every CPU beside it.
+
 Needs scripts/setup to have run (the private MeshLab prefix) and ../shared
 beside the project (the real meshes). Builds the C++ runners if needed."""
 import argparse
@@ -126,6 +131,15 @@ def machine():
     return f"{os.cpu_count()} cores ({cpu}), {platform.system()} {platform.release()}"
 
 
+def threads_used():
+    """What the tables say about threads: ours on MESHMEND_THREADS (as
+    --threads sets it), else on every CPU; the peers on one."""
+    n = os.environ.get("MESHMEND_THREADS")
+    ours = f"{n} thread{'s' if n != '1' else ''} (`--threads {n}`)" if n else \
+        f"every CPU ({os.cpu_count()} threads)"
+    return f"MeshMend on {ours}, the peers on 1 thread"
+
+
 def fmt(ms):
     return f"{ms:,.1f}" if ms < 100 else f"{ms:,.0f}"
 
@@ -163,7 +177,8 @@ def intersections(repeat):
     def cell(m, key="median_ms"):
         return fmt(m[key]) if m.get("ok") else "failed: " + m.get("error", "?")
 
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; each number is the median of "
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}, {threads_used()}; each "
+           "number is the median of "
            f"{repeat} runs in a child process of one `bench_intersections` run (`benchmarks/run.py "
            f"intersections`), so ours and the peers ran on the same input in the same run. Times "
            f"exclude file reading. Peak memory is the child's peak resident set (inputs included).",
@@ -302,7 +317,8 @@ def split(repeat, rounds=3):
 
 
 def split_table(rows, repeat, rounds, tmp):
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; per method the median of "
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}, {threads_used()}; per "
+           "method the median of "
            f"{rounds} rounds, each the median of {repeat} runs in one `bench_split` run per pair "
            "(`benchmarks/run.py split`; in each round ours and the peers run one after the other, "
            "each method in a child process). "
@@ -733,7 +749,13 @@ def main():
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--smoke", action="store_true",
                         help="one run of each on its smallest inputs, tables to build/benchmarks-smoke.md")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="threads MeshMend's runners use (MESHMEND_THREADS; 0: every CPU); "
+                             "the hole-filling comparison runs ours on 1 thread whatever this "
+                             "says, and on every CPU beside it")
     args = parser.parse_args()
+    if args.threads > 0:
+        os.environ["MESHMEND_THREADS"] = str(args.threads)
     names = list(BENCHMARKS) if args.benchmark == "all" else [args.benchmark]
     if args.smoke:
         SMOKE, args.repeat = True, 1
