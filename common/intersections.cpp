@@ -537,23 +537,29 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 
 namespace {
 
-// facesIntersect with the degeneracy of f and g known (`knownFlat`: -1 not
-// known, 0 neither is degenerate); faces with the same three vertices meet
-// unless `sameVertices` is false.
-bool facesMeet(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
-               std::uint32_t g, int knownFlat, bool sameVertices = true) {
-  const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
-  const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+// facesIntersect with the degeneracy of the two faces known (`knownFlat`:
+// -1 not known, 0 neither is degenerate); faces with the same three
+// vertices meet unless `sameVertices` is false.
+bool facesMeet(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+               const TrianglePoints& b, int knownFlat, bool sameVertices = true) {
   // Apart along an axis (exact): most candidates of a widened box search.
   for (int k = 0; k < 3; ++k)
     if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
         std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
       return false;
   if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
-  const SharedCorners c = sharedCorners(T[f], T[g]);
+  const SharedCorners c = sharedCorners(ta, tb);
   if (c.count == 3 && !sameVertices) return false;
-  if (c.count < 3 && separatedInProjection(T[f], a, T[g], b)) return false;
+  if (c.count < 3 && separatedInProjection(ta, a, tb, b)) return false;
   return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+}
+
+// The same for faces f and g of a mesh.
+bool facesMeet(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+               std::uint32_t g, int knownFlat, bool sameVertices = true) {
+  const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
+  const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+  return facesMeet(T[f], a, T[g], b, knownFlat, sameVertices);
 }
 
 }  // namespace
@@ -561,6 +567,11 @@ bool facesMeet(const std::vector<Point3>& P, const std::vector<Triangle>& T, std
 bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
                     std::uint32_t g) {
   return facesMeet(P, T, f, g, -1);
+}
+
+bool facesIntersect(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                    const TrianglePoints& b) {
+  return facesMeet(ta, a, tb, b, -1);
 }
 
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(

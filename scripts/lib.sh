@@ -7,6 +7,11 @@ DEPS_DIR="$MESHMEND_ROOT/.deps"              # unpacked MeshLab source (ignored 
 SHARED_DIR="$(cd "$MESHMEND_ROOT/.." && pwd)/shared"
 SYSTEM_MESHLAB_LIB=/usr/lib/x86_64-linux-gnu/meshlab
 JOBS="${MESHMEND_JOBS:-$(nproc)}"
+# Third-party builds (scripts/hosts) and the compiler cache live outside the
+# clone, shared by every clone and run on the machine.
+CACHE="${MESHMEND_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/meshmend}"
+export CCACHE_DIR="${CCACHE_DIR:-$CACHE/ccache}"
+export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-8G}"
 
 say() { printf '\033[1m==> %s\033[0m\n' "$*"; }
 note() { printf '    %s\n' "$*"; }

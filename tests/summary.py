@@ -8,7 +8,7 @@ CTest test that ran it). A CTest test that ran a pytest suite counts as that
 suite's cases; if the suite wrote no XML (it crashed), as one failure.
 Prints the failed and skipped cases with their reasons and ends with
 
-    tests: N passed, N failed, N skipped (GoogleTest N, pytest N)
+    tests: N passed, N failed, N skipped (GoogleTest N, pytest N, other checks N)
 
 Exit status 1 if a case failed, or, in CI (CI=true), if a case was skipped
 because something was missing ("missing:" reasons: ../shared, the checker,
@@ -52,8 +52,8 @@ def collect(results):
                 # A pytest suite that left no XML: it did not get to its cases.
                 outcomes.append(("pytest", test, "failed" if outcome != "skipped" else outcome,
                                  message or "the suite wrote no results (crashed or timed out)"))
-            else:
-                outcomes.append(("gtest", test, outcome, message))
+            else:  # a GoogleTest case (Suite.Case), or a check of its own (docs_…)
+                outcomes.append(("gtest" if "." in test else "check", test, outcome, message))
     for stem, path in sorted(pytest_files.items()):
         try:
             for name, outcome, message in cases(path):
@@ -83,10 +83,9 @@ def main():
             shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
             print(f"  {len(names)} x {message or 'no reason given'}: {shown}")
     passed = sum(1 for o in outcomes if o[2] == "passed")
-    gtest = sum(1 for o in outcomes if o[0] == "gtest")
-    pytest = len(outcomes) - gtest
+    kinds = {k: sum(1 for o in outcomes if o[0] == k) for k in ("gtest", "pytest", "check")}
     print(f"tests: {passed} passed, {len(failed) + len(required)} failed, {len(skipped) - len(required)} skipped "
-          f"(GoogleTest {gtest}, pytest {pytest})")
+          f"(GoogleTest {kinds['gtest']}, pytest {kinds['pytest']}, other checks {kinds['check']})")
     return 1 if failed or required or not outcomes else 0
 
 

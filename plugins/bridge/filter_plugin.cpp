@@ -216,24 +216,15 @@ std::map<std::string, QVariant> resultMap(const JsonObject& report) {
     const std::string key = scan.string();
     scan.expect(':');
     const std::string_view value = scan.value();
-    QVariant v;
     if (value == "true" || value == "false") {
-      v = QVariant(value == "true");
+      result[key] = QVariant(value == "true");
     } else if (value == "null") {
-      v = QVariant(std::numeric_limits<double>::quiet_NaN());
+      result[key] = QVariant(std::numeric_limits<double>::quiet_NaN());
     } else if (isNumberText(value)) {
-      v = numberVariant(value);
-    } else if (value.front() == '"') {
-      v = QVariant(QString::fromStdString(JsonScanner(value).string()));
+      result[key] = numberVariant(value);
     } else if (value.front() == '[') {
-      if (auto numbers = numberArray(value))
-        v = QVariant::fromValue(*numbers);
-      else
-        v = QVariant(QString::fromStdString(std::string(value)));
-    } else {
-      v = QVariant(QString::fromStdString(std::string(value)));
+      if (auto numbers = numberArray(value)) result[key] = QVariant::fromValue(*numbers);
     }
-    result[key] = v;
   } while (scan.consume(','));
   scan.expect('}');
   return result;

@@ -115,8 +115,9 @@ class FilterAdapter : public MESHMEND_FILTER_INTERFACE {
 #if MESHMEND_MESHLAB_API == 2022
 // The report as a filter result map: numbers as int (when integral and in
 // range) or double, booleans as bool, null as NaN, arrays of numbers as
-// Eigen::VectorXd (the types pymeshlab converts to Python); strings as
-// QString, and other arrays and objects as QString holding their JSON text.
+// Eigen::VectorXd: the types pymeshlab converts to Python. Strings, other
+// arrays and objects are left out (pymeshlab would skip each with a warning);
+// they are in the report file.
 std::map<std::string, QVariant> resultMap(const JsonObject& report);
 #endif
 

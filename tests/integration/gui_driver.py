@@ -1,8 +1,10 @@
-"""Drives the real MeshLab GUI (the private prefix, scripts/meshlab) on a
-virtual display of its own: starts Xvfb and MeshLab, clicks and types with
-xdotool, takes screenshots with ImageMagick's import, and finds text on the
-screen with tesseract (word boxes), so that tests need no fixed pixel
-positions for menus, dialogs and parameters."""
+"""Drives a real MeshLab GUI (2020.09 from the private prefix, scripts/meshlab,
+or a 2025.07 build of scripts/hosts) on a virtual display of its own: starts
+Xvfb and MeshLab, clicks and types with xdotool, takes screenshots with
+ImageMagick's import, and finds text on the screen with tesseract (word
+boxes), so that tests need no fixed pixel positions for menus, dialogs and
+parameters."""
+import datetime
 import os
 import re
 import shutil
@@ -10,16 +12,30 @@ import subprocess
 import time
 from pathlib import Path
 
-from conftest import BUILD
+from conftest import BUILD, filters
 
 PREFIX = BUILD / "meshlab-prefix"
 SCREEN = (1280, 1024)
+SEARCH = (SCREEN[0] - 22, 46)  # the filter search (magnifier) at the right end of the toolbar
 
 
 def require_tools():
     for tool in ("Xvfb", "xdotool", "import", "convert", "tesseract"):
         assert shutil.which(tool), f"{tool} missing: scripts/setup installs it"
-    assert (PREFIX / "bin" / "meshlab").exists(), f"no private MeshLab in {PREFIX}: run scripts/setup"
+
+
+def quiet_home(folder, double):
+    """A HOME whose MeshLab (2022 and later) settings answer its first-start
+    questions (anonymous statistics, update check), so the window opens
+    without a dialog in front."""
+    config = Path(folder) / ".config" / "VCG"
+    config.mkdir(parents=True, exist_ok=True)
+    today = datetime.date.today()
+    checked = f"{today:%a} {today:%b} {today.day} {today.year}"  # QDate::toString()
+    (config / f"MeshLab_64bit_{'dp' if double else 'fp'}.conf").write_text(
+        f"[General]\ninformativeShown=true\ndontRemindMeToSendEmail=true\n"
+        f"lastTimeMeshLabVersionCheckedOnStart={checked}\n")
+    return Path(folder)
 
 
 class Word:
@@ -38,8 +54,17 @@ class MeshLabGui:
     """One MeshLab GUI process on its own Xvfb display, in `workdir` (where
     MeshLab's render plugin writes shaders.log when a shader fails)."""
 
-    def __init__(self, workdir, files=(), geometry=SCREEN, prefix=PREFIX):
+    def __init__(self, workdir, files=(), geometry=SCREEN, prefix=PREFIX, host=None, executable=None):
+        """MeshLab 2020.09 from `prefix`, or the GUI of a scripts/hosts `host`
+        (environment.Host) in a HOME of its own; `executable` another copy of
+        that host's MeshLab."""
         require_tools()
+        if executable is None:
+            executable = Path(prefix) / "bin" / "meshlab"
+            if host is not None:
+                host.require_gui()
+                executable = host.gui
+        assert executable.exists(), f"no MeshLab at {executable}: run scripts/setup or scripts/hosts build"
         self.workdir = Path(workdir)
         self.workdir.mkdir(parents=True, exist_ok=True)
         read, write = os.pipe()
@@ -54,10 +79,12 @@ class MeshLabGui:
             number += chunk
         os.close(read)
         self.env = dict(os.environ, DISPLAY=":" + number.decode().strip())
+        if host is not None:
+            self.env["HOME"] = str(quiet_home(self.workdir / "home", host.double))
         self.log_path = self.workdir / "meshlab.log"
         self.log_file = open(self.log_path, "w")
         self.meshlab = subprocess.Popen(
-            [str(Path(prefix) / "bin" / "meshlab"), *(str(Path(f).resolve()) for f in files)],
+            [str(executable), *(str(Path(f).resolve()) for f in files)],
             cwd=self.workdir, env=self.env, stdout=self.log_file, stderr=subprocess.STDOUT)
         self.window = self.wait_for_window("^MeshLab 20", timeout=60)
         self.fill_screen(geometry)
@@ -136,7 +163,7 @@ class MeshLabGui:
         return path
 
     # ---- reading the screen ------------------------------------------------------
-    def words(self, png=None, region=None):
+    def words(self, png=None, region=None, readings=([], ["-negate"])):
         """The words tesseract reads on the screen (or in `png`; only within
         region = (x0, y0, x1, y1) when given), with their boxes in screen
         pixels (read at twice the size for small GUI fonts)."""
@@ -151,7 +178,7 @@ class MeshLabGui:
         found = []
         # Read twice: as shown, and negated, for light text on highlighted
         # (dark) menu entries and title bars.
-        for negate in ([], ["-negate"]):
+        for negate in readings:
             big = png.with_name(png.stem + "_x2.png")
             subprocess.run(["convert", str(png), "-colorspace", "gray", *negate, "-resize", "200%",
                             str(big)], check=True)
@@ -176,9 +203,16 @@ class MeshLabGui:
         end = time.time() + timeout
         wanted = phrase.split()
         while True:
-            words = self.words(png, region)
-            hits = [words[i] for i in range(len(words) - len(wanted) + 1)
-                    if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted)))]
+            shot = Path(png) if png else self.screenshot(self.workdir / "ocr.png")
+            # The first match is looked for as shown, then negated (light text
+            # on dark); the lowest one needs both readings at once.
+            hits = []
+            for readings in ([[], ["-negate"]],) if last else ([[]], [["-negate"]]):
+                words = self.words(shot, region, readings=readings)
+                hits = [words[i] for i in range(len(words) - len(wanted) + 1)
+                        if all(_same(words[i + k].text, wanted[k]) for k in range(len(wanted)))]
+                if hits:
+                    break
             if hits:
                 return max(hits, key=lambda w: w.top) if last else hits[0]
             if time.time() >= end or png:
@@ -217,6 +251,38 @@ class MeshLabGui:
         compiled = bool(dialog) and not error_box and not text
         return compiled, text
 
+    def run_script(self, script, reports, timeout=600):
+        """Runs a filter script as a user of MeshLab 2022 and later does:
+        Filters > Show current filter script, Open Script (`script`, in the
+        working folder), Apply Script. Waits until every file of `reports`
+        exists (each filter writes its report_file when it has run)."""
+        self.open_menu("Filters", "Show current filter script")
+        window = self.wait_for_window("^Dialog$")
+        time.sleep(0.8)
+        shape = self.xdotool("getwindowgeometry", window)
+        x, y = map(int, re.search(r"Position: (\d+),(\d+)", shape).groups())
+        w, h = map(int, re.search(r"Geometry: (\d+)x(\d+)", shape).groups())
+        box = (x, y, x + w, y + h)
+        button = self.find("Open Script", region=box, timeout=5)
+        assert button, "no Open Script button in the filter script dialog"
+        self.click(*button.center)
+        self.wait_for_window("^Open Filter Script File$")
+        time.sleep(0.8)
+        self.type(Path(script).name)
+        self.key("Return")
+        time.sleep(1.0)
+        button = self.find("Apply Script", region=box, timeout=5)
+        assert button, "no Apply Script button in the filter script dialog"
+        self.click(*button.center)
+        end = time.time() + timeout
+        while not all(Path(r).exists() for r in reports):
+            assert self.alive(), "MeshLab exited: " + self.log_path.read_text()[-2000:]
+            failed = self.windows("^Filter Failure|^Error|^Warning")
+            assert not failed, "the script failed: " + self.log_path.read_text()[-2000:]
+            assert time.time() < end, "the script did not finish: " + self.log_path.read_text()[-2000:]
+            time.sleep(0.5)
+        time.sleep(1.0)
+
     def close(self):
         if self.alive():
             self.meshlab.terminate()
@@ -233,6 +299,113 @@ class MeshLabGui:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def parameter(filter_name, name):
+    """A parameter's declaration: description (the dialog's label), tooltip,
+    type, default (enum index or text)."""
+    for p in filters()[filter_name]["parameters"]:
+        if p["name"] == name:
+            xml = p["xml"]
+            get = lambda key: re.search(f' {key}="([^"]*)"', xml).group(1)
+            choices = dict(re.findall(r' enum_val(\d+)="([^"]*)"', xml))
+            return {"description": get("description"), "tooltip": get("tooltip"),
+                    "type": get("type"), "value": get("value"),
+                    "choices": [choices[str(i)] for i in range(len(choices))]}
+    raise KeyError(f"{filter_name} has no parameter {name}")
+
+
+class Dialog:
+    """A filter's parameter dialog (a window titled with the filter's name)."""
+
+    def __init__(self, gui, name):
+        self.gui, self.name = gui, name
+        gui.click(*SEARCH)
+        gui.type(name)
+        time.sleep(1.0)
+        gui.key("Down")
+        gui.key("Return")
+        self.window = gui.wait_for_window("^" + re.escape(name) + "$", timeout=20)
+        time.sleep(0.8)
+        shape = gui.xdotool("getwindowgeometry", self.window)
+        x, y = map(int, re.search(r"Position: (\d+),(\d+)", shape).groups())
+        w, h = map(int, re.search(r"Geometry: (\d+)x(\d+)", shape).groups())
+        self.box = (x, y, x + w, y + h)
+
+    def label(self, name):
+        p = parameter(self.name, name)
+        words = p["description"].split()[:3]
+        # The lowest match: the filter's description above the parameters may use the words too.
+        found = self.gui.find(" ".join(words), region=self.box, timeout=5, last=True)
+        assert found, f"no label {p['description']!r} in the dialog of {self.name}"
+        return found, p
+
+    def widget_at(self, label):
+        """A point inside the widget on the label's row: the widgets of the
+        dialog's second column reach its right margin."""
+        return self.box[2] - 40, label.center[1]
+
+    def set(self, name, value):
+        label, p = self.label(name)
+        if p["type"] == "RichBool":
+            if (p["value"] == "true") != bool(value):
+                self.gui.click(*label.center)
+        elif p["type"] == "RichEnum":  # open the list, go to its first entry, then down
+            self.gui.click(*self.widget_at(label))
+            time.sleep(0.8)
+            self.gui.key("Home")
+            for _ in range(int(value)):
+                self.gui.key("Down")
+            self.gui.key("Return")
+        else:
+            x, y = self.widget_at(label)
+            if p["type"] == "RichAbsPerc":  # spin boxes under "world unit" and "perc on"
+                unit = self.gui.find("world unit", region=self.box, timeout=3)
+                assert unit, "no absolute field"
+                x, y = unit.center[0], unit.center[1] + 22
+            self.gui.click(x, y)
+            self.gui.key("ctrl+a")
+            self.gui.type(str(value))
+            self.gui.key("Tab")
+
+    def tooltip(self, name, path):
+        """Hovers the parameter's label until its tooltip shows; screenshot of
+        the dialog with the tooltip; returns the words read there. (MeshLab
+        2020.09 gives tooltips to the labels of booleans, numbers, strings
+        and distances; an enumeration's label has none.)"""
+        label, p = self.label(name)
+        self.gui.hover(*label.center, wait=2.5)
+        x0, y0, x1, y1 = self.box
+        crop = (0, 0, min(SCREEN[0], x1 + 460), min(SCREEN[1], y1 + 140))
+        path = self.gui.screenshot(path, crop=crop)
+        return self.gui.text(path), p["tooltip"]
+
+    def apply(self, timeout=300):
+        """Clicks Apply and waits for MeshLab's "Applied filter" line in its log
+        (the GUI prints its log on stdout); returns the log lines the filter
+        added. A failure box fails the test."""
+        before = len(self.gui.log_path.read_text().splitlines())
+        apply = self.gui.find("Apply", region=self.box, timeout=5, last=True)
+        assert apply, f"no Apply button in the dialog of {self.name}"
+        self.gui.click(*apply.center)
+        end = time.time() + timeout
+        while True:
+            lines = self.gui.log_path.read_text().splitlines()[before:]
+            # "Applied filter NAME" in 2020.09, "Applied filter: NAME" in 2025.07.
+            if any(re.search("Applied filter:? " + re.escape(self.name), line) for line in lines):
+                break
+            assert not self.gui.windows("^Filter Failure|^Error"), \
+                f"{self.name} failed: " + "\n".join(lines[-20:])
+            assert time.time() < end, f"{self.name} did not finish: " + "\n".join(lines[-20:])
+            time.sleep(0.5)
+        time.sleep(1.0)  # the view redraws
+        return lines
+
+    def close(self):
+        close = self.gui.find("Close", region=self.box, timeout=5, last=True)
+        assert close, f"no Close button in the dialog of {self.name}"
+        self.gui.click(*close.center)
+        time.sleep(0.8)
 
 
 def _same(read, wanted):

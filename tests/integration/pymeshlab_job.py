@@ -59,20 +59,23 @@ def plain(v):
 
 @contextlib.contextmanager
 def c_stdout():
-    """Captures what C++ code prints on file descriptor 1."""
+    """Captures what is printed, by C++ code on file descriptor 1 (pymeshlab
+    2025.7) or through Python's sys.stdout (2022.2)."""
     sys.stdout.flush()
     saved = os.dup(1)
+    python = io.StringIO()
     with tempfile.TemporaryFile(mode="w+") as f:
         os.dup2(f.fileno(), 1)
         text = io.StringIO()
         try:
-            yield text
+            with contextlib.redirect_stdout(python):
+                yield text
         finally:
             sys.stdout.flush()
             os.dup2(saved, 1)
             os.close(saved)
             f.seek(0)
-            text.write(f.read())
+            text.write(f.read() + python.getvalue())
 
 
 def describe(ms, name):
@@ -110,11 +113,13 @@ def main():
             entry["exception"] = type(e).__name__
         out["plugins"].append(entry)
     ms = pymeshlab.MeshSet()
-    ms.set_verbosity(False)
-    for path in job.get("meshes", []):
-        ms.load_new_mesh(str(path))
+    ms.set_verbosity(True)  # pymeshlab 2022.2 prints nothing otherwise, parameter lists included
+    with c_stdout():
+        for path in job.get("meshes", []):
+            ms.load_new_mesh(str(path))
     for name in job.get("describe", []):
         out["describe"][name] = describe(ms, name)
+    ms.set_verbosity(False)
     for step in job.get("steps", []):
         try:
             if "script" in step:

@@ -18,12 +18,11 @@ import numpy as np
 import pytest
 
 from conftest import BUILD, DATA, filters, require_shared_data, write_off
-from gui_driver import SCREEN, MeshLabGui
+from gui_driver import SCREEN, Dialog, MeshLabGui
 
 pytestmark = pytest.mark.gui
 
 SHOTS = BUILD / "test-artifacts" / "gui-walkthrough"
-SEARCH = (SCREEN[0] - 22, 46)  # the filter search (magnifier) at the right end of the toolbar
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -37,112 +36,6 @@ def slug(name):
     return re.sub(r"[^a-z0-9]+", "_", name.replace("MeshMend: ", "").lower()).strip("_")
 
 
-def parameter(filter_name, name):
-    """A parameter's declaration: description (the dialog's label), tooltip,
-    type, default (enum index or text)."""
-    for p in filters()[filter_name]["parameters"]:
-        if p["name"] == name:
-            xml = p["xml"]
-            get = lambda key: re.search(f' {key}="([^"]*)"', xml).group(1)
-            choices = dict(re.findall(r' enum_val(\d+)="([^"]*)"', xml))
-            return {"description": get("description"), "tooltip": get("tooltip"),
-                    "type": get("type"), "value": get("value"),
-                    "choices": [choices[str(i)] for i in range(len(choices))]}
-    raise KeyError(f"{filter_name} has no parameter {name}")
-
-
-class Dialog:
-    """A filter's parameter dialog (a window titled with the filter's name)."""
-
-    def __init__(self, gui, name):
-        self.gui, self.name = gui, name
-        gui.click(*SEARCH)
-        gui.type(name)
-        time.sleep(1.0)
-        gui.key("Down")
-        gui.key("Return")
-        self.window = gui.wait_for_window("^" + re.escape(name) + "$", timeout=20)
-        time.sleep(0.8)
-        shape = gui.xdotool("getwindowgeometry", self.window)
-        x, y = map(int, re.search(r"Position: (\d+),(\d+)", shape).groups())
-        w, h = map(int, re.search(r"Geometry: (\d+)x(\d+)", shape).groups())
-        self.box = (x, y, x + w, y + h)
-
-    def label(self, name):
-        p = parameter(self.name, name)
-        words = p["description"].split()[:3]
-        # The lowest match: the filter's description above the parameters may use the words too.
-        found = self.gui.find(" ".join(words), region=self.box, timeout=5, last=True)
-        assert found, f"no label {p['description']!r} in the dialog of {self.name}"
-        return found, p
-
-    def widget_at(self, label):
-        """A point inside the widget on the label's row: the widgets of the
-        dialog's second column reach its right margin."""
-        return self.box[2] - 40, label.center[1]
-
-    def set(self, name, value):
-        label, p = self.label(name)
-        if p["type"] == "RichBool":
-            if (p["value"] == "true") != bool(value):
-                self.gui.click(*label.center)
-        elif p["type"] == "RichEnum":  # open the list, go to its first entry, then down
-            self.gui.click(*self.widget_at(label))
-            time.sleep(0.8)
-            self.gui.key("Home")
-            for _ in range(int(value)):
-                self.gui.key("Down")
-            self.gui.key("Return")
-        else:
-            x, y = self.widget_at(label)
-            if p["type"] == "RichAbsPerc":  # spin boxes under "world unit" and "perc on"
-                unit = self.gui.find("world unit", region=self.box, timeout=3)
-                assert unit, "no absolute field"
-                x, y = unit.center[0], unit.center[1] + 22
-            self.gui.click(x, y)
-            self.gui.key("ctrl+a")
-            self.gui.type(str(value))
-            self.gui.key("Tab")
-
-    def tooltip(self, name, shot):
-        """Hovers the parameter's label until its tooltip shows; screenshot of
-        the dialog with the tooltip; returns the words read there. (MeshLab
-        2020.09 gives tooltips to the labels of booleans, numbers, strings
-        and distances; an enumeration's label has none.)"""
-        label, p = self.label(name)
-        self.gui.hover(*label.center, wait=2.5)
-        x0, y0, x1, y1 = self.box
-        crop = (0, 0, min(SCREEN[0], x1 + 460), min(SCREEN[1], y1 + 140))
-        path = self.gui.screenshot(SHOTS / shot, crop=crop)
-        return self.gui.text(path), p["tooltip"]
-
-    def apply(self, timeout=300):
-        """Clicks Apply and waits for MeshLab's "Applied filter" line in its log
-        (the GUI prints its log on stdout); returns the log lines the filter
-        added. A failure box fails the test."""
-        before = len(self.gui.log_path.read_text().splitlines())
-        apply = self.gui.find("Apply", region=self.box, timeout=5, last=True)
-        assert apply, f"no Apply button in the dialog of {self.name}"
-        self.gui.click(*apply.center)
-        end = time.time() + timeout
-        while True:
-            lines = self.gui.log_path.read_text().splitlines()[before:]
-            if any(f"Applied filter {self.name}" in line for line in lines):
-                break
-            assert not self.gui.windows("^Filter Failure|^Error"), \
-                f"{self.name} failed: " + "\n".join(lines[-20:])
-            assert time.time() < end, f"{self.name} did not finish: " + "\n".join(lines[-20:])
-            time.sleep(0.5)
-        time.sleep(1.0)  # the view redraws
-        return lines
-
-    def close(self):
-        close = self.gui.find("Close", region=self.box, timeout=5, last=True)
-        assert close, f"no Close button in the dialog of {self.name}"
-        self.gui.click(*close.center)
-        time.sleep(0.8)
-
-
 def run_filter(gui, name, values, hover, check):
     """The whole walk for one filter; `check(report)` asserts its outcome in
     the report it wrote to the file typed into its dialog."""
@@ -151,7 +44,7 @@ def run_filter(gui, name, values, hover, check):
     for key, value in values.items():
         dialog.set(key, value)
     dialog.set("report_file", path.name)  # relative: MeshLab's working folder
-    seen, tooltip = dialog.tooltip(hover, f"{slug(name)}_dialog.png")
+    seen, tooltip = dialog.tooltip(hover, SHOTS / f"{slug(name)}_dialog.png")
     # Its first words, read back from the screen (OCR misses a few on the yellow tooltip).
     tip = re.findall(r"[A-Za-z]{4,}", tooltip)[:8]
     found = sum(1 for w in tip if w.lower() in seen.lower())
