@@ -109,6 +109,19 @@ TEST(Retriangulate, CrossingConstraintsMeetAtTheirExactCrossing) {
   EXPECT_EQ(x.x, want.x);
 }
 
+TEST(Retriangulate, StopsAtItsBoundOnExactEvaluations) {
+  // Two crossing constraints: their crossing point is computed exactly.
+  PatchInput in = input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(0, 0),
+                         on(mpq_class(1, 3), mpq_class(1, 3))},
+                        {{3, 4}, {5, 6}});
+  const Patch p = retriangulate(in);
+  EXPECT_GE(p.exact_evaluations, 2u);
+  in.max_exact_evaluations = 1;
+  EXPECT_THROW(retriangulate(in), WorkLimitError);
+  in.max_exact_evaluations = 0;  // no bound
+  EXPECT_EQ(retriangulate(in).triangles.size(), p.triangles.size());
+}
+
 TEST(Retriangulate, VertexOnAConstraintSplitsIt) {
   const Patch p = retriangulate(
       input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(mpq_class(1, 4), mpq_class(1, 4))},
