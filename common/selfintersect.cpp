@@ -6,7 +6,9 @@
 #include <string>
 
 #include "common/errors.h"
+#include "common/inspect.h"
 #include "common/intersections.h"
+#include "common/predicates.h"
 #include "common/selfintersect_stages.h"
 #include "common/split.h"
 
@@ -16,238 +18,382 @@ using namespace selfintersect;
 
 namespace {
 
-SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  auto lap = start;
-  // Milliseconds since the previous lap.
-  auto elapsed = [&lap] {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - lap).count();
-    lap = now;
-    return ms;
-  };
-  requireFacesAndFiniteCoordinates(input, "the mesh");
+// ---- The working state of one removal, filled stage by stage -------------
+
+struct Removal {
+  Removal(const Mesh& m, const SelfIntersectionOptions& o) : input(m), options(o) {}
+  const Mesh& input;
+  const SelfIntersectionOptions& options;
+  SelfIntersectionResult r;
+  // The input as arrays, welded, cleaned and pre-treated; each vertex and
+  // face remembers its index in `input`.
+  MeshArrays in;
+  std::vector<int> vertexOrigin, faceOrigin;
+  std::size_t degenerateIn = 0;  // collinear faces left after the pre-treatment
+  // The mesh cut along its self-intersection curves (§2.2).
+  SplitResult split;
+  MeshArrays cut;
+  // §2.3-2.4, and the output as arrays (outFace: each output face's cut face).
+  Grown grown;
+  std::vector<Point3> outPoints;
+  std::vector<Triangle> outTriangles;
+  std::vector<int> outFace;
+};
+
+std::size_t collinearFaces(const std::vector<Point3>& P, const std::vector<Triangle>& T) {
+  std::size_t n = 0;
+  for (const Triangle& t : T) n += collinear(P[t[0]], P[t[1]], P[t[2]]);
+  return n;
+}
+
+void checkOptions(const SelfIntersectionOptions& options) {
   if (!(options.degenerate_angle_deg >= 0 && options.degenerate_angle_deg < 60))
     throw InvalidInputError("the degenerate face angle must be between 0 and 60 degrees");
   if (!(options.snap_tolerance >= 0 && options.snap_tolerance < 0.5))
     throw InvalidInputError("the snapping tolerance must be between 0 and 0.5");
-  SelfIntersectionResult r;
-  r.faces_in = std::size_t(input.fn);
-  reportProgress(options.progress, 0, "checking the input");
+}
 
-  // The mesh as arrays, welded; each vertex and face remembers its input index.
-  MeshArrays arrays = arraysOf(input);
+// The input as welded arrays without duplicate faces, checked against the
+// preconditions; a closed mesh turned inside out is turned over (the
+// growing keeps what is outside with respect to the orientation, which
+// would be nothing) and turned back at the end.
+void readInput(Removal& w) {
+  SelfIntersectionResult& r = w.r;
+  requireFacesAndFiniteCoordinates(w.input, "the mesh");
+  r.faces_in = std::size_t(w.input.fn);
+  w.in = arraysOf(w.input);
   // Output in float is decided on float: the input as it will be stored
   // too (MeshLab's already is), so only new and moved vertices change later.
-  if (options.round_to_float)
-    for (Point3& p : arrays.points) p = roundedToFloat(p);
-  std::vector<int> vertexOrigin(arrays.points.size()), faceOrigin(arrays.triangles.size());
-  std::iota(vertexOrigin.begin(), vertexOrigin.end(), 0);
-  std::iota(faceOrigin.begin(), faceOrigin.end(), 0);
-  if (options.weld_duplicates) {
-    WeldedArrays w = weldCoincident(arrays);
-    r.vertices_welded = w.vertices_merged;
-    arrays = std::move(w.mesh);
-    vertexOrigin = std::move(w.vertex_origin);
-    faceOrigin = std::move(w.face_origin);
+  if (w.options.round_to_float)
+    for (Point3& p : w.in.points) p = roundedToFloat(p);
+  w.vertexOrigin.resize(w.in.points.size());
+  w.faceOrigin.resize(w.in.triangles.size());
+  std::iota(w.vertexOrigin.begin(), w.vertexOrigin.end(), 0);
+  std::iota(w.faceOrigin.begin(), w.faceOrigin.end(), 0);
+  if (w.options.weld_duplicates) {
+    WeldedArrays welded = weldCoincident(w.in);
+    r.vertices_welded = welded.vertices_merged;
+    w.in = std::move(welded.mesh);
+    w.vertexOrigin = std::move(welded.vertex_origin);
+    w.faceOrigin = std::move(welded.face_origin);
   }
-  std::vector<Point3>& P = arrays.points;
-  std::vector<Triangle>& T = arrays.triangles;
-  r.duplicate_faces_removed = removeDuplicateFaces(T, faceOrigin);
-  if (T.empty()) throw InvalidInputError("the mesh has no faces left after welding");
-  {
-    const Edges edges(T);
-    requireConsistentOrientation(edges, T);
-    const TopologyCounts before = topologyOf(edges, T, P.size());
-    r.components_before = before.components;
-    r.genus_before = before.genus;
-    r.border_edges_before = before.border_edges;
-    r.non_manifold_edges_before = before.non_manifold_edges;
-    r.fin_edges_before = before.fin_edges;
-    r.input_closed = before.border_edges == 0;
-  }
-  // A closed mesh with negative volume is inside out: the region growing
-  // keeps what is outside with respect to the orientation, which would be
-  // nothing. It runs on the mesh turned over, and the result is turned back.
-  r.inside_out = signedVolume(P, T) < 0;
+  r.duplicate_faces_removed = removeDuplicateFaces(w.in.triangles, w.faceOrigin);
+  if (w.in.triangles.empty()) throw InvalidInputError("the mesh has no faces left after welding");
+  const Edges edges(w.in.triangles);
+  requireConsistentOrientation(edges, w.in.triangles);
+  const TopologyCounts before = topologyOf(edges, w.in.triangles, w.in.points.size());
+  r.components_before = before.components;
+  r.genus_before = before.genus;
+  r.border_edges_before = before.border_edges;
+  r.non_manifold_edges_before = before.non_manifold_edges;
+  r.fin_edges_before = before.fin_edges;
+  r.input_closed = before.border_edges == 0;
+  r.inside_out = signedVolume(w.in.points, w.in.triangles) < 0;
   if (r.inside_out)
-    for (Triangle& t : T) std::swap(t[1], t[2]);
+    for (Triangle& t : w.in.triangles) std::swap(t[1], t[2]);
+}
 
-  // §2.1 Pre-treatment.
-  elapsed();
-  {
-    const PretreatmentCounts c = pretreat(P, T, faceOrigin, options.degenerate_angle_deg,
-                                          options.pretreat, options.progress);
-    r.degenerate_faces_before = c.degenerate_before;
-    r.collapses = c.collapses;
-    r.flips = c.flips;
-    r.degenerate_faces_left = c.degenerate_left;
+// §2.1 Pre-treatment.
+void pretreatInput(Removal& w) {
+  const PretreatmentCounts c =
+      pretreat(w.in.points, w.in.triangles, w.faceOrigin, w.options.degenerate_angle_deg,
+               w.options.pretreat, w.options.progress);
+  w.r.degenerate_faces_before = c.degenerate_before;
+  w.r.collapses = c.collapses;
+  w.r.flips = c.flips;
+  w.r.degenerate_faces_left = c.degenerate_left;
+  w.degenerateIn = collinearFaces(w.in.points, w.in.triangles);
+}
+
+// The most triple points (pairs of a face's crossing faces that cross each
+// other) in one face, and that face; stops counting past `bound`.
+std::pair<std::size_t, int> mostTriplePoints(const std::vector<IntersectingPair>& pairs,
+                                             std::size_t faces, std::size_t bound) {
+  std::vector<std::vector<std::uint32_t>> crossing(faces);
+  for (const IntersectingPair& p : pairs) {
+    crossing[p.a.face].push_back(p.b.face);
+    crossing[p.b.face].push_back(p.a.face);
   }
-  r.stage_ms.pretreat = elapsed();
+  for (auto& list : crossing) std::sort(list.begin(), list.end());
+  auto cross = [&](std::uint32_t g, std::uint32_t h) {
+    return std::binary_search(crossing[g].begin(), crossing[g].end(), h);
+  };
+  std::pair<std::size_t, int> most{0, -1};
+  for (std::size_t f = 0; f < faces && most.first <= bound; ++f) {
+    const auto& list = crossing[f];
+    std::size_t triples = 0;
+    for (std::size_t i = 0; i < list.size() && triples <= bound; ++i)
+      for (std::size_t j = i + 1; j < list.size(); ++j) triples += cross(list[i], list[j]);
+    if (triples > most.first) most = {triples, int(f)};
+  }
+  return most;
+}
 
-  // §2.2 Self-intersections, cut into the faces (split.h).
-  reportProgress(options.progress, 10, "splitting along the self-intersections");
+// The work bounds, before anything is cut: the split's cost grows with the
+// intersecting pairs (about 0.1 ms each) and, within a face, with the
+// square of the curves crossing there.
+void boundWork(Removal& w) {
+  reportProgress(w.options.progress, 8, "finding the self-intersections");
+  FindIntersectionsOptions fo;
+  fo.cross = false;
+  fo.progress = w.options.progress;
+  const FindIntersectionsResult found = findIntersectionsInArrays({&w.in}, fo);
+  w.r.intersecting_pairs_before = found.pairs.size();
+  const std::size_t bound = w.options.max_intersecting_pairs;
+  if (bound > 0 && found.pairs.size() > bound)
+    throw WorkLimitError(
+        "the mesh has " + std::to_string(found.pairs.size()) +
+        " intersecting face pairs, more than the work bound of " + std::to_string(bound) +
+        " (max_intersecting_pairs): cutting them all would take minutes. Nothing was changed. "
+        "Raise the bound if that is acceptable, or work on parts of the mesh (select a region "
+        "and move it to its own layer)");
+  const std::size_t tripleBound = w.options.max_triple_points_per_face;
+  if (tripleBound == 0) return;
+  const auto [triples, face] = mostTriplePoints(found.pairs, w.in.triangles.size(), tripleBound);
+  if (triples > tripleBound)
+    throw WorkLimitError(
+        "in face " + std::to_string(w.faceOrigin[face]) + " more than " +
+        std::to_string(tripleBound) +
+        " pairs of the faces crossing it cross each other too (max_triple_points_per_face): the "
+        "surface passes many times through nearly one point there, as the meridians of a "
+        "spindle torus do near its axis, and cutting it would take the exact arithmetic "
+        "minutes. Nothing was changed. Remove the faces around that point (select them, "
+        "Filters > Selection > Delete Selected Faces) and close the hole with MeshMend: Fill "
+        "Holes, then remove the self-intersections");
+}
+
+// §2.2 The self-intersection curves, cut into the faces (split.h).
+void cutAlongCurves(Removal& w) {
+  reportProgress(w.options.progress, 10, "splitting along the self-intersections");
   Mesh work;
-  buildMesh(work, P, T);
+  buildMesh(work, w.in.points, w.in.triangles);
   SplitOptions so;
   so.between_meshes = false;
   so.self = true;
   so.separate_meshes = false;
-  so.snap_tolerance = options.snap_tolerance;
-  SplitResult split = splitAlongIntersections({&work}, so);
-  if (options.round_to_float) roundToFloat(split);
-  r.intersecting_pairs_before = split.intersecting_pairs;
-  r.faces_split = split.faces_split;
-  const MeshArrays cut = arraysOf(split.merged);
-  r.faces_after_split = cut.triangles.size();
-  r.stage_ms.split = elapsed();
+  so.snap_tolerance = w.options.snap_tolerance;
+  so.progress = w.options.progress;
+  w.split = splitAlongIntersections({&work}, so);
+  if (w.options.round_to_float) roundToFloat(w.split);
+  w.r.intersecting_pairs_before = w.split.intersecting_pairs;
+  w.r.faces_split = w.split.faces_split;
+  w.cut = arraysOf(w.split.merged);
+  w.r.faces_after_split = w.cut.triangles.size();
+}
 
-  // §2.3 Valid region growing.
-  reportProgress(options.progress, 60, "growing the valid region");
-  // The planes the radial order decides on: each face's birth face, or its
-  // own, where snapping moved it off that plane (deciding on the birth plane
-  // there let the growing pass from the outer surface into the inner one).
-  std::vector<TrianglePoints> births(cut.triangles.size());
-  {
-    FaceOriginHandle birth = faceOrigins(split.merged);
-    const std::vector<char>& snapped = split.merged_snapped_face;
-    for (std::size_t f = 0; f < births.size(); ++f)
-      births[f] = f < snapped.size() && snapped[f] ? pointsOf(cut.points, cut.triangles[f])
-                                                   : pointsOf(P, T[birth[f].face]);
-  }
-  Grown grown = growAndStitch(cut.points, cut.triangles, split.merged_new_face, std::move(births),
-                              options.progress);
-  const std::vector<char>& valid = grown.valid;
-  r.seeds = grown.seeds;
-  r.rays = grown.rays;
-  r.side_conflicts = grown.conflicts;
-  for (char v : valid) r.faces_kept += v;
-  r.faces_removed = valid.size() - r.faces_kept;
-  r.stage_ms.growing = elapsed();
-
-  // §2.4 Stitching (done by growAndStitch).
-  const Stitched& stitched = grown.stitched;
+// §2.3 Valid region growing and §2.4 stitching. The planes the radial order
+// decides on are each face's birth face, or its own where snapping moved it
+// off that plane (deciding on the birth plane there let the growing pass
+// from the outer surface into the inner one).
+void growValidRegion(Removal& w) {
+  reportProgress(w.options.progress, 60, "growing the valid region");
+  std::vector<TrianglePoints> births(w.cut.triangles.size());
+  FaceOriginHandle birth = faceOrigins(w.split.merged);
+  const std::vector<char>& snapped = w.split.merged_snapped_face;
+  for (std::size_t f = 0; f < births.size(); ++f)
+    births[f] = f < snapped.size() && snapped[f]
+                    ? pointsOf(w.cut.points, w.cut.triangles[f])
+                    : pointsOf(w.in.points, w.in.triangles[birth[f].face]);
+  w.grown = growAndStitch(w.cut.points, w.cut.triangles, w.split.merged_new_face, std::move(births),
+                          w.options.progress);
+  SelfIntersectionResult& r = w.r;
+  r.seeds = w.grown.seeds;
+  r.rays = w.grown.rays;
+  r.side_conflicts = w.grown.conflicts;
+  for (char v : w.grown.valid) r.faces_kept += v;
+  r.faces_removed = w.grown.valid.size() - r.faces_kept;
+  const Stitched& stitched = w.grown.stitched;
   r.edges_duplicated = stitched.edges_duplicated;
-  {
-    std::vector<char> seen(cut.points.size(), 0);
-    std::size_t distinct = 0;
-    for (int v : stitched.source_vertex) distinct += !seen[v], seen[v] = 1;
-    r.vertices_duplicated = stitched.source_vertex.size() - distinct;
-  }
-  std::vector<Point3> outPoints;
-  outPoints.reserve(stitched.source_vertex.size());
-  for (int v : stitched.source_vertex) outPoints.push_back(cut.points[v]);
-  std::vector<Triangle> outTriangles;
-  std::vector<int> outFace;
+  std::vector<char> seen(w.cut.points.size(), 0);
+  std::size_t distinct = 0;
+  for (int v : stitched.source_vertex) distinct += !seen[v], seen[v] = 1;
+  r.vertices_duplicated = stitched.source_vertex.size() - distinct;
+}
+
+// The kept faces on the stitched vertices.
+void assembleOutput(Removal& w) {
+  const Stitched& stitched = w.grown.stitched;
+  w.outPoints.reserve(stitched.source_vertex.size());
+  for (int v : stitched.source_vertex) w.outPoints.push_back(w.cut.points[v]);
+  const std::vector<char>& valid = w.grown.valid;
   for (std::size_t f = 0; f < valid.size(); ++f)
     if (valid[f]) {
-      outTriangles.push_back({stitched.vertex_of_corner[3 * f],
-                              stitched.vertex_of_corner[3 * f + 1],
-                              stitched.vertex_of_corner[3 * f + 2]});
-      outFace.push_back(int(f));
+      w.outTriangles.push_back({stitched.vertex_of_corner[3 * f],
+                                stitched.vertex_of_corner[3 * f + 1],
+                                stitched.vertex_of_corner[3 * f + 2]});
+      w.outFace.push_back(int(f));
     }
-  r.stage_ms.stitching = elapsed();
-  if (options.separate_touching)
-    r.vertices_separated =
-        separateCopies(outPoints, outTriangles, stitched.source_vertex, options.round_to_float);
-  r.stage_ms.separation = elapsed();
-  if (r.inside_out)
-    for (Triangle& t : outTriangles) std::swap(t[1], t[2]);
-  buildMesh(r.mesh, outPoints, outTriangles);
+}
 
-  // Provenance back to the caller's mesh: the split names the vertices and
-  // faces of the welded, pre-treated arrays.
-  VertexOriginHandle cutVertex = vertexOrigins(split.merged);
-  FaceOriginHandle cutFace = faceOrigins(split.merged);
+// Copies of singular vertices moved apart (separate_touching).
+void separateTouching(Removal& w) {
+  if (w.options.separate_touching && !w.outTriangles.empty())
+    w.r.vertices_separated =
+        separateCopies(w.outPoints, w.outTriangles, w.grown.stitched.source_vertex,
+                       w.options.round_to_float, w.options.progress, &w.r.separation_bound_reached);
+}
+
+// The result mesh (turned back if the input was inside out) with its
+// provenance: the split names the vertices and faces of the welded,
+// pre-treated arrays, which name the input's.
+void buildOutput(Removal& w) {
+  SelfIntersectionResult& r = w.r;
+  if (r.inside_out)
+    for (Triangle& t : w.outTriangles) std::swap(t[1], t[2]);
+  buildMesh(r.mesh, w.outPoints, w.outTriangles);
+  VertexOriginHandle cutVertex = vertexOrigins(w.split.merged);
+  FaceOriginHandle cutFace = faceOrigins(w.split.merged);
   auto inputVertex = [&](int v) {
     VertexOrigin o = cutVertex[v];
     o.layer = 0;
-    if (o.vertex >= 0) o.vertex = vertexOrigin[o.vertex];
-    if (o.face >= 0) o.face = faceOrigin[o.face];
+    if (o.vertex >= 0) o.vertex = w.vertexOrigin[o.vertex];
+    if (o.face >= 0) o.face = w.faceOrigin[o.face];
     return o;
   };
-  auto inputFace = [&](int f) { return FaceOrigin{0, faceOrigin[cutFace[f].face]}; };
-  {
-    VertexOriginHandle vo = vertexOrigins(r.mesh);
-    FaceOriginHandle fo = faceOrigins(r.mesh);
-    for (std::size_t v = 0; v < stitched.source_vertex.size(); ++v)
-      vo[v] = inputVertex(stitched.source_vertex[v]);
-    for (std::size_t f = 0; f < outFace.size(); ++f) fo[f] = inputFace(outFace[f]);
-  }
-  if (options.keep_removed && r.faces_removed > 0) {
-    std::vector<int> index(cut.points.size(), -1);
-    std::vector<Point3> points;
-    std::vector<int> source;
-    std::vector<Triangle> triangles;
-    std::vector<int> faces;
-    for (std::size_t f = 0; f < valid.size(); ++f) {
-      if (valid[f]) continue;
-      Triangle t = cut.triangles[f];
-      for (int& v : t) {
-        if (index[v] < 0)
-          index[v] = int(points.size()), points.push_back(cut.points[v]), source.push_back(v);
-        v = index[v];
-      }
-      if (r.inside_out) std::swap(t[1], t[2]);
-      triangles.push_back(t);
-      faces.push_back(int(f));
+  auto inputFace = [&](int f) { return FaceOrigin{0, w.faceOrigin[cutFace[f].face]}; };
+  VertexOriginHandle vo = vertexOrigins(r.mesh);
+  FaceOriginHandle fo = faceOrigins(r.mesh);
+  const std::vector<int>& source = w.grown.stitched.source_vertex;
+  for (std::size_t v = 0; v < source.size(); ++v) vo[v] = inputVertex(source[v]);
+  for (std::size_t f = 0; f < w.outFace.size(); ++f) fo[f] = inputFace(w.outFace[f]);
+  if (!w.options.keep_removed || r.faces_removed == 0) return;
+  // The removed faces, each vertex once.
+  std::vector<int> index(w.cut.points.size(), -1), sourceOf, faces;
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  for (std::size_t f = 0; f < w.grown.valid.size(); ++f) {
+    if (w.grown.valid[f]) continue;
+    Triangle t = w.cut.triangles[f];
+    for (int& v : t) {
+      if (index[v] < 0)
+        index[v] = int(points.size()), points.push_back(w.cut.points[v]), sourceOf.push_back(v);
+      v = index[v];
     }
-    buildMesh(r.removed, points, triangles);
-    VertexOriginHandle vo = vertexOrigins(r.removed);
-    FaceOriginHandle fo = faceOrigins(r.removed);
-    for (std::size_t v = 0; v < source.size(); ++v) vo[v] = inputVertex(source[v]);
-    for (std::size_t f = 0; f < faces.size(); ++f) fo[f] = inputFace(faces[f]);
+    if (r.inside_out) std::swap(t[1], t[2]);
+    triangles.push_back(t);
+    faces.push_back(int(f));
   }
+  buildMesh(r.removed, points, triangles);
+  VertexOriginHandle rvo = vertexOrigins(r.removed);
+  FaceOriginHandle rfo = faceOrigins(r.removed);
+  for (std::size_t v = 0; v < sourceOf.size(); ++v) rvo[v] = inputVertex(sourceOf[v]);
+  for (std::size_t f = 0; f < faces.size(); ++f) rfo[f] = inputFace(faces[f]);
+}
 
-  const TopologyCounts after = topologyOf(Edges(outTriangles), outTriangles, outPoints.size());
-  r.components_after = outTriangles.empty() ? 0 : after.components;
+void measureOutput(Removal& w) {
+  SelfIntersectionResult& r = w.r;
+  const TopologyCounts after =
+      topologyOf(Edges(w.outTriangles), w.outTriangles, w.outPoints.size());
+  r.components_after = w.outTriangles.empty() ? 0 : after.components;
   r.genus_after = after.genus;
   r.border_edges_after = after.border_edges;
   r.non_manifold_edges_after = after.non_manifold_edges;
-  r.output_closed = !outTriangles.empty() && after.border_edges == 0;
-
-  elapsed();
-  if (options.verify && !outTriangles.empty()) {
-    reportProgress(options.progress, 90, "verifying");
-    // The split searched every pair of the mesh it cut, and the faces it
-    // left as they were cross nothing. So only a face that is new, moved
-    // (rounding, separation) or re-connected (a corner on a copied vertex)
-    // can cross anything: every pair with one of those is tested, exactly,
-    // on the coordinates as stored.
-    std::vector<int> copies(cut.points.size(), 0);
-    for (int v : stitched.source_vertex) ++copies[v];
-    std::vector<char> vertexChanged(outPoints.size(), 0);
-    for (std::size_t v = 0; v < outPoints.size(); ++v) {
-      const int c = stitched.source_vertex[v];
-      const int birth = cutVertex[c].vertex;
-      vertexChanged[v] = copies[c] > 1 || birth < 0 || !(outPoints[v] == P[birth]);
-    }
-    std::vector<char> faceChanged(outTriangles.size(), 0);
-    for (std::size_t f = 0; f < outTriangles.size(); ++f) {
-      faceChanged[f] = split.merged_new_face[outFace[f]];
-      for (int v : outTriangles[f]) faceChanged[f] |= vertexChanged[v];
-    }
-    r.remaining_intersecting_pairs =
-        intersectingOf(outPoints, outTriangles,
-                       pairsWithChangedFaces(outPoints, outTriangles, faceChanged))
-            .size();
-    r.verified = true;
-  }
-  r.stage_ms.verify = elapsed();
-  r.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  reportProgress(options.progress, 100, "done");
-  return r;
+  r.output_closed = !w.outTriangles.empty() && after.border_edges == 0;
 }
 
-// How far a result falls short of a valid outer surface: intersecting
-// pairs left, non-manifold edges made. (A closed input with fins may open
-// at them either way: see fin_edges_before.)
+// What the contract asks of a mesh that is stored as `mesh` (float values
+// with asFloat): the failures, one item each; empty when it holds.
+// `closed`: it must have no border edge; `degenerateAllowed`: collinear
+// faces the input brought. Sets remaining/verified when `countPairs`.
+std::vector<std::string> contractFailures(const Mesh& mesh, bool asFloat, bool countPairs,
+                                          bool closed, std::size_t degenerateAllowed,
+                                          const Progress& progress,
+                                          SelfIntersectionResult* counts = nullptr) {
+  std::vector<std::string> failures;
+  if (mesh.fn == 0) {
+    failures.push_back(
+        "no face is outside with respect to the orientation, so nothing would be kept (check "
+        "the orientation: Filters > Normals > Invert Faces Orientation)");
+    return failures;
+  }
+  const InspectResult shape = inspect(mesh);
+  auto fail = [&](std::size_t n, const char* what) {
+    if (n > 0) failures.push_back(std::to_string(n) + " " + what);
+  };
+  if (countPairs) {
+    reportProgress(progress, 92, "checking the result");
+    const std::size_t pairs = selfIntersectingPairs(mesh, asFloat);
+    if (counts) counts->remaining_intersecting_pairs = pairs, counts->verified = true;
+    fail(pairs, "intersecting face pairs are left");
+  }
+  fail(shape.non_manifold_edges, "edges have more than two faces");
+  fail(shape.non_manifold_vertices, "vertices join separate fans of faces");
+  fail(shape.orientation_inconsistent_edges, "edges are run the same way by both their faces");
+  if (closed) fail(shape.border_edges, "border edges opened in a closed mesh");
+  if (shape.degenerate_faces > degenerateAllowed)
+    fail(shape.degenerate_faces - degenerateAllowed, "faces are degenerate (no area) as stored");
+  return failures;
+}
+
+void checkContract(Removal& w) {
+  SelfIntersectionResult& r = w.r;
+  const bool closed = r.input_closed && r.fin_edges_before == 0;
+  r.contract_failures = contractFailures(r.mesh, w.options.round_to_float, w.options.verify, closed,
+                                         w.degenerateIn, w.options.progress, &r);
+  r.contract_met = r.contract_failures.empty();
+}
+
+double millisecondsSince(std::chrono::steady_clock::time_point& lap) {
+  const auto now = std::chrono::steady_clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - lap).count();
+  lap = now;
+  return ms;
+}
+
+SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto lap = start;
+  checkOptions(options);
+  Removal w(input, options);
+  SelfIntersectionResult::StageTimes& ms = w.r.stage_ms;
+  reportProgress(options.progress, 0, "checking the input");
+  readInput(w);
+  millisecondsSince(lap);
+  pretreatInput(w);
+  ms.pretreat = millisecondsSince(lap);
+  boundWork(w);
+  ms.detect = millisecondsSince(lap);
+  cutAlongCurves(w);
+  ms.split = millisecondsSince(lap);
+  growValidRegion(w);
+  ms.growing = millisecondsSince(lap);
+  assembleOutput(w);
+  ms.stitching = millisecondsSince(lap);
+  separateTouching(w);
+  ms.separation = millisecondsSince(lap);
+  buildOutput(w);
+  measureOutput(w);
+  checkContract(w);
+  ms.verify = millisecondsSince(lap);
+  w.r.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::move(w.r);
+}
+
+// How far a result falls short of its contract: the failures, then the
+// intersecting pairs left (fewer is better).
 std::array<std::size_t, 2> shortfall(const SelfIntersectionResult& r) {
-  return {r.verified ? r.remaining_intersecting_pairs : 0,
-          r.non_manifold_edges_after > r.non_manifold_edges_before
-              ? r.non_manifold_edges_after - r.non_manifold_edges_before
-              : 0};
+  return {r.contract_failures.size(), r.remaining_intersecting_pairs};
+}
+
+// Nothing to remove: no pair was cut and the growing kept every face, and
+// the input as it is already meets the contract (an unwelded soup does not:
+// its seams touch). Then the input is the result, exactly as it was.
+bool nothingToRemove(const Mesh& input, const SelfIntersectionResult& r,
+                     const SelfIntersectionOptions& options) {
+  if (r.intersecting_pairs_before > 0 || r.faces_removed > 0 || r.vertices_separated > 0)
+    return false;
+  const InspectResult shape = inspect(input);
+  return contractFailures(input, options.round_to_float, true,
+                          r.input_closed && r.fin_edges_before == 0, shape.degenerate_faces,
+                          options.progress)
+      .empty();
+}
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string s;
+  for (const std::string& item : items) s += (s.empty() ? "" : "; ") + item;
+  return s;
 }
 
 }  // namespace
@@ -255,22 +401,39 @@ std::array<std::size_t, 2> shortfall(const SelfIntersectionResult& r) {
 SelfIntersectionResult removeSelfIntersections(const Mesh& input,
                                                const SelfIntersectionOptions& options) {
   SelfIntersectionResult r = removeOnce(input, options);
+  if (r.contract_met && nothingToRemove(input, r, options)) {
+    r.mesh = input;
+    r.unchanged = true;
+  }
   // Snapping moves the surface near the curves by up to its tolerance:
   // where two sheets lie closer than that (nearly coincident scans), it can
   // carry one through the other, and the growing then passes into the inner
-  // sheet. Without snapping every decision is exact: such a result is made
-  // again without it, and returned instead where it falls short less.
-  if (options.snap_tolerance > 0 && shortfall(r) != std::array<std::size_t, 2>{}) {
+  // sheet. Without snapping every decision is exact: a result that misses
+  // its contract is made again without it, and that one is returned where
+  // it falls short less.
+  if (!r.contract_met && options.snap_tolerance > 0) {
     SelfIntersectionOptions exact = options;
     exact.snap_tolerance = 0;
     SelfIntersectionResult again = removeOnce(input, exact);
     if (shortfall(again) < shortfall(r)) {
       again.snapping_dropped = true;
       again.time_ms += r.time_ms;
-      return again;
+      r = std::move(again);
     }
   }
-  return r;
+  reportProgress(options.progress, 100, "done");
+  if (r.contract_met || options.keep_partial) return r;
+  throw ContractError(
+      "Remove Self-Intersections could not make a valid surface of this mesh: " +
+      joined(r.contract_failures) +
+      ". Nothing was changed. This happens where sheets overlap in a plane or touch along "
+      "edges (solids of a CAD export placed side by side), where the surface passes many "
+      "times through nearly one point, or where rounding to " +
+      std::string(options.round_to_float ? "float" : "double") +
+      " cannot keep nearly coincident faces apart. To try: the layer's parts one at a time "
+      "(Filters > Layer and Mesh > Split in Connected Components), the double host (pymeshlab, "
+      "or MeshLab's double build) where the float one fails, or 'Keep a partial result' to see "
+      "what could be made");
 }
 
 JsonObject toJson(const SelfIntersectionResult& r) {
@@ -305,12 +468,17 @@ JsonObject toJson(const SelfIntersectionResult& r) {
       .set("vertices_duplicated", r.vertices_duplicated)
       .set("vertices_separated", r.vertices_separated)
       .set("edges_duplicated", r.edges_duplicated)
-      .set("snapping_dropped", r.snapping_dropped);
+      .set("snapping_dropped", r.snapping_dropped)
+      .set("contract_met", r.contract_met)
+      .set("contract_failures", r.contract_failures)
+      .set("unchanged", r.unchanged)
+      .set("verified", r.verified);
   if (r.verified) j.set("remaining_intersecting_pairs", r.remaining_intersecting_pairs);
   j.set("time_ms", r.time_ms);
   const auto& t = r.stage_ms;
   j.set("stage_ms", JsonObject()
                         .set("pretreat", t.pretreat)
+                        .set("detect", t.detect)
                         .set("split", t.split)
                         .set("growing", t.growing)
                         .set("stitching", t.stitching)

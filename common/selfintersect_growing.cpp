@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <numeric>
 
@@ -414,6 +415,14 @@ class ValidRegionGrowing {
 
 }  // namespace
 
+namespace {
+// Thrown inside separateCopies when its exact tests reach their bound.
+struct SeparationBoundReached {};
+// The bound: about a second of exact tests where the moving copies' faces
+// lie among many others (the real meshes take a few thousand).
+constexpr std::size_t kMaxSeparationTests = 2000000;
+}  // namespace
+
 Grown growAndStitch(const std::vector<Point3>& P, const std::vector<Triangle>& T,
                     const std::vector<char>& newFace, std::vector<TrianglePoints> births,
                     const Progress& progress) {
@@ -437,8 +446,10 @@ Grown growAndStitch(const std::vector<Point3>& P, const std::vector<Triangle>& T
 // With `asFloat` the moved positions are rounded to float (as stored).
 // Returns the copies left moved.
 std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& T,
-                           const std::vector<int>& source, bool asFloat) {
+                           const std::vector<int>& source, bool asFloat, const Progress& progress,
+                           bool* boundReached) {
   constexpr double kSeparation = 1e-3;
+  *boundReached = false;
   std::vector<int> copies(*std::max_element(source.begin(), source.end()) + 1, 0);
   for (int s : source) ++copies[s];
   std::vector<Point3> normal(P.size(), Point3(0, 0, 0)), centroid(P.size(), Point3(0, 0, 0));
@@ -500,32 +511,49 @@ std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& 
     if (aroundMoving[f])
       for (int v : T[f])
         if (isMoving[v]) around[v].push_back(std::uint32_t(f));
-  auto crossings = [&](int v) {
+  // The crossings of v's faces, counted up to `limit` (a position that
+  // reaches the best so far is out), against the work bound.
+  std::size_t tests = 0;
+  auto crossings = [&](int v, std::size_t limit) {
     std::size_t n = 0;
     for (std::uint32_t f : around[v])
-      for (std::uint32_t g : others[reachIndex[f]]) n += facesIntersect(P, T, f, g);
+      for (std::uint32_t g : others[reachIndex[f]]) {
+        if (n >= limit) return n;
+        if (++tests > kMaxSeparationTests) throw SeparationBoundReached();
+        n += facesIntersect(P, T, f, g);
+      }
     return n;
   };
   // One copy at a time, against the others where they are now: the first
   // step that leaves its faces crossing nothing, else the one that crosses
   // least if it beats home. Two sweeps: a copy that had to stay home may
-  // move once its twin has.
-  for (int sweep = 0; sweep < 2; ++sweep)
-    for (int v : moving) {
-      const Point3 home = steps[v].back();
-      if (sweep == 1 && !(P[v] == home)) continue;
-      P[v] = home;
-      Point3 best = home;
-      std::size_t fewest = crossings(v);
-      if (fewest == 0) continue;
-      for (const Point3& q : steps[v]) {
-        P[v] = q;
-        const std::size_t n = crossings(v);
-        if (n < fewest) best = q, fewest = n;
-        if (n == 0) break;
+  // move once its twin has. Past the work bound, the copies not yet tried
+  // stay home (the contract check counts what they touch).
+  ProgressSpan span(progress, 84, 88, 2 * moving.size(), "separating touching sheets");
+  int current = -1;  // the copy being placed, and its best position so far
+  Point3 best(0, 0, 0);
+  try {
+    for (int sweep = 0; sweep < 2; ++sweep)
+      for (std::size_t i = 0; i < moving.size(); ++i) {
+        span.step(sweep * moving.size() + i);
+        const int v = current = moving[i];
+        const Point3 home = steps[v].back();
+        if (sweep == 1 && !(P[v] == home)) continue;
+        P[v] = best = home;
+        std::size_t fewest = crossings(v, SIZE_MAX);
+        if (fewest == 0) continue;
+        for (const Point3& q : steps[v]) {
+          P[v] = q;
+          const std::size_t n = crossings(v, fewest);
+          if (n < fewest) best = q, fewest = n;
+          if (n == 0) break;
+        }
+        P[v] = best;
       }
-      P[v] = best;
-    }
+  } catch (const SeparationBoundReached&) {
+    P[current] = best;  // the moves made stay
+    *boundReached = true;
+  }
   std::size_t moved = 0;
   for (int v : moving) moved += !(P[v] == steps[v].back());
   return moved;

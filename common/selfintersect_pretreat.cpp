@@ -329,8 +329,10 @@ void requireConsistentOrientation(const Edges& edges, const std::vector<Triangle
   throw TopologyError(
       "the mesh is not consistently oriented: on " + std::to_string(bad) +
       " edges (e.g. between vertices " + std::to_string(use.u) + " and " + std::to_string(use.v) +
-      ") neighbouring faces run the same way, so inside and outside are undefined there. Run "
-      "Filters > Normals, Curvatures and Orientation > \"Re-Orient all faces coherently\" first.");
+      ") neighbouring faces run the same way, so inside and outside are undefined there; the "
+      "layer is unchanged. Orient the faces first: MeshMend: Close Gaps Between Borders does it "
+      "('Orient faces consistently', on by default, turns closed parts outward), as does Filters > "
+      "Normals, Curvatures and Orientation > \"Re-Orient all faces coherently\".");
 }
 
 double signedVolume(const std::vector<Point3>& P, const std::vector<Triangle>& T) {

@@ -122,8 +122,10 @@ Grown growAndStitch(const std::vector<Point3>& P, const std::vector<Triangle>& T
                     const Progress& progress);
 
 // Moves the coincident copies that stitching made apart (see the .cpp);
-// returns the copies left moved.
+// returns the copies left moved. Its exact tests have a work bound: past it
+// the copies not yet placed stay home and `boundReached` is set.
 std::size_t separateCopies(std::vector<Point3>& P, const std::vector<Triangle>& T,
-                           const std::vector<int>& source, bool asFloat);
+                           const std::vector<int>& source, bool asFloat, const Progress& progress,
+                           bool* boundReached);
 
 }  // namespace meshmend::selfintersect
