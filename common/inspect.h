@@ -64,7 +64,7 @@ struct InspectResult {
   double min_angle_deg = 180;     // smallest interior angle
   double mean_min_angle_deg = 0;  // mean over triangles of their smallest angle
   // With the self_intersections option (the rule of CGAL's self_intersections,
-  // as in intersections.h); empty otherwise or with non-finite coordinates.
+  // as in intersections.h); empty otherwise, without faces or with non-finite coordinates.
   std::optional<std::size_t> self_intersecting_pairs;
   std::optional<std::size_t> self_intersecting_faces;
   double time_ms = 0;                        // compute time of inspect()
