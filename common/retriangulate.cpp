@@ -46,7 +46,7 @@ int compareMeasures(double before, double after, const std::array<const ExactPoi
 // allocates only its output.
 class Retriangulator {
  public:
-  Patch run(const PatchInput& in) {
+  RetriangulatedPatch run(const PatchInput& in) {
     reset(in);
     return triangulate(in);
   }
@@ -77,8 +77,8 @@ class Retriangulator {
     T_.push_back({0, 1, 2});
   }
 
-  Patch triangulate(const PatchInput& in) {
-    Patch out;
+  RetriangulatedPatch triangulate(const PatchInput& in) {
+    RetriangulatedPatch out;
     out.vertex_of_input.reserve(3 + in.points.size());
     out.vertex_of_input = {0, 1, 2};
     if (!in.on_edges.empty() && in.on_edges.size() != in.points.size())
@@ -688,7 +688,7 @@ int onlyEdge(std::uint8_t bits) {
 // so the triangles are the same. Every triangle is proper: no three of
 // these points are collinear. False (and `out` untouched) when the input is
 // not of that shape.
-bool cutCorner(const PatchInput& in, Patch& out) {
+bool cutCorner(const PatchInput& in, RetriangulatedPatch& out) {
   if (!in.improve || in.points.size() != 2 || in.on_edges.size() != 2 || in.segments.size() != 1)
     return false;
   const std::array<int, 2> s = in.segments[0];
@@ -733,8 +733,8 @@ bool cutCorner(const PatchInput& in, Patch& out) {
 
 }  // namespace
 
-Patch retriangulate(const PatchInput& input) {
-  Patch patch;
+RetriangulatedPatch retriangulate(const PatchInput& input) {
+  RetriangulatedPatch patch;
   if (cutCorner(input, patch)) return patch;
   thread_local Retriangulator workspace;
   return workspace.run(input);

@@ -35,7 +35,10 @@ struct PatchInput {
   std::size_t max_exact_evaluations = 20000;
 };
 
-struct Patch {
+// Named apart from patches.h's Patch: two classes of one name in one
+// namespace break the one-definition rule (the booleans fuzz target found
+// std::vector<Patch> of one used with the other's layout).
+struct RetriangulatedPatch {
   // Vertices: the corners, then the distinct input points, then crossings of
   // constraints (new points).
   std::vector<ExactPoint> vertices;
@@ -49,7 +52,7 @@ struct Patch {
 // on it, or a segment index is out of range; WorkLimitError past
 // max_exact_evaluations. Safe to call from several
 // threads at once: each thread keeps its own working storage between calls,
-// so that a patch in steady state allocates only the returned Patch.
-Patch retriangulate(const PatchInput& input);
+// so that a patch in steady state allocates only the returned RetriangulatedPatch.
+RetriangulatedPatch retriangulate(const PatchInput& input);
 
 }  // namespace meshmend

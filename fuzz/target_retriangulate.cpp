@@ -38,7 +38,7 @@ void addContact(const TrianglePoints& t, const TrianglePoints& other, PatchInput
     for (int i = 0; i < n; ++i) input.segments.push_back({first + i, first + (i + 1) % n});
 }
 
-void checkPatch(const PatchInput& input, const Patch& patch, int axis) {
+void checkPatch(const PatchInput& input, const RetriangulatedPatch& patch, int axis) {
   const std::size_t inputs = 3 + input.points.size();
   const int nv = int(patch.vertices.size());
   check(patch.vertex_of_input.size() == inputs, "one vertex per input point");
@@ -90,7 +90,7 @@ void retriangulateTriangle(const std::uint8_t* data, std::size_t size) {
     if (flags & (2 << i % 4)) other[0] = t[i % 3];
     if (usable(other)) addContact(t, other, input);
   }
-  Patch patch;
+  RetriangulatedPatch patch;
   try {
     patch = retriangulate(input);
   } catch (const InvalidInputError& e) {
