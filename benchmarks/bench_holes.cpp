@@ -1,17 +1,20 @@
-// bench_holes [--repeat N] [--limit S] [--methods a,b,...] [--out-dir DIR] FILE:
+// bench_holes [--repeat N] [--limit S] [--threads N] [--methods a,b,...] [--out-dir DIR] FILE:
 // hole filling, ours against CGAL 5.5 and MeshLab's own "Close Holes" on the
 // same holes in the same run. Fills every hole of FILE. Prints one JSON object.
 //
 // Methods:
 //   meshmend_biharmonic   ours, fillHoles with the default options (the
-//                         biharmonic shape)
+//                         biharmonic shape), on --threads threads (default 1)
+//   meshmend_biharmonic_all_cores
+//                         the same on every CPU the process may use
 //   meshmend_regression, meshmend_harmonic, meshmend_flat
 //                         ours with the other patch shapes (regression: the
 //                         paper's LS-SVM Laplacian regression)
 //   cgal_refine_fair      PMP::triangulate_refine_and_fair_hole on each border
 //                         cycle (defaults: Delaunay search space, fairing
 //                         continuity 1), on a Surface_mesh copy; only the calls
-//                         are timed (the cycles are found beforehand)
+//                         are timed (the cycles are found beforehand); one
+//                         thread (CGAL's hole filling has no parallel code)
 //   meshlab_close_holes   the work of MeshLab 2020.09's filter "Close Holes"
 //                         (meshfilter.cpp, FP_CLOSE_HOLES with its default
 //                         "prevent self-intersections"): face-face adjacency,
@@ -21,14 +24,15 @@
 //                         compiled here from the same vcglib headers
 //
 // Each method runs in child processes (benchmarks/harness.h). A first child
-// fills one copy, timing the call by hand, and writes the filled mesh
-// (DIR/<method>.ply for ours, .off for the peers) and a report
-// (DIR/<method>.json: faces added, ours' full HoleFillResult, the first run's
-// time) outside the clock; the harness then times N runs on copies made
-// beforehand, so that copying the input is never timed. A method whose first
-// run takes over 10 s is not repeated. Ours' report adds the medians of its
-// own per-hole and per-stage times over N more fills. Without --out-dir
-// nothing is written and only the times are printed.
+// loads the input, then copies and fills it once, timing the fill by hand:
+// its peak memory (the input, its copy and the fill; the harness resets the
+// peak once the input is loaded) is the method's. The harness then times N
+// runs on copies made beforehand, so that copying the input is never timed.
+// A method whose first run takes over 10 s is not repeated. With --out-dir,
+// a last child writes the filled mesh (DIR/<method>.ply for ours, .off for
+// the peers) and a report (DIR/<method>.json: faces added, ours' full
+// HoleFillResult, and for ours the medians of its own per-hole and
+// per-stage times over N more fills).
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
@@ -51,6 +55,7 @@
 #include "benchmarks/harness.h"
 #include "common/holes.h"
 #include "common/mesh_io.h"
+#include "common/parallel.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
@@ -129,30 +134,47 @@ struct Filler {
   std::function<void(M&, long faces, double ms, const std::string& stem)> write;
 };
 
-// The two harness passes of one method (see the file comment). `stem` is
-// DIR/<method>, empty when nothing is written. The first pass returns its
-// run's time in microseconds as its result, which is how the parent learns it.
+// The harness passes of one method (see the file comment): the first run
+// (its result the fill's time in microseconds, which is how the parent
+// learns it), the timed runs, and the writing of the outputs (`stem` is
+// DIR/<method>; no pass when it is empty).
+struct Passes {
+  Method first, timed, write;
+  bool writes = false;
+};
+
 template <class M>
-std::pair<Method, Method> passes(const std::string& name, const std::string& role,
-                                 const Filler<M>& f, const std::string& stem, int repeat) {
-  Method first{name, role, [=] {
-                 auto input = std::make_shared<M>(f.load());
-                 return std::function<long()>([=] {
-                   M copy = *input;
-                   const auto t0 = std::chrono::steady_clock::now();
-                   const long faces = f.fill(copy);
-                   const double ms = msSince(t0);
-                   if (!stem.empty()) f.write(copy, faces, ms, stem);
-                   return long(ms * 1000);
-                 });
-               }};
-  Method timed{name, role, [=] {
-                 auto input = std::make_shared<M>(f.load());
-                 auto copies = std::make_shared<std::vector<M>>(std::size_t(repeat), *input);
-                 auto next = std::make_shared<std::size_t>(0);
-                 return std::function<long()>([=] { return f.fill((*copies)[(*next)++]); });
-               }};
-  return {first, timed};
+Passes passes(const std::string& name, const std::string& role, const Filler<M>& f,
+              const std::string& stem, int repeat) {
+  Passes p;
+  p.first = {name, role, [=] {
+               auto input = std::make_shared<M>(f.load());
+               return std::function<long()>([=] {
+                 M copy = *input;
+                 const auto t0 = std::chrono::steady_clock::now();
+                 f.fill(copy);
+                 return long(msSince(t0) * 1000);
+               });
+             }};
+  p.timed = {name, role, [=] {
+               auto input = std::make_shared<M>(f.load());
+               auto copies = std::make_shared<std::vector<M>>(std::size_t(repeat), *input);
+               auto next = std::make_shared<std::size_t>(0);
+               return std::function<long()>([=] { return f.fill((*copies)[(*next)++]); });
+             }};
+  p.writes = !stem.empty();
+  p.write = {name, role, [=] {
+               auto input = std::make_shared<M>(f.load());
+               return std::function<long()>([=] {
+                 M copy = *input;
+                 const auto t0 = std::chrono::steady_clock::now();
+                 const long faces = f.fill(copy);
+                 const double ms = msSince(t0);
+                 f.write(copy, faces, ms, stem);
+                 return faces;
+               });
+             }};
+  return p;
 }
 
 // Ours keeps the result of its fill for the report.
@@ -293,7 +315,7 @@ std::vector<std::string> splitList(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 5, limit = 600;
+  int repeat = 5, limit = 600, threads = 1;
   std::string outDir, file;
   bool bad = false;
   std::vector<std::string> names = {"meshmend_biharmonic", "meshmend_regression",
@@ -304,6 +326,8 @@ int main(int argc, char** argv) {
       repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
       limit = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      threads = std::max(0, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--methods") && i + 1 < argc)
       names = splitList(argv[++i]);
     else if (!std::strcmp(argv[i], "--out-dir") && i + 1 < argc)
@@ -315,48 +339,64 @@ int main(int argc, char** argv) {
   }
   if (bad || file.empty()) {
     std::fprintf(stderr,
-                 "usage: bench_holes [--repeat N] [--limit SECONDS] [--methods a,b,...] "
-                 "[--out-dir DIR] FILE\n");
+                 "usage: bench_holes [--repeat N] [--limit SECONDS] [--threads N (0: all)] "
+                 "[--methods a,b,...] [--out-dir DIR] FILE\n");
     return 1;
   }
   std::vector<JsonObject> results;
   for (const std::string& name : names) {
     const std::string stem = outDir.empty() ? "" : outDir + "/" + name;
-    std::pair<Method, Method> p;
+    // Ours on the threads asked for (all of them for *_all_cores); the
+    // peers use one whatever this says.
+    setThreadCount(name == "meshmend_biharmonic_all_cores" ? 0 : unsigned(threads));
+    const unsigned used = name.rfind("meshmend", 0) == 0 ? workerCount() : 1;
+    auto run = [&](auto p) {
+      const Measurement first = measure(p.first, 1, limit);
+      Measurement m = first;
+      if (first.ok) {
+        const double firstMs = double(first.result) / 1000;
+        if (firstMs <= kSlowMs && repeat > 1) {
+          m = measure(p.timed, repeat, limit);
+        } else {          // too slow to repeat: the first run's own clock
+          m.result = -1;  // faces added: in the report
+          m.times_ms = {firstMs};
+          m.median_ms = m.min_ms = firstMs;
+        }
+      }
+      JsonObject j = toJson(m);
+      if (first.ok)
+        j.set("first_run_ms", double(first.result) / 1000)
+            .set("first_peak_rss_mb", first.peak_rss_mb);
+      else if (m.ok)
+        j.set("ok", false).set("error", first.error);
+      j.set("threads", long(used));
+      if (p.writes && first.ok) {
+        const Measurement w = measure(p.write, 1, limit);
+        if (w.ok)
+          j.set("output", stem + (name.rfind("meshmend", 0) == 0 ? ".ply" : ".off"))
+              .set("report", stem + ".json");
+      }
+      return j;
+    };
+    JsonObject j;
     if (name == "meshmend_regression")
-      p = passes(name, "alternative", ours(file, HoleFairing::LaplacianRegression, repeat), stem,
-                 repeat);
-    else if (name == "meshmend_biharmonic")
-      p = passes(name, "ours", ours(file, HoleFairing::Biharmonic, repeat), stem, repeat);
+      j = run(passes(name, "alternative", ours(file, HoleFairing::LaplacianRegression, repeat),
+                     stem, repeat));
+    else if (name == "meshmend_biharmonic" || name == "meshmend_biharmonic_all_cores")
+      j = run(passes(name, name == "meshmend_biharmonic" ? "ours" : "alternative",
+                     ours(file, HoleFairing::Biharmonic, repeat), stem, repeat));
     else if (name == "meshmend_harmonic")
-      p = passes(name, "alternative", ours(file, HoleFairing::Harmonic, repeat), stem, repeat);
+      j = run(passes(name, "alternative", ours(file, HoleFairing::Harmonic, repeat), stem, repeat));
     else if (name == "meshmend_flat")
-      p = passes(name, "alternative", ours(file, HoleFairing::Flat, repeat), stem, repeat);
+      j = run(passes(name, "alternative", ours(file, HoleFairing::Flat, repeat), stem, repeat));
     else if (name == "cgal_refine_fair")
-      p = passes(name, "peer", cgal(file), stem, repeat);
+      j = run(passes(name, "peer", cgal(file), stem, repeat));
     else if (name == "meshlab_close_holes")
-      p = passes(name, "peer", meshlab(file), stem, repeat);
+      j = run(passes(name, "peer", meshlab(file), stem, repeat));
     else {
       std::fprintf(stderr, "unknown method %s\n", name.c_str());
       return 1;
     }
-    const Measurement first = measure(p.first, 1, limit);
-    Measurement m = first;
-    if (first.ok) {
-      const double firstMs = double(first.result) / 1000;
-      if (firstMs <= kSlowMs && repeat > 1) {
-        m = measure(p.second, repeat, limit);
-      } else {          // too slow to repeat: the first run's own clock
-        m.result = -1;  // faces added: in the report
-        m.times_ms = {firstMs};
-        m.median_ms = m.min_ms = firstMs;
-      }
-    }
-    JsonObject j = toJson(m);
-    if (first.ok) j.set("first_run_ms", double(first.result) / 1000);
-    if (!stem.empty() && first.ok)
-      j.set("output", stem + (name.rfind("meshmend", 0) == 0 ? ".ply" : ".off"))
-          .set("report", stem + ".json");
     results.push_back(j);
     std::fprintf(stderr, "  %-22s %s\n", name.c_str(), j.str().c_str());
   }

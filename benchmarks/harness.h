@@ -26,7 +26,11 @@ struct Measurement {
   long result = 0;
   std::vector<double> times_ms;
   double median_ms = 0, min_ms = 0;
-  double peak_rss_mb = 0;      // the child's peak resident memory
+  // The child's peak resident memory while the timed runs ran (its
+  // prepared inputs included): the kernel's peak is reset once the inputs
+  // are made (/proc/self/clear_refs), so that reading the input files does
+  // not count; where that is refused, the process's peak since it started.
+  double peak_rss_mb = 0;
   double baseline_rss_mb = 0;  // after preparing, before the timed work
   // Pages a timed run touched for the first time (minor page faults; the
   // median run): after the first runs, memory the allocator had given back

@@ -43,6 +43,7 @@ DATA = ROOT.parent / "shared" / "data"
 MESHES = ["spot.obj", "fandisk.obj", "armadillo.off", "igea.ply", "horse.ply"]
 OURS = ["meshmend_biharmonic", "meshmend_regression", "meshmend_harmonic", "meshmend_flat"]
 DEFAULT = OURS[0]  # what fillHoles does with its default options
+ALL_CORES = "meshmend_biharmonic_all_cores"  # the same on every CPU
 DEFAULT_FAIRING = "biharmonic"
 MODE_LABEL = {"meshmend_biharmonic": "ours: biharmonic (default)",
               "meshmend_regression": "ours: regression", "meshmend_harmonic": "ours: harmonic",
@@ -474,8 +475,10 @@ class Tools:
         return json.loads(out)
 
     def bench(self, path, repeat, out_dir, methods=None, limit=600):
+        """bench_holes on one file, ours on one thread (as CGAL and MeshLab
+        run), and ours on every CPU as meshmend_biharmonic_all_cores."""
         cmd = [str(self.bench_holes), "--repeat", str(repeat), "--limit", str(limit),
-               "--out-dir", str(out_dir)]
+               "--threads", "1", "--out-dir", str(out_dir)]
         if methods:
             cmd += ["--methods", ",".join(methods)]
         out = subprocess.run(cmd + [str(path)], capture_output=True, text=True, check=True).stdout
@@ -589,10 +592,15 @@ def fill_and_measure(tools, hole, repeat):
     hV, hF = read_mesh(holed)
     results = {}
     # Ours (each shape), CGAL and MeshLab's ear cutting, timed in one run.
-    timing = tools.bench(holed, repeat, d)
+    timing = tools.bench(holed, repeat, d, OURS + [ALL_CORES, "cgal_refine_fair",
+                                                   "meshlab_close_holes"])
+    t = timing[ALL_CORES]
+    results[ALL_CORES] = {"ok": t["ok"], "ms": t.get("median_ms"), "threads": t.get("threads"),
+                          "peak_mb": t.get("first_peak_rss_mb"), "error": t.get("error")}
     for m in OURS:
         t = timing[m]
-        results[m] = {"ok": t["ok"], "ms": t.get("median_ms"), "error": t.get("error")}
+        results[m] = {"ok": t["ok"], "ms": t.get("median_ms"), "error": t.get("error"),
+                      "peak_mb": t.get("first_peak_rss_mb"), "threads": t.get("threads")}
         if t["ok"]:
             report = json.loads((d / f"{m}.json").read_text())
             h = report["holes"][0] if report["holes"] else {}
@@ -609,6 +617,7 @@ def fill_and_measure(tools, hole, repeat):
     rf = peer["refine_fair"]
     t = timing["cgal_refine_fair"]
     results["cgal"] = {"ok": "error" not in rf and rf.get("filled") == 1, "ms": t.get("median_ms"),
+                       "peak_mb": t.get("first_peak_rss_mb"), "threads": t.get("threads"),
                        "error": rf.get("error") or t.get("error"),
                        "fair_ok": rf.get("holes", [{}])[0].get("fair_ok"),
                        "peer_ms": rf.get("total_ms")}
@@ -632,6 +641,7 @@ def fill_and_measure(tools, hole, repeat):
         time.sleep(2)
     t = timing["meshlab_close_holes"]
     results["meshlab"] = {"ok": proc.returncode == 0, "ms": t.get("median_ms"),
+                          "peak_mb": t.get("first_peak_rss_mb"),
                           "error": None if proc.returncode == 0 else
                           f"exit {proc.returncode}: {(proc.stdout + proc.stderr)[-300:]}"}
     if proc.returncode == 0:
@@ -736,11 +746,14 @@ def sphere_hole(work, n=152, target=1000):
             "n": n}
 
 
-def speed_row(name, border_edges, faces, ours, cgal, meshlab, hole_ms):
-    """One row of the speed table: each method's median (None: failed) or error."""
-    cell = lambda t: (t["median_ms"] if t.get("ok") else None, t.get("error"))
+def speed_row(name, border_edges, faces, ours, cgal, meshlab, hole_ms, all_cores=None):
+    """One row of the speed table: each method's median (None: failed) or
+    error, and its peak memory."""
+    cell = lambda t: (t["median_ms"] if t.get("ok") else None, t.get("error"),
+                      t.get("first_peak_rss_mb"), t.get("threads"))
     return {"name": name, "border_edges": border_edges, "faces": faces, "ours": cell(ours),
-            "cgal": cell(cgal), "meshlab": cell(meshlab), "hole_ms": hole_ms}
+            "cgal": cell(cgal), "meshlab": cell(meshlab), "hole_ms": hole_ms,
+            "all_cores": cell(all_cores or {})}
 
 
 def speed(tools, repeat, work, fidelity_holes):
@@ -754,7 +767,7 @@ def speed(tools, repeat, work, fidelity_holes):
                   check["longest_border_loop"] == h["border_edges"] and
                   check["connected_components"] == 1)
     timing = tools.bench(d / "holed.off", repeat, d,
-                         [DEFAULT, "cgal_refine_fair", "meshlab_close_holes"])
+                         [DEFAULT, ALL_CORES, "cgal_refine_fair", "meshlab_close_holes"])
     hV, hF = read_mesh(d / "holed.off")
     h["timing"] = timing
     h["report"] = json.loads((d / f"{DEFAULT}.json").read_text())
@@ -764,15 +777,18 @@ def speed(tools, repeat, work, fidelity_holes):
         h["cgal"] = measure_output(tools, h, hV, hF, "cgal", d / "cgal_refine_fair.off")
     h["rows"] = [speed_row("sphere, 1,000-edge hole", h["border_edges"], h["faces"],
                            timing[DEFAULT], timing["cgal_refine_fair"],
-                           timing["meshlab_close_holes"], h["report"]["median_holes_ms"])]
+                           timing["meshlab_close_holes"], h["report"]["median_holes_ms"],
+                           timing[ALL_CORES])]
     for f in fidelity_holes:
         if f["label"] == "round L":
             r = f["results"]
             as_timing = lambda x: {"ok": x.get("ms") is not None, "median_ms": x.get("ms"),
-                                   "error": x.get("error")}
+                                   "error": x.get("error"), "first_peak_rss_mb": x.get("peak_mb"),
+                                   "threads": x.get("threads")}
             h["rows"].append(speed_row(f"{f['mesh']} {f['label']}", f["border_edges"], f["faces"],
                                        as_timing(r[OURS[0]]), as_timing(r["cgal"]),
-                                       as_timing(r["meshlab"]), r[OURS[0]].get("hole_ms")))
+                                       as_timing(r["meshlab"]), r[OURS[0]].get("hole_ms"),
+                                       as_timing(r[ALL_CORES])))
     return h
 
 
@@ -920,35 +936,80 @@ def tables(holes, sp, repeat, machine, elapsed):
                 f"Ours fell back to a flatter shape on {len(fallbacks)} "
                 f"({', '.join(fallbacks) or 'none'}).",
                 ""]
-    # Times of the fidelity holes.
+    # Times of the fidelity holes: ours against CGAL, one thread each.
+    def threads_of(key):
+        used = {h["results"][key].get("threads") for h in holes} - {None}
+        return ", ".join(str(t) for t in sorted(used)) or "?"
+
+    def fmt_mb(mb):
+        return "–" if mb is None else f"{mb:,.0f}"
+
     out += [f"Times of the fidelity holes (ms, medians of {repeat} runs of `bench_holes` in child "
-            "processes, the input copied beforehand). Ours: `fillHoles` on the whole holed mesh, "
-            "which includes finding the border and writing the patch into the mesh, two passes "
-            "over the whole mesh; *hole only* is the hole's own time in our report (split, "
-            f"patch, shape, exact check; median of {repeat} more fills). CGAL: the `triangulate_refine_and_fair_hole` "
-            "call alone, the border cycle found beforehand. MeshLab: what its filter runs "
-            "(face-face adjacency, the non-manifold check, vcglib's "
-            "`EarCuttingIntersectionFill` with `SelfIntersectionEar`), compiled from the same "
-            "vcglib 2020.09 on a float mesh like MeshLab's; the faces it adds match those of "
-            "`meshlabserver` above" +
-            ("" if all("vcglib_faces_differ" not in h["results"]["meshlab"] for h in holes)
-             else " except where marked ≠") + ".",
+            "processes, the input copied beforehand), **ours on "
+            f"{threads_of(DEFAULT)} thread and CGAL on {threads_of('cgal')} thread** "
+            "(`bench_holes --threads 1`; CGAL's hole filling has no parallel code). Ours: "
+            "`fillHoles` on the whole holed mesh with its default options (finding the borders, "
+            "gathering the faces around the holes, writing the patch into the mesh included); "
+            f"*hole only* is the hole's own time in our report (median of {repeat} more fills). "
+            "CGAL: the `triangulate_refine_and_fair_hole` call alone, the border cycle found "
+            "beforehand. *Peak MB*: the peak resident memory of a child that holds the input, "
+            "copies it and fills the copy once (the peak reset once the input is read, so that "
+            "reading the file does not count). *Faces*: the patch's faces over the faces that "
+            "were cut out.",
             "",
-            "| hole | faces | " + " | ".join(MODE_LABEL[m] for m in OURS) +
-            " | ours: hole only | CGAL | MeshLab | CGAL / ours | CGAL / ours (hole only) |",
-            "|---|---:|" + "---:|" * (len(OURS) + 5)]
+            "| hole | mesh faces | ours ms | ours peak MB | CGAL ms | CGAL peak MB | CGAL / ours | "
+            "ours: hole only | ours faces / removed | CGAL faces / removed |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for h in holes:
         res = h["results"]
         o, c = res[OURS[0]], res["cgal"]
         ratio = f"{c['ms'] / o['ms']:.1f}×" if o.get("ms") and c.get("ms") else "–"
-        ratio_hole = (f"{c['ms'] / o['hole_ms']:.1f}×" if o.get("hole_ms") and c.get("ms")
-                      else "–")
+        faces = lambda r: (f"{r['patch_faces'] / h['removed_faces']:.2f}"
+                           if r.get("patch_faces") else "–")
+        out.append(f"| {h['mesh']} {h['label']} | {h['faces']:,} | {fmt_ms(o.get('ms'))} | "
+                   f"{fmt_mb(o.get('peak_mb'))} | {fmt_ms(c.get('ms'))} | "
+                   f"{fmt_mb(c.get('peak_mb'))} | {ratio} | {fmt_ms(o.get('hole_ms'))} | "
+                   f"{faces(o)} | {faces(c)} |")
+    n = len(holes)
+    faster = [h for h in holes if h["results"][OURS[0]].get("ms") and h["results"]["cgal"].get("ms")
+              and h["results"]["cgal"]["ms"] >= 3 * h["results"][OURS[0]]["ms"]]
+    lighter = [h for h in holes if h["results"][OURS[0]].get("peak_mb") is not None and
+               h["results"]["cgal"].get("peak_mb") is not None and
+               h["results"][OURS[0]]["peak_mb"] <= h["results"]["cgal"]["peak_mb"]]
+    dense = [h for h in holes if h["results"][OURS[0]].get("patch_faces") and
+             1 / 1.5 <= h["results"][OURS[0]]["patch_faces"] / h["removed_faces"] <= 1.5]
+    ratios = sorted(h["results"]["cgal"]["ms"] / h["results"][OURS[0]]["ms"] for h in holes
+                    if h["results"][OURS[0]].get("ms") and h["results"]["cgal"].get("ms"))
+    out += ["",
+            f"**Against issue 43's targets** (one thread each): ours at least 3× faster than "
+            f"CGAL on **{len(faster)} of {n} holes** (CGAL / ours from "
+            f"{ratios[0]:.1f}× to {ratios[-1]:.1f}×, median {ratios[len(ratios) // 2]:.1f}×; "
+            "target: all 22); peak memory at most CGAL's on "
+            f"**{len(lighter)} of {n}**; patch within 1.5× of the removed faces (either way) on "
+            f"**{len(dense)} of {n}**; at least as accurate as CGAL by mean distance on "
+            f"**{share['mean']} of {n}** and by maximum distance on **{share['max']} of {n}** "
+            "(before this issue: 18 and 17).",
+            ""]
+    # The other shapes, MeshLab, and ours on every CPU.
+    out += [f"The other shapes of ours (1 thread), ours on every CPU "
+            f"({threads_of(ALL_CORES)} threads), and MeshLab's Close Holes (its filter's work: "
+            "face-face adjacency, the non-manifold check, vcglib's `EarCuttingIntersectionFill` "
+            "with `SelfIntersectionEar`, compiled from the same vcglib 2020.09 on a float mesh "
+            "like MeshLab's; the faces it adds match those of `meshlabserver` above" +
+            ("" if all("vcglib_faces_differ" not in h["results"]["meshlab"] for h in holes)
+             else " except where marked ≠") + "), ms:",
+            "",
+            "| hole | " + " | ".join(MODE_LABEL[m] for m in OURS) +
+            f" | ours, {threads_of(ALL_CORES)} threads | MeshLab | MeshLab peak MB |",
+            "|---|" + "---:|" * (len(OURS) + 3)]
+    for h in holes:
+        res = h["results"]
         ml = fmt_ms(res["meshlab"].get("ms")) + (" ≠" if "vcglib_faces_differ" in res["meshlab"]
                                                  else "")
-        out.append(f"| {h['mesh']} {h['label']} | {h['faces']:,} | " +
+        out.append(f"| {h['mesh']} {h['label']} | " +
                    " | ".join(fmt_ms(res[m].get("ms")) for m in OURS) +
-                   f" | {fmt_ms(o.get('hole_ms'))} | {fmt_ms(c.get('ms'))} | {ml} | {ratio} | "
-                   f"{ratio_hole} |")
+                   f" | {fmt_ms(res[ALL_CORES].get('ms'))} | {ml} | "
+                   f"{fmt_mb(res['meshlab'].get('peak_mb'))} |")
     # Speed.
     once = any(len(t.get("times_ms", [])) == 1 for t in sp["timing"].values()) and repeat > 1
     out += ["",
@@ -957,21 +1018,23 @@ def tables(holes, sp, repeat, machine, elapsed):
             f"triangles, {sp['sphere_faces']:,} faces; the hole is a cap of {sp['removed_faces']:,} "
             f"faces, a little smaller than a hemisphere, {sp['faces']:,} faces are left), then "
             "the large round holes of the fidelity set: filled and faired by ours (default "
-            "mode) and by CGAL, the same hole in the same `bench_holes` run, times as above "
-            f"(medians of {repeat} runs" + ("; a method over 10 s runs once" if once else "") +
-            ").",
+            "mode) and by CGAL, the same hole in the same `bench_holes` run, times and peaks as "
+            f"above (medians of {repeat} runs" + ("; a method over 10 s runs once" if once else "") +
+            "), one thread each, and ours on every CPU.",
             "",
-            "| hole | border edges | faces | ours ms | ours: hole only | CGAL ms | MeshLab ms | "
-            "CGAL / ours | CGAL / ours (hole only) |",
-            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+            "| hole | border edges | faces | ours ms (1 thread) | ours peak MB | ours: hole only | "
+            "CGAL ms (1 thread) | CGAL peak MB | CGAL / ours | ours, all CPUs ms (threads) | "
+            "MeshLab ms |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in sp["rows"]:
         cell = lambda x: fmt_ms(x[0]) if x[0] is not None else (x[1] or "failed")
         ratio = f"{r['cgal'][0] / r['ours'][0]:.1f}×" if r["ours"][0] and r["cgal"][0] else "–"
-        ratio_hole = (f"{r['cgal'][0] / r['hole_ms']:.1f}×" if r["hole_ms"] and r["cgal"][0]
-                      else "–")
+        allc = r.get("all_cores") or (None, None, None, None)
         out.append(f"| {r['name']} | {r['border_edges']:,} | {r['faces']:,} | {cell(r['ours'])} | "
-                   f"{fmt_ms(r['hole_ms'])} | {cell(r['cgal'])} | {cell(r['meshlab'])} | {ratio} | "
-                   f"{ratio_hole} |")
+                   f"{fmt_mb(r['ours'][2])} | {fmt_ms(r['hole_ms'])} | {cell(r['cgal'])} | "
+                   f"{fmt_mb(r['cgal'][2])} | {ratio} | "
+                   f"{fmt_ms(allc[0])} ({allc[3] if allc[3] is not None else '?'}) | "
+                   f"{cell(r['meshlab'])} |")
     first = sp["rows"][0]
     o_ms, c_ms = first["ours"][0], first["cgal"][0]
     ratio = c_ms / o_ms if o_ms and c_ms else None
@@ -989,9 +1052,8 @@ def tables(holes, sp, repeat, machine, elapsed):
     if "cgal" in sp:
         facts.append(f"CGAL {sp['cgal']['faces_added']:,}")
     out += ["",
-            f"On the sphere hole {', '.join(facts)}. Ours' stages (ms of wall time on the calling "
-            f"thread, medians; the wait for the disk's patch made on the other core counts as "
-            f"fair): " +
+            f"On the sphere hole {', '.join(facts)}. Ours' stages (ms of wall time, medians, "
+            f"1 thread): " +
             ", ".join(f"{k} {v:.1f}" for k, v in rep["median_stage_ms"].items() if v >= 0.05) +
             "."]
     if sp.get("ours", {}).get("mean") is not None and sp.get("cgal", {}).get("mean") is not None:

@@ -8,6 +8,17 @@ and rewrites the matching section of docs/BENCHMARKS.md.
     benchmarks/run.py holes [--repeat N]        (needs numpy: /usr/bin/python3)
     benchmarks/run.py clearance [--repeat N]
     benchmarks/run.py stitch [--repeat N]
+    benchmarks/run.py all --smoke
+
+--smoke runs every benchmark once on its smallest inputs and writes the
+tables to build/benchmarks-smoke.md instead of docs/BENCHMARKS.md: it proves
+that the runners build, run and agree with their peers (it fails on a failed
+or disagreeing method), and asserts no speed. The full test tier runs it.
+
+Every benchmark takes --threads N: the threads MeshMend's runners use (it sets
+MESHMEND_THREADS; 0, the default, leaves every CPU). The peers run on one
+thread. The hole-filling comparison runs ours on 1 thread whatever it says,
+and on every CPU beside it.
 
 Needs scripts/setup to have run (the private MeshLab prefix) and ../shared
 beside the project (the real meshes). Builds the C++ runners if needed."""
@@ -29,6 +40,12 @@ ROOT = Path(__file__).resolve().parents[1]
 BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
 DATA = ROOT.parent / "shared" / "data"
 DOC = ROOT / "docs" / "BENCHMARKS.md"
+SMOKE = False  # --smoke: the smallest inputs only, one run each
+
+
+def smallest(items, keep=1):
+    """Under --smoke the first `keep` items (each list is ordered smallest first)."""
+    return items[:keep] if SMOKE else items
 
 
 RUNNERS = ["bench_intersections", "bench_split", "bench_selfintersect", "filter_mend_intersect"]
@@ -114,6 +131,15 @@ def machine():
     return f"{os.cpu_count()} cores ({cpu}), {platform.system()} {platform.release()}"
 
 
+def threads_used():
+    """What the tables say about threads: ours on MESHMEND_THREADS (as
+    --threads sets it), else on every CPU; the peers on one."""
+    n = os.environ.get("MESHMEND_THREADS")
+    ours = f"{n} thread{'s' if n != '1' else ''} (`--threads {n}`)" if n else \
+        f"every CPU ({os.cpu_count()} threads)"
+    return f"MeshMend on {ours}, the peers on 1 thread"
+
+
 def fmt(ms):
     return f"{ms:,.1f}" if ms < 100 else f"{ms:,.0f}"
 
@@ -130,7 +156,7 @@ def intersections(repeat):
              ("res2", "bun_zipper_res2.ply", "dragon_vrip_res2.ply"),
              ("full", "bun_zipper.ply", "dragon_vrip.ply")]
     rows, scaling, meshlab_rows = [], [], []
-    for label, bunny, dragon in sizes:
+    for label, bunny, dragon in smallest(sizes):
         a, b = data_file("stanford/" + bunny, tmp), data_file("stanford/" + dragon, tmp)
         fa, fb = faces_of(a), faces_of(b)
         print(f"bunny + dragon {label}: {fa:,} + {fb:,} faces", file=sys.stderr)
@@ -140,10 +166,10 @@ def intersections(repeat):
         scaling.append((fa + fb, by))
     # MeshLab's built-in filter against ours, both through meshlabserver.
     ours_script = (ROOT / "samples" / "select_intersecting.mlx").read_text()
-    for name in ["stanford/dragon_vrip_res2.ply", "stanford/dragon_vrip.ply"]:
+    for name in smallest(["stanford/dragon_vrip_res2.ply", "stanford/dragon_vrip.ply"]):
         path = data_file(name, tmp)
-        builtin_ms, _ = meshlabserver_ms([path], BUILTIN, 3)
-        ours_ms, log = meshlabserver_ms([path], ours_script, 3)
+        builtin_ms, _ = meshlabserver_ms([path], BUILTIN, 1 if SMOKE else 3)
+        ours_ms, log = meshlabserver_ms([path], ours_script, 1 if SMOKE else 3)
         m = re.search(r"has (\d+) self-intersecting pairs \((\d+) faces\)", log)
         meshlab_rows.append((Path(name).name, faces_of(path), ours_ms, builtin_ms, m.group(2) if m else "?"))
     shutil.rmtree(tmp)
@@ -151,7 +177,8 @@ def intersections(repeat):
     def cell(m, key="median_ms"):
         return fmt(m[key]) if m.get("ok") else "failed: " + m.get("error", "?")
 
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; each number is the median of "
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}, {threads_used()}; each "
+           "number is the median of "
            f"{repeat} runs in a child process of one `bench_intersections` run (`benchmarks/run.py "
            f"intersections`), so ours and the peers ran on the same input in the same run. Times "
            f"exclude file reading. Peak memory is the child's peak resident set (inputs included).",
@@ -275,16 +302,23 @@ def split_rounds(command, rounds):
 def split(repeat, rounds=3):
     import tempfile
     tmp = tempfile.mkdtemp(prefix="meshmend-bench-")
+    rows = [("blobby + eight", DATA / "pairs/blobby.off", DATA / "pairs/eight.off", [])]
+    if SMOKE:
+        return split_table(rows, repeat, 1, tmp)
     small = uv_sphere(Path(tmp) / "sphere_70k.off", (0, 0, 0), 1.0, 141, 250)
     large = uv_sphere(Path(tmp) / "sphere_870k.off", (0.37, 0.21, 0.13), 1.0, 484, 900)
-    rows = [("blobby + eight", DATA / "pairs/blobby.off", DATA / "pairs/eight.off", []),
-            ("ballA + ballB", DATA / "pairs/ballA.off", DATA / "pairs/ballB.off", []),
-            ("cheburashka + decimated-knight", DATA / "pairs/cheburashka.off",
-             DATA / "pairs/decimated-knight.off", []),
-            ("generated spheres, 70k + 870k faces", small, large, []),
-            ("bunny + dragon (sample configuration)", DATA / "stanford/bun_zipper.ply",
-             data_file("stanford/dragon_vrip.ply", tmp), ["--sample", "--autorefine", "--limit", "300"])]
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; per method the median of "
+    rows += [("ballA + ballB", DATA / "pairs/ballA.off", DATA / "pairs/ballB.off", []),
+             ("cheburashka + decimated-knight", DATA / "pairs/cheburashka.off",
+              DATA / "pairs/decimated-knight.off", []),
+             ("generated spheres, 70k + 870k faces", small, large, []),
+             ("bunny + dragon (sample configuration)", DATA / "stanford/bun_zipper.ply",
+              data_file("stanford/dragon_vrip.ply", tmp), ["--sample", "--autorefine", "--limit", "300"])]
+    return split_table(rows, repeat, rounds, tmp)
+
+
+def split_table(rows, repeat, rounds, tmp):
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}, {threads_used()}; per "
+           "method the median of "
            f"{rounds} rounds, each the median of {repeat} runs in one `bench_split` run per pair "
            "(`benchmarks/run.py split`; in each round ours and the peers run one after the other, "
            "each method in a child process). "
@@ -375,15 +409,16 @@ SELFINTERSECT_PEERS = ["cgal_remove_self_intersections",
 
 def selfintersect(repeat):
     tmp = tempfile.mkdtemp(prefix="meshmend-bench-")
-    generated = two_spheres(Path(tmp) / "two_spheres_50k.off")
-    inputs = [("generated: two overlapping spheres", generated),
-              ("cow.off", data_file("self_intersecting/cow.off", tmp)),
-              ("self_intersectA.obj", data_file("self_intersecting/self_intersectA.obj", tmp)),
-              ("horse.ply", data_file("scanned/horse.ply", tmp)),
-              ("dragon_vrip_res4.ply", data_file("stanford/dragon_vrip_res4.ply", tmp)),
-              ("dragon_vrip_res3.ply", data_file("stanford/dragon_vrip_res3.ply", tmp)),
-              ("bun_zipper_res2.ply", data_file("stanford/bun_zipper_res2.ply", tmp))]
-    limit = 600
+    inputs = [("cow.off", data_file("self_intersecting/cow.off", tmp)),
+              ("self_intersectA.obj", data_file("self_intersecting/self_intersectA.obj", tmp))]
+    if not SMOKE:
+        generated = two_spheres(Path(tmp) / "two_spheres_50k.off")
+        inputs = [("generated: two overlapping spheres", generated), *inputs,
+                  ("horse.ply", data_file("scanned/horse.ply", tmp)),
+                  ("dragon_vrip_res4.ply", data_file("stanford/dragon_vrip_res4.ply", tmp)),
+                  ("dragon_vrip_res3.ply", data_file("stanford/dragon_vrip_res3.ply", tmp)),
+                  ("bun_zipper_res2.ply", data_file("stanford/bun_zipper_res2.ply", tmp))]
+    limit = 60 if SMOKE else 600
     rows = []
     for name, path in inputs:
         print(name, file=sys.stderr)
@@ -467,6 +502,8 @@ def selfintersect(repeat):
             both = succeeded(o, before) and succeeded(c, before)
             ratios.append(f"{c['median_ms'] / o['median_ms']:.1f}×" if both else "–")
         out.append("| " + " | ".join(cells + ratios) + " |")
+    if SMOKE:
+        return "\n".join(out)
     before, o = next((r["input"], r["methods"][0]) for _, r in rows if r["file"] == str(generated))
     met = succeeded(o, before) and o["median_ms"] < 100
     out += ["",
@@ -489,7 +526,7 @@ def holes(repeat):
                     "-DCMAKE_BUILD_TYPE=Release"], check=True, stdout=subprocess.DEVNULL)
     subprocess.run(["cmake", "--build", str(tools), "-j", str(os.cpu_count() or 2), "--target",
                     "meshcheck", "peer_holefill"], check=True, stdout=subprocess.DEVNULL)
-    return driver.section(BUILD, repeat, machine())
+    return driver.section(BUILD, repeat, machine(), only="spot" if SMOKE else None)
 
 
 def icosphere_arrays(centre, radius, levels):
@@ -579,7 +616,7 @@ def stitch(repeat):
     stitches two paths across a gap), and Close Gaps Between Borders against
     CGAL's stitch_borders on the stitching corpus."""
     runner = str(BUILD / "benchmarks" / "bench_stitch")
-    paths = 100000
+    paths = 1000 if SMOKE else 100000
     r = json.loads(subprocess.run([runner, "--repeat", str(repeat), "--paths", str(paths)],
                                   capture_output=True, text=True, check=True).stdout)
     by = {m["method"]: m for m in r["methods"]}
@@ -645,7 +682,7 @@ def stitch(repeat):
            "border edges before | ours | CGAL |",
            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     tmp = tempfile.mkdtemp(prefix="meshmend-bench-")
-    for name in STITCHING_FILES:
+    for name in smallest(STITCHING_FILES, 2):
         path = data_file(f"stitching/{name}", tmp)
         print(name, file=sys.stderr)
         f = json.loads(subprocess.run([runner, "--repeat", str(repeat), str(path)],
@@ -693,32 +730,45 @@ def write_section(name, title, body):
     DOC.write_text(text)
 
 
+BENCHMARKS = {"intersections": ("Intersection detection", intersections),
+              "split": ("Intersect and split", split),
+              "selfintersect": ("Self-intersection removal", selfintersect),
+              "holes": ("Hole filling", holes),
+              "clearance": ("Minimum clearance", clearance),
+              "stitch": ("Stitching and gap closing", stitch)}
+# The runners each benchmark needs (the intersections also time the MeshLab filter).
+TARGETS = {"intersections": RUNNERS, "split": ["bench_split"],
+           "selfintersect": ["bench_selfintersect"], "holes": ["bench_holes"],
+           "clearance": ["bench_clearance"], "stitch": ["bench_stitch"]}
+
+
 def main():
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("benchmark",
-                        choices=["intersections", "split", "selfintersect", "holes", "clearance",
-                                 "stitch"])
+    global DOC, SMOKE
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("benchmark", choices=[*BENCHMARKS, "all"])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--smoke", action="store_true",
+                        help="one run of each on its smallest inputs, tables to build/benchmarks-smoke.md")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="threads MeshMend's runners use (MESHMEND_THREADS; 0: every CPU); "
+                             "the hole-filling comparison runs ours on 1 thread whatever this "
+                             "says, and on every CPU beside it")
     args = parser.parse_args()
-    # Intersect and split, self-intersection removal need their runner only (no MeshLab plugin).
-    # Hole filling needs its runner only (MeshLab's filter runs from the prefix).
-    build_runners({"split": ["bench_split"],
-                   "selfintersect": ["bench_selfintersect"],
-                   "holes": ["bench_holes"],
-                   "clearance": ["bench_clearance"],
-                   "stitch": ["bench_stitch"]}.get(args.benchmark, RUNNERS))
-    if args.benchmark == "intersections":
-        write_section("intersections", "Intersection detection", intersections(args.repeat))
-    if args.benchmark == "split":
-        write_section("split", "Intersect and split", split(args.repeat))
-    if args.benchmark == "selfintersect":
-        write_section("selfintersect", "Self-intersection removal", selfintersect(args.repeat))
-    if args.benchmark == "holes":
-        write_section("holes", "Hole filling", holes(args.repeat))
-    if args.benchmark == "clearance":
-        write_section("clearance", "Minimum clearance", clearance(args.repeat))
-    if args.benchmark == "stitch":
-        write_section("stitch", "Stitching and gap closing", stitch(args.repeat))
+    if args.threads > 0:
+        os.environ["MESHMEND_THREADS"] = str(args.threads)
+    names = list(BENCHMARKS) if args.benchmark == "all" else [args.benchmark]
+    if args.smoke:
+        SMOKE, args.repeat = True, 1
+        DOC = BUILD / "benchmarks-smoke.md"
+        DOC.unlink(missing_ok=True)
+    build_runners(sorted({t for name in names for t in TARGETS[name]}))
+    for name in names:
+        title, run = BENCHMARKS[name]
+        started = time.time()
+        write_section(name, title, run(args.repeat))
+        print(f"{name}: {time.time() - started:.0f} s", file=sys.stderr)
+    if SMOKE and "differ!" in DOC.read_text():
+        sys.exit(f"a method disagrees with its peer on a count: see {DOC}")
     print(f"updated {DOC}")
 
 

@@ -1,13 +1,19 @@
 // Feature-preserving hole filling (Xu, Li, Tan: "Feature Based Hole Filling
 // Algorithm on Triangular Mesh", papers/004): border loops are found and their
 // long edges split (§3.1), each hole is covered by an advancing-front patch
-// whose triangles grade from the boundary edge lengths (§3.2), and the patch
-// vertices are placed by a Poisson solve whose right-hand side is the
+// whose triangles take the size of the input's border edges (§3.2), and the
+// patch vertices are placed by a Poisson solve whose right-hand side is the
 // Laplacian predicted by least-squares SVM regression from the rings of
 // vertices around the hole (§2.2, §3.3, §3.4). Simpler shapes (flat,
 // harmonic, biharmonic) are options. Every patch is checked exactly against
 // itself and the mesh around it; a patch that would intersect falls back to a
-// flatter shape, and is left out (the hole reported skipped) when none fits.
+// flatter shape or another domain, and is left out (the hole reported
+// skipped) when none fits.
+//
+// The work follows the holes, not the mesh: the borders are found from one
+// pass over the faces (common/border_loops.h), the faces around the holes
+// are gathered in one pass over the points and one over the faces, and the
+// mesh is never copied; the stages of one hole are in common/holes/.
 #pragma once
 
 #include <cstddef>
@@ -65,13 +71,14 @@ struct HoleFillOptions {
   // border) until none is; 0 turns it off.
   double long_edge_factor = 1.5;
 
-  // ---- Patch (§3.2). Patch triangles take the size of the boundary edges
-  // around them. A hole whose uniform patch would exceed uniform_face_limit
-  // triangles gets triangles that grow by size_growth per front layer
-  // towards its middle, up to max_size_factor x the mean boundary edge
-  // length: a round hole of n boundary edges needs ~n^2/12 uniform
-  // triangles, a graded patch a few times n.
-  std::size_t uniform_face_limit = 4000;
+  // ---- Patch (§3.2). Patch triangles take the size of the input's border
+  // edges around them (before the pre-treatment split them): the density of
+  // the surface around the hole. A hole whose uniform patch would exceed
+  // uniform_face_limit triangles gets triangles that grow by size_growth
+  // per front layer towards its middle, up to max_size_factor x the mean
+  // border edge length: a round hole of n border edges needs ~n^2/5
+  // uniform triangles, a graded patch a few times n.
+  std::size_t uniform_face_limit = 20000;
   double size_growth = 1.5;
   double max_size_factor = 16;
   // A new front vertex closer than merge_distance x its target size to
@@ -92,8 +99,9 @@ struct HoleFillOptions {
   // split) against itself and the surface around it; a patch that
   // intersects is replaced by a flatter one (LaplacianRegression ->
   // Biharmonic -> Harmonic -> Flat; from Biharmonic, LaplacianRegression
-  // last), or left out. Each shape is tried over both domains (plane,
-  // disk) that were triangulated before the next one. Its counts make
+  // last), or left out. Each shape is tried over every domain (the hole's
+  // plane, a disk, a disk with triangles of the border's spacing
+  // throughout) before the next shape. Its counts make
   // remaining_intersecting_pairs exact.
   bool check_intersections = true;
   // Recount, independently and exactly, the intersecting pairs that involve
@@ -142,9 +150,9 @@ struct HoleFillResult {
   std::size_t remaining_intersecting_pairs = 0;
   double time_ms = 0;
   // Where the time went, in milliseconds of wall time on the calling
-  // thread, summed over the holes (they add up to about time_ms). While a
-  // hole's disk patch is made on the second core, the wait for it counts as
-  // fair.
+  // thread, summed over the holes (they add up to about time_ms): find is
+  // the borders, the selection and the gathering of the faces around the
+  // holes; triangulate, fair and check are the patches' stages.
   struct StageTimes {
     double find = 0, split = 0, triangulate = 0, fair = 0, check = 0, verify = 0, write = 0;
   } stage_ms;
@@ -159,10 +167,11 @@ struct HoleFillResult {
 // patch vertices take the origin of the border vertex nearest to them along
 // the patch's edges (so attributes carried by origins continue into the
 // patch), patch faces have no origin face.
-// Throws InvalidInputError for an empty mesh, a non-finite coordinate,
-// deleted elements or a bad option; the mesh is unchanged when it throws
-// (CancelledError included). A mesh without holes is returned unchanged with
-// holes_found = 0.
+// Throws InvalidInputError for an empty mesh, deleted elements or a bad
+// option (checked first), or a non-finite coordinate (found as the fill
+// reads the points: a mesh with nothing to fill is not read further); the
+// mesh is unchanged when it throws (CancelledError included). A mesh without
+// holes is returned unchanged with holes_found = 0.
 HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options = {});
 
 // The report_file keys: holes_found, holes_filled, holes_skipped, skipped

@@ -531,14 +531,19 @@ bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T
                     std::uint32_t g) {
   const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
   const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+  return facesIntersect(T[f], a, T[g], b);
+}
+
+bool facesIntersect(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                    const TrianglePoints& b) {
   // Apart along an axis (exact): most candidates of a widened box search.
   for (int k = 0; k < 3; ++k)
     if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
         std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
       return false;
   if (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2])) return false;
-  const SharedCorners c = sharedCorners(T[f], T[g]);
-  if (c.count < 3 && separatedInProjection(T[f], a, T[g], b)) return false;
+  const SharedCorners c = sharedCorners(ta, tb);
+  if (c.count < 3 && separatedInProjection(ta, a, tb, b)) return false;
   return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
 }
 

@@ -92,6 +92,10 @@ std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
 // degenerate face): they meet beyond what their shared corners explain.
 bool facesIntersect(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
                     std::uint32_t f, std::uint32_t g);
+// The same for two faces given by their corners (vertex indices: equal
+// indices are shared corners) and their points.
+bool facesIntersect(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                    const TrianglePoints& b);
 
 // Of `pairs`, those that intersect (facesIntersect), in parallel.
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(

@@ -17,13 +17,17 @@ void Mesh::copyFrom(const Mesh& other) {
   Mesh& source = const_cast<Mesh&>(other);  // vcglib 2020.09's Append takes non-const meshes
   Clear();
   ClearAttributes();
+  // The copy keeps the room to grow a built mesh has (startMesh), made
+  // before anything is added: reserving later would move the vertices.
+  reserveInHugePages(vert, withRoomToGrow(source.vert.size()));
+  reserveInHugePages(face, withRoomToGrow(source.face.size()));
   // Append copies the attributes present in both meshes: create ours first.
   if (Allocator::IsValidHandle(
           source, Allocator::FindPerVertexAttribute<VertexOrigin>(source, kVertexOriginAttribute)))
-    vertexOrigins(*this);
+    vertexOrigins(*this)._handle->data.reserve(vert.capacity());
   if (Allocator::IsValidHandle(
           source, Allocator::FindPerFaceAttribute<FaceOrigin>(source, kFaceOriginAttribute)))
-    faceOrigins(*this);
+    faceOrigins(*this)._handle->data.reserve(face.capacity());
   vcg::tri::Append<Mesh, Mesh>::MeshCopy(*this, source);
 }
 
@@ -76,8 +80,8 @@ void startMesh(Mesh& mesh, std::size_t vertices, std::size_t faces, VertexOrigin
                FaceOriginHandle& fo) {
   mesh.Clear();
   mesh.ClearAttributes();
-  reserveInHugePages(mesh.vert, vertices);
-  reserveInHugePages(mesh.face, faces);
+  reserveInHugePages(mesh.vert, withRoomToGrow(vertices));
+  reserveInHugePages(mesh.face, withRoomToGrow(faces));
   // The attributes once the room is made (each reserves its elements'
   // capacity), and while the mesh is empty: adding one edits state that
   // vertex and face attributes share (vcglib's attribute counter).

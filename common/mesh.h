@@ -92,10 +92,19 @@ void buildMesh(Mesh& mesh, const std::vector<Point3>& positions,
                const std::vector<VertexOrigin>& vertexOrigin,
                const std::vector<FaceOrigin>& faceOrigin);
 
-// Clears `mesh`, makes room for `vertices` and `faces` (vcglib's arrays,
-// reserved: adding up to that many moves nothing) and gives it empty origin
-// attributes with the same room, all in huge pages (huge_pages.h): the
-// start of every mesh the core builds.
+// The room a mesh keeps for `count` elements: a sixteenth more and 1,024,
+// so that an operation that appends a little to a mesh (a hole's patch, a
+// stitch) moves none of its elements, and no face's corner pointers need
+// re-pointing. Reserved memory no element uses is never touched: it costs
+// address space, not memory.
+inline std::size_t withRoomToGrow(std::size_t count) {
+  return count + count / 16 + 1024;
+}
+
+// Clears `mesh`, makes room for `vertices` and `faces` and a little more
+// (withRoomToGrow; vcglib's arrays, reserved: adding up to that many moves
+// nothing) and gives it empty origin attributes with the same room, all in
+// huge pages (huge_pages.h): the start of every mesh the core builds.
 void startMesh(Mesh& mesh, std::size_t vertices, std::size_t faces, VertexOriginHandle& vo,
                FaceOriginHandle& fo);
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdlib>
 #include <deque>
 #include <mutex>
 #include <system_error>
@@ -253,14 +254,43 @@ void runJob(Job& job) {
 
 }  // namespace detail
 
-unsigned workerCount() {
+namespace {
+
+std::atomic<unsigned> chosenThreads{0};  // setThreadCount's, 0 when not set
+
+// MESHMEND_THREADS as a count, or 0 when it is not set or not a whole
+// number from 1 (then the CPUs decide).
+unsigned threadsFromEnvironment() {
+  const char* text = std::getenv("MESHMEND_THREADS");
+  if (!text || !*text) return 0;
+  char* end = nullptr;
+  const unsigned long count = std::strtoul(text, &end, 10);
+  if (*end != '\0' || count < 1 || count > 4096) return 0;
+  return unsigned(count);
+}
+
+}  // namespace
+
+unsigned defaultThreadCount() {
   static const unsigned count = [] {
+    if (const unsigned fromEnvironment = threadsFromEnvironment()) return fromEnvironment;
     cpu_set_t allowed;
     if (sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_COUNT(&allowed) > 0)
       return unsigned(CPU_COUNT(&allowed));
     return std::max(1u, std::thread::hardware_concurrency());
   }();
   return count;
+}
+
+unsigned workerCount() {
+  const unsigned chosen = chosenThreads.load(std::memory_order_relaxed);
+  return chosen ? chosen : defaultThreadCount();
+}
+
+void setThreadCount(unsigned count) {
+  const unsigned before = workerCount();
+  chosenThreads.store(count, std::memory_order_relaxed);
+  if (workerCount() < before) releaseHelperThreads();  // the next job starts what it may use
 }
 
 void releaseHelperThreads() {

@@ -23,11 +23,22 @@
 
 namespace meshmend {
 
-// Number of worker threads used by parallelChunks (at least 1): the CPUs
-// the process may run on (taskset, cgroup cpusets), asked once, where
+// Number of threads MeshMend's work runs on (at least 1): the count set
+// by setThreadCount, else the environment variable MESHMEND_THREADS (a
+// whole number from 1; read once, at the first use), else the CPUs the
+// process may run on (taskset, cgroup cpusets), asked once, where
 // hardware_concurrency counts every CPU of the machine (and reads /sys on
-// every call, which costs more than a small job's work).
+// every call, which costs more than a small job's work). Every operation
+// of the core, the filters and the Python module follow it.
 unsigned workerCount();
+
+// Sets the number of threads from now on (0: back to MESHMEND_THREADS or
+// the CPUs); helper threads beyond it leave. Call it between operations,
+// not while one runs (they size per-thread results by workerCount()).
+void setThreadCount(unsigned count);
+
+// What workerCount() is when nothing is set: MESHMEND_THREADS, else the CPUs.
+unsigned defaultThreadCount();
 
 namespace detail {
 

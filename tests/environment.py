@@ -65,7 +65,6 @@ class Host:
                            f"scripts/hosts build {self.name}")
 
     def require_pymeshlab(self):
-        self.require_plugins()
         need(VENDOR.is_dir(), f"{VENDOR} (pymeshlab is built from its sources there)")
         need(self.pymeshlab and (self.pymeshlab / "pymeshlab").is_dir(),
              f"pymeshlab for MeshLab {self.name}: scripts/hosts build {self.name}")

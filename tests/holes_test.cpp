@@ -521,6 +521,30 @@ TEST(HoleChecks, FairedPatchThatWouldHitAnotherPartFallsBackToAFlatterOne) {
   EXPECT_EQ(selfIntersectingPairs(m), 0u);
 }
 
+// The faces a patch is checked against are gathered around the hole before
+// it is shaped, other parts of the mesh among them: a plate above a tube's
+// open end, which the biharmonic dome would cross, makes it fall back.
+TEST(HoleChecks, PlateAboveATubesEndMakesTheDomeFallBack) {
+  const Mesh tube = openTube(24, 30, 1, 4);
+  const Mesh plate =
+      makeMesh({{-0.1, -0.1, 4.5}, {0.1, -0.1, 4.5}, {0.1, 0.1, 4.5}, {-0.1, 0.1, 4.5}},
+               {{0, 1, 2}, {0, 2, 3}});
+  Mesh m = appended(tube, plate);
+  const std::vector<Point3> before = positionsOf(m);
+  HoleFillOptions o;
+  o.verify = true;
+  const HoleFillResult r = fillHoles(m, o);
+  ASSERT_EQ(r.holes_found, 3u);  // the tube's two ends and the plate's outline
+  const HoleReport& top = *std::find_if(r.holes.begin(), r.holes.end(), [&](const HoleReport& h) {
+    return h.boundary.size() == 24 && before[std::size_t(h.boundary[0])][2] > 3.9;
+  });
+  ASSERT_TRUE(top.filled) << top.reason;
+  std::cout << "tube end under a plate: " << toString(top.fairing) << ", " << top.reason << "\n";
+  EXPECT_NE(top.reason.find("biharmonic patch would intersect"), std::string::npos) << top.reason;
+  EXPECT_EQ(r.remaining_intersecting_pairs, 0u);
+  EXPECT_EQ(selfIntersectingPairs(m), 0u);
+}
+
 TEST(HoleChecks, VerificationCountsWhatAnUncheckedPatchCrosses) {
   // The same plate through the opening, with the check off: the hole is
   // filled through the plate and the independent recount sees it.
@@ -605,15 +629,13 @@ TEST(HoleInput, NonFiniteCoordinateIsRefusedAndTheMeshKept) {
   EXPECT_EQ(std::size_t(m.fn), faces);
 }
 
-TEST(HoleInput, InfiniteCoordinateIsRefusedBeforeBadOptions) {
+TEST(HoleInput, InfiniteCoordinateIsRefusedNamingTheVertex) {
   for (int axis = 0; axis < 3; ++axis) {
     Mesh m = sphereWithCap();
     m.vert[m.vert.size() - 1].P()[axis] = axis == 1 ? -INFINITY : INFINITY;
     const std::vector<Triangle> t = trianglesOf(m);
-    HoleFillOptions o;
-    o.long_edge_factor = 0.5;  // also bad: the coordinate is named first
     try {
-      fillHoles(m, o);
+      fillHoles(m);
       FAIL() << "no error";
     } catch (const InvalidInputError& e) {
       EXPECT_NE(std::string(e.what()).find("vertex " + std::to_string(m.vert.size() - 1) +
@@ -623,6 +645,30 @@ TEST(HoleInput, InfiniteCoordinateIsRefusedBeforeBadOptions) {
     }
     EXPECT_EQ(trianglesOf(m), t);
   }
+}
+
+// Options are checked before anything is read from the mesh (the cheap
+// checks first): a bad option is named even when a coordinate is bad too.
+TEST(HoleInput, BadOptionsAreRefusedBeforeTheMeshIsRead) {
+  Mesh m = sphereWithCap();
+  m.vert[0].P()[0] = INFINITY;
+  HoleFillOptions o;
+  o.long_edge_factor = 0.5;
+  try {
+    fillHoles(m, o);
+    FAIL() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("long_edge_factor"), std::string::npos) << e.what();
+  }
+}
+
+// Where nothing is filled, nothing is read but the faces: a closed mesh with
+// a non-finite coordinate is left as it is, with no hole found.
+TEST(HoleInput, ClosedMeshIsNotReadFurther) {
+  Mesh m = icosphere(2);
+  m.vert[3].P()[2] = std::nan("");
+  const HoleFillResult r = fillHoles(m);
+  EXPECT_EQ(r.holes_found, 0u);
 }
 
 TEST(HoleInput, DeletedElementsAreRefused) {

@@ -15,9 +15,11 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -208,8 +210,74 @@ cpu_set_t allowedCpus() {
 }  // namespace
 
 TEST(ParallelChunks, WorkerCountIsTheCpusTheProcessMayRunOn) {
+  if (std::getenv("MESHMEND_THREADS")) GTEST_SKIP() << "MESHMEND_THREADS is set";
   cpu_set_t allowed = allowedCpus();
   EXPECT_EQ(workerCount(), unsigned(CPU_COUNT(&allowed)));
+}
+
+// setThreadCount caps the threads of every job that follows: one thread
+// runs every chunk (on the caller) and a task alongside on the caller when
+// waited for; 0 goes back to the default.
+TEST(ThreadCount, OneThreadRunsEverythingOnTheCaller) {
+  setThreadCount(1);
+  EXPECT_EQ(workerCount(), 1u);
+  std::mutex mutex;
+  std::set<std::thread::id> threads;
+  int chunks = 0;
+  parallelChunks(
+      1 << 20,
+      [&](std::size_t, std::size_t, unsigned worker) {
+        std::lock_guard<std::mutex> lock(mutex);
+        EXPECT_EQ(worker, 0u);
+        ++chunks;
+        threads.insert(std::this_thread::get_id());
+      },
+      1);
+  EXPECT_EQ(chunks, 1);
+  EXPECT_EQ(threads, std::set<std::thread::id>{std::this_thread::get_id()});
+  std::thread::id ranOn;
+  TaskAlongside task([&] { ranOn = std::this_thread::get_id(); });
+  task.wait();
+  EXPECT_EQ(ranOn, std::this_thread::get_id());
+  setThreadCount(0);
+  EXPECT_EQ(workerCount(), defaultThreadCount());
+  setThreadCount(3);
+  EXPECT_EQ(workerCount(), 3u);
+  setThreadCount(0);
+}
+
+// Run in a child process started with MESHMEND_THREADS (and the count it
+// should give in MESHMEND_THREADS_EXPECTED); in this process it checks
+// nothing when they are not set.
+TEST(ThreadCount, ChildSeesTheEnvironmentVariable) {
+  const char* expected = std::getenv("MESHMEND_THREADS_EXPECTED");
+  if (!expected) GTEST_SKIP() << "run by EnvironmentVariableSetsTheDefault";
+  EXPECT_EQ(defaultThreadCount(), unsigned(std::atoi(expected)));
+  EXPECT_EQ(workerCount(), unsigned(std::atoi(expected)));
+}
+
+// MESHMEND_THREADS sets the default count of a process; a value that is
+// not a whole number from 1 leaves the CPUs' count.
+TEST(ThreadCount, EnvironmentVariableSetsTheDefault) {
+  const cpu_set_t allowed = allowedCpus();
+  const std::string cpus = std::to_string(CPU_COUNT(&allowed));
+  for (const auto& [value, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"1", "1"}, {"3", "3"}, {"0", cpus}, {"two", cpus}, {"-1", cpus}}) {
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      setenv("MESHMEND_THREADS", value.c_str(), 1);
+      setenv("MESHMEND_THREADS_EXPECTED", expected.c_str(), 1);
+      execl("/proc/self/exe", "parallel_test",
+            "--gtest_filter=ThreadCount.ChildSeesTheEnvironmentVariable",
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        << "MESHMEND_THREADS=" << value << ": the child failed (status " << status << ")";
+  }
 }
 
 // moveOffCpu leaves the CPU it is given and keeps the set the thread may run
@@ -362,15 +430,27 @@ TEST(ParallelChunks, AChildOfForkRunsJobsWithoutItsParentsHelpers) {
   EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
+// The mesh in arrays of exactly its size (a built mesh keeps room to grow):
+// vcglib's allocator on an empty mesh, as an importer fills one.
+void exactSize(const Mesh& from, Mesh& m) {
+  const std::vector<Point3> p = positionsOf(from);
+  const std::vector<Triangle> t = trianglesOf(from);
+  vcg::tri::Allocator<Mesh>::AddVertices(m, p.size());
+  for (std::size_t v = 0; v < p.size(); ++v) m.vert[v].P() = p[v];
+  vcg::tri::Allocator<Mesh>::AddFaces(m, t.size());
+  for (std::size_t f = 0; f < t.size(); ++f)
+    for (int k = 0; k < 3; ++k) m.face[f].V(k) = &m.vert[std::size_t(t[f][k])];
+}
+
 TEST(ParallelChunks, HoleFillingWithoutThreadsGivesTheSameMesh) {
-  Mesh withThreads = sphereWithCap();
-  const std::size_t inputFaces = withThreads.face.size();
-  ASSERT_GT(inputFaces, 20000u);  // large enough for the parallel paths
-  Mesh withoutThreads = sphereWithCap();
   // Exact-size arrays, so that the write-back moves the vertices and
   // re-points every face (the step that must not be left half done).
-  withThreads.vert.shrink_to_fit(), withThreads.face.shrink_to_fit();
-  withoutThreads.vert.shrink_to_fit(), withoutThreads.face.shrink_to_fit();
+  Mesh withThreads, withoutThreads;
+  exactSize(sphereWithCap(), withThreads);
+  const std::size_t inputFaces = withThreads.face.size();
+  ASSERT_GT(inputFaces, 20000u);  // large enough for the parallel paths
+  ASSERT_EQ(withThreads.vert.capacity(), withThreads.vert.size());
+  exactSize(sphereWithCap(), withoutThreads);
   const HoleFillResult a = fillHoles(withThreads);
   HoleFillResult b;
   {

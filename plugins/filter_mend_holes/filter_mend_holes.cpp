@@ -33,8 +33,9 @@ QString HolesPlugin::filterInfo(FilterIDType) const {
   return "Fills the holes of a mesh with patches that follow the shape around them (Xu, Li and "
          "Tan, feature based hole filling). Each hole's long border edges are split first; the "
          "hole is covered by an advancing front whose triangles take the size of the border "
-         "edges around them (over the hole's plane, or a disk where the plane would squeeze "
-         "it); the patch vertices are then placed by a least-squares Poisson solve, by default "
+         "edges around them (over the hole's plane; over a disk where no plane fits, the "
+         "plane's patch is less round or would intersect); the patch vertices are then placed "
+         "by a least-squares Poisson solve, by default "
          "the biharmonic one (smoothest, tangent to the surface: on the project's fidelity "
          "benchmark the closest to the removed surface). The paper's shape, whose target "
          "Laplacians are learned (LS-SVM regression) from the rings of vertices around the "
@@ -42,7 +43,8 @@ QString HolesPlugin::filterInfo(FilterIDType) const {
          "Every patch is checked exactly against itself and the surface around it; one that "
          "would intersect falls back to a flatter shape, or is left out with a reason in the "
          "log. Holes at a non-manifold border vertex are split there. Existing vertices and "
-         "faces keep their indices; new ones are appended.";
+         "faces keep their indices; new ones are appended. Threads: every CPU, or as many as "
+         "the environment variable MESHMEND_THREADS says.";
 }
 
 void HolesPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& parameters) {

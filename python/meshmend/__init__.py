@@ -199,6 +199,19 @@ def _pairs(meshes) -> List[Arrays]:
 
 
 @_with_options("inspect")
+def set_threads(count: int) -> None:
+    """Sets how many threads MeshMend's functions use from now on; 0 goes
+    back to the default: the environment variable MESHMEND_THREADS (read
+    once, when MeshMend first runs something), else every CPU the process
+    may run on. Call it between calls, not while one runs in another thread."""
+    _core.set_threads(int(count))
+
+
+def threads() -> int:
+    """How many threads MeshMend's functions use."""
+    return _core.threads()
+
+
 def inspect(vertices, faces, **options) -> Dict[str, Any]:
     """Defect counts with the keys and definitions of the checker meshcheck
     (vertices, faces, border_edges, non_manifold_edges, is_closed, volume,
@@ -465,7 +478,8 @@ def to_trimesh(vertices, faces):
 
 __all__ = [
     "Error", "InvalidInputError", "TopologyError", "CancelledError", "FACE_DEFECTS",
-    "VERTEX_DEFECTS", "inspect", "count_self_intersections", "find_intersections",
+    "VERTEX_DEFECTS", "set_threads", "threads", "inspect", "count_self_intersections",
+    "find_intersections",
     "intersect_and_split", "intersect_and_split_meshes", "split_self_intersections",
     "remove_self_intersections", "fill_holes", "trim_along_loop", "stitch_boundaries",
     "stitch_sequence", "border_paths", "close_gaps", "measure_clearance", "enforce_clearance",

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include "common/errors.h"
+#include "common/parallel.h"
 #include "python/src/bindings.h"
 
 namespace py = pybind11;
@@ -59,6 +60,17 @@ PYBIND11_MODULE(_core, m) {
     }
   });
 
+  m.def(
+      "set_threads",
+      [](long count) {
+        if (count < 0)
+          throw meshmend::InvalidInputError("set_threads: the count must be 0 or more");
+        meshmend::setThreadCount(unsigned(count));
+      },
+      py::arg("count"),
+      "Sets how many threads MeshMend uses from now on (0: back to MESHMEND_THREADS or the "
+      "CPUs).");
+  m.def("threads", &meshmend::workerCount, "How many threads MeshMend uses.");
   meshmend::python::bindIntersect(m);
   meshmend::python::bindRepair(m);
   meshmend::python::bindClearance(m);

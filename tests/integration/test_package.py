@@ -38,6 +38,7 @@ def package(host, tmp_path):
 def test_a_double_package_loads_into_pymeshlab(name, tmp_path):
     host = Host(name)
     host.require_pymeshlab()
+    host.require_plugins()
     folder = package(name, tmp_path)
     plugins = sorted((folder / "plugins").glob("*.so"))
     assert [p.name for p in plugins] == [p.name for p in sorted(host.plugin_dir.glob("*.so"))]

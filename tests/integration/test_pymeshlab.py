@@ -42,6 +42,7 @@ if not VENDOR.is_dir():
 def host(request):
     h = Host(request.param)
     h.require_pymeshlab()
+    h.require_plugins()
     return h
 
 

@@ -69,6 +69,7 @@ def meshmend_errors(log):
 def test_sample_has_the_same_outcome_on_2020_09_and_2025_07d(name, tmp_path):
     host = Host("2025.07d")
     host.require_pymeshlab()
+    host.require_plugins()
     meshes = inputs(name, tmp_path)
     old_code, old_log = run("meshlabserver", tmp_path, name, meshes, tmp_path / "2020.09.ply")
     new_code, new_log = run("meshmend-run", tmp_path, name, meshes, tmp_path / "2025.07d.ply")
@@ -92,7 +93,9 @@ def test_sample_has_the_same_outcome_on_2020_09_and_2025_07d(name, tmp_path):
 def test_meshmend_run_says_what_is_wrong(tmp_path):
     """Bad input to scripts/meshmend-run: meshlabserver's exit status (255
     for what the run could not do, 1 for a bad command line) and a message."""
-    Host("2025.07d").require_pymeshlab()
+    host = Host("2025.07d")
+    host.require_pymeshlab()
+    host.require_plugins()
     tri = write_off(tmp_path / "tri.off", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
     garbage = tmp_path / "garbage.mlx"
     garbage.write_text("not a filter script")

@@ -478,6 +478,35 @@ def test_fill_holes_options_choose_holes_and_shapes():
     assert {h["fairing"] for h in flat.report["holes"]} == {"flat"}
 
 
+def test_threads_are_set_and_the_result_does_not_depend_on_them():
+    S, G = icosphere(4)
+    V, F = without_faces(S, G, lambda c: np.abs(c[:, 2]) > 0.7)  # two holes
+    default = mm.threads()
+    assert default >= 1
+    try:
+        mm.set_threads(1)
+        assert mm.threads() == 1
+        one = mm.fill_holes(V, F)
+        mm.set_threads(3)
+        assert mm.threads() == 3
+        three = mm.fill_holes(V, F)
+        assert np.array_equal(one.vertices, three.vertices)
+        assert np.array_equal(one.faces, three.faces)
+        with pytest.raises(mm.InvalidInputError, match="0 or more"):
+            mm.set_threads(-1)
+    finally:
+        mm.set_threads(0)
+    assert mm.threads() == default
+
+
+def test_meshmend_threads_sets_the_default_of_a_process():
+    code = "import meshmend as mm; print(mm.threads())"
+    env = {**os.environ, "MESHMEND_THREADS": "1", "PYTHONPATH": str(BUILD / "python")}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "1"
+
+
 def test_fill_holes_on_a_closed_mesh_changes_nothing():
     V, F = icosphere(1)
     out = mm.fill_holes(V, F)
