@@ -27,6 +27,22 @@ class TopologyError : public Error {
   using Error::Error;
 };
 
+// The operation reached one of its work bounds (candidate pairs, rounds,
+// exact-arithmetic evaluations) and stopped; the message names the bound
+// and what to try. Nothing was changed.
+class WorkLimitError : public Error {
+ public:
+  using Error::Error;
+};
+
+// What the operation computed does not meet its stated contract (checked
+// exactly on what it would store): the message says what does not hold and
+// what to try. Nothing was changed.
+class ContractError : public Error {
+ public:
+  using Error::Error;
+};
+
 // The user's progress callback asked to stop.
 class CancelledError : public Error {
  public:

@@ -75,7 +75,7 @@ struct InspectResult {
   double float_steps_in_shortest_edge = 0;
   double double_steps_in_shortest_edge = 0;
   // With the self_intersections option (the rule of CGAL's self_intersections,
-  // as in intersections.h); empty otherwise or with non-finite coordinates.
+  // as in intersections.h); empty otherwise, without faces or with non-finite coordinates.
   std::optional<std::size_t> self_intersecting_pairs;
   std::optional<std::size_t> self_intersecting_faces;
   double time_ms = 0;                        // compute time of inspect()

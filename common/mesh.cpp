@@ -280,7 +280,7 @@ WeldedArrays weldCoincident(const MeshArrays& in) {
 std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces) {
   const WeldedArrays w = weldCoincident(arraysOf(mesh));
   if (removedFaces) *removedFaces = w.faces_removed;
-  if (w.vertices_merged == 0) return 0;
+  if (w.vertices_merged == 0 && w.faces_removed == 0) return 0;
   VertexOriginHandle vo = vertexOrigins(mesh);
   FaceOriginHandle fo = faceOrigins(mesh);
   std::vector<VertexOrigin> keptOrigins;

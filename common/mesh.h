@@ -155,7 +155,8 @@ WeldedArrays weldCoincident(const MeshArrays& mesh);
 
 // Merges vertices with exactly equal coordinates (scan seams, STL facets):
 // faces are re-pointed to the first such vertex, faces left with a repeated
-// corner are removed, unused duplicates are dropped. Provenance is kept.
+// corner (or that had one) are removed, unused duplicates are dropped: the
+// mesh becomes weldCoincident's. Provenance is kept.
 // Returns the number of vertices merged away; `removedFaces` (optional)
 // receives the number of faces removed.
 std::size_t weldCoincidentVertices(Mesh& mesh, std::size_t* removedFaces = nullptr);

@@ -1,8 +1,10 @@
 #include "common/obj_reader.h"
 
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -65,6 +67,9 @@ class ObjParser {
     const long i = std::strtol(token.c_str(), &end, 10);
     if (end == token.c_str() || *end != '\0') fail("bad index '" + token + "'");
     if (i == 0) fail("index 0 (OBJ indices start at 1)");
+    // Beyond int, an index would wrap (and -1 means "none"): no file has
+    // that many elements.
+    if (i > INT_MAX || i < -long(INT_MAX)) fail("index '" + token + "' is out of range");
     return i > 0 ? int(i - 1) : int(long(count) + i);
   }
 
@@ -139,8 +144,13 @@ class ObjParser {
   void readMaterials(const std::string& name) {
     const std::size_t slash = path_.find_last_of('/');
     const std::string folder = slash == std::string::npos ? "" : path_.substr(0, slash + 1);
-    std::ifstream in(folder + name);
-    if (!in) {
+    // Only a regular file: a name that leads to a device or a pipe
+    // (/dev/zero has no line end) would never finish.
+    std::error_code error;
+    const bool regular = std::filesystem::is_regular_file(folder + name, error);
+    std::ifstream in;
+    if (regular) in.open(folder + name);
+    if (!regular || !in) {
       data_.warnings.push_back("material library '" + name + "' not found; colours ignored");
       return;
     }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/predicates.h"
@@ -44,7 +46,7 @@ int compareMeasures(double before, double after, const std::array<const ExactPoi
 // allocates only its output.
 class Retriangulator {
  public:
-  Patch run(const PatchInput& in) {
+  RetriangulatedPatch run(const PatchInput& in) {
     reset(in);
     return triangulate(in);
   }
@@ -57,7 +59,9 @@ class Retriangulator {
     T_.clear();
     constrained_.clear();
     lineEnds_.clear();
-    exactOrientations_.clear();
+    if (!exactOrientations_.empty()) exactOrientations_ = {};  // (clear() would keep its buckets)
+    exactEvaluations_ = 0;
+    maxExactEvaluations_ = in.max_exact_evaluations;
     normalKnown_ = false;
     // Room for every vertex and triangle a few constraints make, without
     // moving the points (each copy of an ExactPoint is a reference count).
@@ -73,8 +77,8 @@ class Retriangulator {
     T_.push_back({0, 1, 2});
   }
 
-  Patch triangulate(const PatchInput& in) {
-    Patch out;
+  RetriangulatedPatch triangulate(const PatchInput& in) {
+    RetriangulatedPatch out;
     out.vertex_of_input.reserve(3 + in.points.size());
     out.vertex_of_input = {0, 1, 2};
     if (!in.on_edges.empty() && in.on_edges.size() != in.points.size())
@@ -101,6 +105,7 @@ class Retriangulator {
     out.constrained_edges.reserve(constrained_.size());
     for (const auto& piece : constrained_)
       out.constrained_edges.push_back({piece.edge.first, piece.edge.second});
+    out.exact_evaluations = exactEvaluations_;
     return out;
   }
 
@@ -137,6 +142,7 @@ class Retriangulator {
   // Orientation of (a, b, c) in the projection, exactly, relative to the
   // input triangle: positive = same turn as the input.
   mpq_class orientValue(int a, int b, int c) const {
+    countExactEvaluation();
     const mpq_class r = orient2dValue(V_[a].exact(), V_[b].exact(), V_[c].exact(), axis_);
     return sign_ > 0 ? r : mpq_class(-r);
   }
@@ -188,12 +194,14 @@ class Retriangulator {
     const std::uint64_t packed =
         (std::uint64_t(key[0]) << 42) | (std::uint64_t(key[1]) << 21) | std::uint64_t(key[2]);
     const bool packable = key[2] < (1 << 21);  // else not remembered
-    if (packable)
-      for (const auto& [triple, known] : exactOrientations_)
-        if (triple == packed) return parity * known;
+    if (packable) {
+      const auto known = exactOrientations_.find(packed);
+      if (known != exactOrientations_.end()) return parity * known->second;
+    }
+    countExactEvaluation();
     const int sign =
         sgn(orient2dValue(V_[key[0]].exact(), V_[key[1]].exact(), V_[key[2]].exact(), axis_));
-    if (packable) exactOrientations_.push_back({packed, sign});
+    if (packable) exactOrientations_.emplace(packed, sign);
     return parity * sign;
   }
 
@@ -646,7 +654,20 @@ class Retriangulator {
   Point3 normal_;                // (corner 1 - corner 0) x (corner 2 - corner 0), rounded
   double cornerDifference_ = 0;  // the largest coordinate of those differences
   // Sorted triple -> sign; rare (only where the rounded values cannot tell).
-  mutable std::vector<std::pair<std::uint64_t, int>> exactOrientations_;
+  mutable std::unordered_map<std::uint64_t, int> exactOrientations_;
+  mutable std::size_t exactEvaluations_ = 0;
+  std::size_t maxExactEvaluations_ = 0;
+
+  // Counts one rational evaluation against the patch's work bound.
+  void countExactEvaluation() const {
+    if (++exactEvaluations_ > maxExactEvaluations_ && maxExactEvaluations_ > 0)
+      throw WorkLimitError(
+          "the intersection curves meet in one face at points that need exact arithmetic for "
+          "every decision (more than " +
+          std::to_string(maxExactEvaluations_) +
+          " exact evaluations): many sheets pass through nearly one point there, as the "
+          "meridians of a spindle torus do near its axis");
+  }
 };
 
 }  // namespace
@@ -667,7 +688,7 @@ int onlyEdge(std::uint8_t bits) {
 // so the triangles are the same. Every triangle is proper: no three of
 // these points are collinear. False (and `out` untouched) when the input is
 // not of that shape.
-bool cutCorner(const PatchInput& in, Patch& out) {
+bool cutCorner(const PatchInput& in, RetriangulatedPatch& out) {
   if (!in.improve || in.points.size() != 2 || in.on_edges.size() != 2 || in.segments.size() != 1)
     return false;
   const std::array<int, 2> s = in.segments[0];
@@ -712,8 +733,8 @@ bool cutCorner(const PatchInput& in, Patch& out) {
 
 }  // namespace
 
-Patch retriangulate(const PatchInput& input) {
-  Patch patch;
+RetriangulatedPatch retriangulate(const PatchInput& input) {
+  RetriangulatedPatch patch;
   if (cutCorner(input, patch)) return patch;
   thread_local Retriangulator workspace;
   return workspace.run(input);

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
+#include <vector>
 
 #include "common/json.h"
 #include "common/mesh.h"
@@ -44,8 +46,28 @@ struct SelfIntersectionOptions {
   // free of touching faces too (which count as intersections).
   bool separate_touching = true;
   bool keep_removed = false;  // also return the removed faces (result.removed)
-  bool verify = true;         // count the intersecting pairs left (exact) in the result
-  Progress progress;          // called between stages
+  // Count the intersecting pairs of the result (exact, every pair, on the
+  // coordinates as stored): part of the contract below. Off, the contract
+  // is checked without it and the result says it was not verified.
+  bool verify = true;
+  // Work bound: more intersecting pairs than this (found exactly before
+  // anything is cut; splitting costs about 0.1 ms per pair) and the removal
+  // stops with WorkLimitError, the input unchanged. 0 = no bound. Each
+  // face's re-triangulation has its own bound (PatchInput::max_exact_evaluations).
+  std::size_t max_intersecting_pairs = 200000;
+  // Work bound: a face in which more than this many pairs of the faces
+  // crossing it cross each other too (triple points: three faces through
+  // one point) stops the removal with WorkLimitError. The curves then cross
+  // each other in that face about as often, each crossing an exact point of
+  // long numbers (a spindle torus: thousands per face near its axis; the
+  // real meshes: at most 6; boxes of a CAD export overlapping in planes: a
+  // few hundred). 0 = no bound.
+  std::size_t max_triple_points_per_face = 100;
+  // A result that misses its contract: false throws ContractError, saying
+  // what does not hold; true returns it with contract_met false and the
+  // failures listed (the plugin marks such a layer as partial).
+  bool keep_partial = false;
+  Progress progress;  // called between stages and inside the long ones (cancellation)
 };
 
 struct SelfIntersectionResult {
@@ -68,9 +90,10 @@ struct SelfIntersectionResult {
   std::size_t seeds = 0;           // seed faces the growing started from
   std::size_t rays = 0;            // exact ray tests cast to find them
   std::size_t side_conflicts = 0;  // curve edges where no face continued the surface consistently
-  std::size_t vertices_duplicated = 0;  // singular vertices split while stitching (§2.4)
-  std::size_t edges_duplicated = 0;     // singular edges (more than two kept faces) split
-  std::size_t vertices_separated = 0;   // copies moved apart (separate_touching)
+  std::size_t vertices_duplicated = 0;    // singular vertices split while stitching (§2.4)
+  std::size_t edges_duplicated = 0;       // singular edges (more than two kept faces) split
+  std::size_t vertices_separated = 0;     // copies moved apart (separate_touching)
+  bool separation_bound_reached = false;  // the separation's exact tests hit their bound
   bool inside_out =
       false;  // closed input with negative volume: grown turned over, returned as it was
   bool input_closed = false, output_closed = false;
@@ -91,20 +114,38 @@ struct SelfIntersectionResult {
   StoredOutput stored;                           // the output stage on the cut (output_stage.h)
   bool verified = false;                         // remaining_intersecting_pairs was counted
   std::size_t remaining_intersecting_pairs = 0;  // in the result, as stored (float if rounded)
+  // The contract (see removeSelfIntersections), checked on `mesh` as stored.
+  bool contract_met = false;
+  std::vector<std::string> contract_failures;  // what does not hold, one item each
+  // Nothing to remove: the input already met the contract and the growing
+  // kept every face. `mesh` is then the input exactly as it was.
+  bool unchanged = false;
   double time_ms = 0;
   // Where the time went, in milliseconds (the stages of the paper, then ours).
   struct StageTimes {
-    double pretreat = 0, split = 0, growing = 0, stitching = 0, separation = 0, verify = 0;
+    double pretreat = 0, detect = 0, split = 0, growing = 0, stitching = 0, separation = 0,
+           verify = 0;
   } stage_ms;
 };
 
-// Preconditions: a non-empty mesh with finite coordinates whose faces are
-// consistently oriented (no edge whose faces all run it the same way).
-// Throws InvalidInputError / TopologyError otherwise, with the MeshLab
-// filter that fixes it. A mesh with an edge used unequally in the two
+// Preconditions, checked first: a non-empty mesh with finite coordinates
+// whose faces are consistently oriented (no edge whose faces all run it the
+// same way), with at most max_intersecting_pairs intersecting pairs.
+// Throws InvalidInputError / TopologyError / WorkLimitError otherwise, with
+// the filter that fixes it. A mesh with an edge used unequally in the two
 // directions (a border, or a fin of three faces) has no winding number: its
 // seeds follow the paper's rule (nothing in front of them), and borders stay
 // borders.
+//
+// Contract, checked exactly at the end on the mesh as it will be stored
+// (float coordinates with round_to_float): it has faces; no intersecting
+// pair (meshcheck's rule; with verify); every edge has at most two faces and
+// every vertex one fan; faces that share an edge run it opposite ways; it is
+// closed where the input was closed without fins; no face is degenerate
+// that the pre-treated input did not have. Where a result misses it, the
+// removal is made again without snapping; if that misses it too, it throws
+// ContractError (or, with keep_partial, returns the result marked).
+// Stops with CancelledError when the progress callback asks.
 SelfIntersectionResult removeSelfIntersections(const Mesh& input,
                                                const SelfIntersectionOptions& options = {});
 

@@ -671,7 +671,7 @@ class MeshSplitter {
     std::vector<char> split(triangles_.size(), 0);
     std::size_t splitCount = 0, newFaces = 0, newVerticesAtMost = 0;
     for (std::size_t i = 0; i < order_.size(); ++i) {
-      const Patch& patch = patches_[i];
+      const RetriangulatedPatch& patch = patches_[i];
       split[order_[i]] = !patch.triangles.empty();
       if (patch.triangles.empty()) continue;
       ++splitCount;
@@ -699,7 +699,7 @@ class MeshSplitter {
     double smallestSine = 2;             // its measure (smallestAngleMeasure)
     for (std::size_t i = 0; i < order_.size(); ++i) {
       const std::uint32_t f = order_[i];
-      const Patch& patch = patches_[i];
+      const RetriangulatedPatch& patch = patches_[i];
       if (patch.triangles.empty()) {
         ++degenerateKept_;
         continue;
@@ -758,7 +758,7 @@ class MeshSplitter {
   // the other meshes, where freeing everything at the end took a serial
   // tenth of a small split.
   void releaseWorkingMemory() {
-    std::vector<Patch>().swap(patches_);
+    std::vector<RetriangulatedPatch>().swap(patches_);
     work_ = FaceWorkTable(0);
     std::vector<Triangle>().swap(triangles_);
   }
@@ -801,7 +801,7 @@ class MeshSplitter {
   std::vector<int> vertexOrigin_, faceOrigin_;  // input index of each vertex and face
   FaceWorkTable work_;
   std::vector<std::uint32_t> order_;
-  std::vector<Patch> patches_;
+  std::vector<RetriangulatedPatch> patches_;
   std::size_t degenerateKept_ = 0;
   std::size_t keptFaces_ = 0;
   double smallestAngle_ = M_PI;

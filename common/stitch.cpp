@@ -578,9 +578,10 @@ class Polyline {
     for (std::size_t i = 1; i < p_.size(); ++i) s_[i] = s_[i - 1] + (p_[i] - p_[i - 1]).Norm();
   }
   double length() const { return s_.back(); }
-  // The point at arc length s (clamped).
+  // The point at arc length s (clamped; NaN, as 0 x an infinite length
+  // gives, is the start).
   Point3 at(double s) const {
-    if (p_.size() == 1 || s <= 0) return p_.front();
+    if (p_.size() == 1 || !(s > 0)) return p_.front();
     if (s >= s_.back()) return p_.back();
     const std::size_t i = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin() - 1;
     const double span = s_[i + 1] - s_[i];
@@ -603,9 +604,10 @@ class PathLine {
       s_[i] = s_[i - 1] + (point(i) - point(i - 1)).Norm();
   }
   double length() const { return s_.back(); }
-  // The point at arc length s (clamped).
+  // The point at arc length s (clamped; NaN, as 0 x an infinite length
+  // gives, is the start: past the search it read beyond the arrays).
   Point3 at(double s) const {
-    if (s_.size() == 1 || s <= 0) return point(0);
+    if (s_.size() == 1 || !(s > 0)) return point(0);
     if (s >= s_.back()) return point(s_.size() - 1);
     const std::size_t i = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin() - 1;
     const double span = s_[i + 1] - s_[i];
@@ -1511,7 +1513,7 @@ class NearPoints {
   // further; a cell may be visited twice where two hash alike).
   template <class Visit>
   void near(const Point3& q, double radius, Visit&& visit) const {
-    const long reach = std::max(1L, long(std::ceil(radius / radius_)));
+    const long reach = std::max(1L, cellIndex(std::ceil(radius / radius_)));
     const auto c = cellOf(q);
     for (long dx = -reach; dx <= reach; ++dx)
       for (long dy = -reach; dy <= reach; ++dy)
@@ -1524,9 +1526,13 @@ class NearPoints {
   }
 
  private:
+  // A coordinate's cell, clamped to what a long holds (a coordinate over
+  // the radius may overflow to infinity, and converting that is undefined).
+  static long cellIndex(double x) {
+    return x == x ? long(std::clamp(std::floor(x), -4e18, 4e18)) : 0;
+  }
   std::array<long, 3> cellOf(const Point3& p) const {
-    return {long(std::floor(p[0] / radius_)), long(std::floor(p[1] / radius_)),
-            long(std::floor(p[2] / radius_))};
+    return {cellIndex(p[0] / radius_), cellIndex(p[1] / radius_), cellIndex(p[2] / radius_)};
   }
   static std::uint64_t hash(const std::array<long, 3>& c) {
     std::uint64_t h = 0;

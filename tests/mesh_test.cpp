@@ -153,6 +153,20 @@ TEST(Mesh, WeldRemovesFacesThatCollapse) {
   EXPECT_EQ(m.fn, 1);
 }
 
+TEST(Mesh, WeldRemovesFacesWithARepeatedCornerEvenWithoutMerging) {
+  // Nothing to merge, but a face naming one vertex twice: it goes, as in
+  // weldCoincident (the count reported was once not what the mesh held).
+  Mesh m = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 0, 1}});
+  std::size_t removed = 0;
+  EXPECT_EQ(weldCoincidentVertices(m, &removed), 0u);
+  EXPECT_EQ(removed, 1u);
+  EXPECT_EQ(m.fn, 1);
+  EXPECT_EQ(
+      weldCoincident(arraysOf(makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 0, 1}})))
+          .mesh.triangles.size(),
+      std::size_t(m.fn));
+}
+
 // Rounding coordinates to float and back must really round (GCC 12's SLP
 // vectorizer dropped such round trips; the build disables it).
 TEST(Mesh, RoundingToFloatRoundsEveryCoordinate) {

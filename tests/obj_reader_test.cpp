@@ -66,6 +66,18 @@ TEST(ObjReader, MissingMaterialLibraryIsAWarning) {
   EXPECT_EQ(d.polygon_material[0], 0);
 }
 
+TEST(ObjReader, MaterialLibraryThatIsNotARegularFileIsIgnored) {
+  // A device or a folder named as material library (names are relative to
+  // the file's folder): reading /dev/zero line by line would never end. It
+  // is a warning, like a missing one.
+  const ObjData d = readObj(writeTemp(
+      "devmtl.obj",
+      "mtllib ../../../../../../../../dev/zero\nmtllib .\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  ASSERT_EQ(d.warnings.size(), 2u);
+  EXPECT_NE(d.warnings[0].find("not found"), std::string::npos);
+  EXPECT_EQ(d.polygons.size(), 1u);
+}
+
 TEST(ObjReader, ErrorsNameFileAndLine) {
   auto message = [](const std::string& text) {
     try {
@@ -81,6 +93,11 @@ TEST(ObjReader, ErrorsNameFileAndLine) {
             std::string::npos);
   EXPECT_NE(message("v 0 0 0\nf 0 1 2\n").find("index 0"), std::string::npos);
   EXPECT_NE(message("# nothing\n").find("defines no vertex"), std::string::npos);
+  // Beyond int an index would wrap to a valid-looking or negative one.
+  EXPECT_NE(message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967298\n").find("out of range"),
+            std::string::npos);
+  EXPECT_NE(message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9999999999\n").find("out of range"),
+            std::string::npos);
   EXPECT_THROW(readObj("/nonexistent/file.obj"), InvalidInputError);
 }
 

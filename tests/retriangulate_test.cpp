@@ -30,7 +30,7 @@ RationalPoint on(mpq_class s,
 }
 
 // Twice the area, projected along z (the triangle's normal has a non-zero z).
-mpq_class area2(const Patch& p, const std::array<int, 3>& t) {
+mpq_class area2(const RetriangulatedPatch& p, const std::array<int, 3>& t) {
   const auto& a = p.vertices[t[0]].exact().x;
   const auto& b = p.vertices[t[1]].exact().x;
   const auto& c = p.vertices[t[2]].exact().x;
@@ -39,7 +39,7 @@ mpq_class area2(const Patch& p, const std::array<int, 3>& t) {
 
 // Every triangle turns like the input, none is degenerate, and together they
 // cover exactly the input's area.
-void expectValidTiling(const Patch& p) {
+void expectValidTiling(const RetriangulatedPatch& p) {
   const std::array<int, 3> whole{0, 1, 2};
   const mpq_class total = area2(p, whole);
   mpq_class sum = 0;
@@ -51,7 +51,7 @@ void expectValidTiling(const Patch& p) {
   EXPECT_EQ(sum, total);
 }
 
-bool hasEdge(const Patch& p, int a, int b) {
+bool hasEdge(const RetriangulatedPatch& p, int a, int b) {
   for (const auto& t : p.triangles)
     for (int i = 0; i < 3; ++i)
       if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a)) return true;
@@ -68,19 +68,19 @@ PatchInput input(const std::vector<RationalPoint>& points,
 }
 
 TEST(Retriangulate, NoPointsKeepsTheTriangle) {
-  const Patch p = retriangulate(input({}, {}));
+  const RetriangulatedPatch p = retriangulate(input({}, {}));
   ASSERT_EQ(p.triangles.size(), 1u);
   EXPECT_EQ(p.triangles[0], (std::array<int, 3>{0, 1, 2}));
 }
 
 TEST(Retriangulate, InteriorPointSplitsIntoThree) {
-  const Patch p = retriangulate(input({on(mpq_class(1, 3), mpq_class(1, 3))}, {}));
+  const RetriangulatedPatch p = retriangulate(input({on(mpq_class(1, 3), mpq_class(1, 3))}, {}));
   EXPECT_EQ(p.triangles.size(), 3u);
   expectValidTiling(p);
 }
 
 TEST(Retriangulate, PointOnAnEdgeSplitsIntoTwo) {
-  const Patch p = retriangulate(input({on(mpq_class(1, 2), 0)}, {}));
+  const RetriangulatedPatch p = retriangulate(input({on(mpq_class(1, 2), 0)}, {}));
   EXPECT_EQ(p.triangles.size(), 2u);
   expectValidTiling(p);
 }
@@ -88,7 +88,7 @@ TEST(Retriangulate, PointOnAnEdgeSplitsIntoTwo) {
 TEST(Retriangulate, SegmentAcrossBecomesAConstrainedEdge) {
   // From a point on edge 0-1 to a point on edge 0-2, plus an interior point
   // that a Delaunay-like improvement would like to connect across it.
-  const Patch p = retriangulate(input(
+  const RetriangulatedPatch p = retriangulate(input(
       {on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(mpq_class(1, 10), mpq_class(1, 10))},
       {{3, 4}}));
   expectValidTiling(p);
@@ -97,9 +97,10 @@ TEST(Retriangulate, SegmentAcrossBecomesAConstrainedEdge) {
 }
 
 TEST(Retriangulate, CrossingConstraintsMeetAtTheirExactCrossing) {
-  const Patch p = retriangulate(input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(0, 0),
-                                       on(mpq_class(1, 3), mpq_class(1, 3))},
-                                      {{3, 4}, {5, 6}}));
+  const RetriangulatedPatch p =
+      retriangulate(input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(0, 0),
+                           on(mpq_class(1, 3), mpq_class(1, 3))},
+                          {{3, 4}, {5, 6}}));
   expectValidTiling(p);
   EXPECT_EQ(p.vertices.size(), 3u + 3u + 1u);  // corner 0 repeated as a point; one crossing
   EXPECT_EQ(p.constrained_edges.size(), 4u);
@@ -109,8 +110,21 @@ TEST(Retriangulate, CrossingConstraintsMeetAtTheirExactCrossing) {
   EXPECT_EQ(x.x, want.x);
 }
 
+TEST(Retriangulate, StopsAtItsBoundOnExactEvaluations) {
+  // Two crossing constraints: their crossing point is computed exactly.
+  PatchInput in = input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(0, 0),
+                         on(mpq_class(1, 3), mpq_class(1, 3))},
+                        {{3, 4}, {5, 6}});
+  const RetriangulatedPatch p = retriangulate(in);
+  EXPECT_GE(p.exact_evaluations, 2u);
+  in.max_exact_evaluations = 1;
+  EXPECT_THROW(retriangulate(in), WorkLimitError);
+  in.max_exact_evaluations = 0;  // no bound
+  EXPECT_EQ(retriangulate(in).triangles.size(), p.triangles.size());
+}
+
 TEST(Retriangulate, VertexOnAConstraintSplitsIt) {
-  const Patch p = retriangulate(
+  const RetriangulatedPatch p = retriangulate(
       input({on(mpq_class(1, 2), 0), on(0, mpq_class(1, 2)), on(mpq_class(1, 4), mpq_class(1, 4))},
             {{3, 4}}));
   expectValidTiling(p);
@@ -118,7 +132,8 @@ TEST(Retriangulate, VertexOnAConstraintSplitsIt) {
 }
 
 TEST(Retriangulate, ConstraintAlongATriangleEdge) {
-  const Patch p = retriangulate(input({on(mpq_class(1, 4), 0), on(mpq_class(3, 4), 0)}, {{3, 4}}));
+  const RetriangulatedPatch p =
+      retriangulate(input({on(mpq_class(1, 4), 0), on(mpq_class(3, 4), 0)}, {{3, 4}}));
   expectValidTiling(p);
   EXPECT_EQ(p.triangles.size(), 3u);
   EXPECT_TRUE(hasEdge(p, p.vertex_of_input[3], p.vertex_of_input[4]));
@@ -149,7 +164,7 @@ TEST(Retriangulate, StarOfChordsGetsEveryPairwiseCrossing) {
   }
   std::vector<std::array<int, 2>> segments;
   for (int i = 0; i < n; ++i) segments.push_back({3 + 2 * i, 4 + 2 * i});
-  const Patch p = retriangulate(input(points, segments));
+  const RetriangulatedPatch p = retriangulate(input(points, segments));
   expectValidTiling(p);
   std::set<std::array<mpq_class, 3>> want, got;
   for (std::size_t i = 0; i < chords.size(); ++i)
@@ -190,7 +205,7 @@ TEST(Retriangulate, RandomConstraintsAlwaysGiveValidTilings) {
     std::vector<std::array<int, 2>> segments;
     std::uniform_int_distribution<int> pick(0, 12);
     for (int i = 0; i < 6; ++i) segments.push_back({pick(rng), pick(rng)});
-    const Patch p = retriangulate(input(points, segments));
+    const RetriangulatedPatch p = retriangulate(input(points, segments));
     expectValidTiling(p);
     // Each segment's end points are joined by constrained edges along it.
     std::map<int, std::vector<int>> graph;
@@ -216,7 +231,7 @@ TEST(Retriangulate, RandomConstraintsAlwaysGiveValidTilings) {
 }
 
 // The triangles of a patch as a set, each rotated to start at its smallest vertex.
-std::set<std::array<int, 3>> triangleSet(const Patch& p) {
+std::set<std::array<int, 3>> triangleSet(const RetriangulatedPatch& p) {
   std::set<std::array<int, 3>> set;
   for (std::array<int, 3> t : p.triangles) {
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
@@ -253,7 +268,7 @@ TEST(Retriangulate, SegmentAcrossACornerGivesWhatTheFlipsGive) {
         input(points, {direction ? std::array<int, 2>{3, 4} : std::array<int, 2>{4, 3}});
     PatchInput known = unknown;
     known.on_edges = edges;
-    const Patch fast = retriangulate(known), general = retriangulate(unknown);
+    const RetriangulatedPatch fast = retriangulate(known), general = retriangulate(unknown);
     ASSERT_EQ(fast.triangles.size(), 3u);
     expectValidTiling(fast);
     EXPECT_EQ(triangleSet(fast), triangleSet(general)) << "trial " << trial;
@@ -282,7 +297,7 @@ TEST(Retriangulate, SegmentAcrossACornerGivesWhatTheFlipsGive) {
           unknown.segments = {{3, 4}};
           PatchInput known = unknown;
           known.on_edges = edges;
-          const Patch fast = retriangulate(known), general = retriangulate(unknown);
+          const RetriangulatedPatch fast = retriangulate(known), general = retriangulate(unknown);
           EXPECT_EQ(triangleSet(fast), triangleSet(general))
               << "edge " << k << " at " << i << "/8 and " << j << "/8, order " << order;
         }
@@ -314,7 +329,7 @@ TEST(Retriangulate, PointsOnOneCircleGiveTheSameTrianglesInAnyOrder) {
     }
     for (std::size_t i = 0; i < ring.size(); ++i)
       in.segments.push_back({slot[i], slot[(i + 1) % ring.size()]});
-    const Patch p = retriangulate(in);
+    const RetriangulatedPatch p = retriangulate(in);
     std::vector<std::array<double, 9>> triangles;  // by coordinates, each from its smallest corner
     for (std::array<int, 3> t : p.triangles) {
       std::rotate(t.begin(),

@@ -6,10 +6,12 @@
 #include <cmath>
 
 #include "common/errors.h"
+#include "common/inspect.h"
 #include "common/intersections.h"
 #include "common/patches.h"
 #include "common/split.h"
 #include "mesh_builders.h"
+#include "robustness_builders.h"
 
 using namespace meshmend;
 using namespace meshmend::testing;
@@ -113,6 +115,8 @@ TEST(RemoveSelfIntersections, ValidMeshIsReturnedUnchanged) {
   expectValid(r);
   EXPECT_EQ(r.intersecting_pairs_before, 0u);
   EXPECT_EQ(r.faces_removed, 0u);
+  EXPECT_TRUE(r.unchanged);  // nothing to remove: the input as it was
+  EXPECT_TRUE(r.contract_met);
   EXPECT_EQ(r.mesh.fn, sphere.fn);
   EXPECT_EQ(r.components_after, 1);
   EXPECT_EQ(r.genus_after, 0);
@@ -253,11 +257,16 @@ TEST(RemoveSelfIntersections, TouchingCubesAreSeparatedAtTheSharedEdge) {
   EXPECT_GT(r.vertices_separated, 0u);
   expectValid(r);
 
-  // Left where they are, the copies touch: the verification, which tests
-  // only pairs with a changed face, counts what a full search counts.
+  // Left where they are, the copies touch: the contract does not hold, so
+  // the removal refuses, or with keep_partial returns the result marked.
   SelfIntersectionOptions o;
   o.separate_touching = false;
+  EXPECT_THROW(removeSelfIntersections(makeMesh(p, t), o), ContractError);
+  o.keep_partial = true;
   const SelfIntersectionResult touching = removeSelfIntersections(makeMesh(p, t), o);
+  EXPECT_FALSE(touching.contract_met);
+  ASSERT_EQ(touching.contract_failures.size(), 1u);
+  EXPECT_NE(touching.contract_failures[0].find("intersecting face pairs"), std::string::npos);
   EXPECT_EQ(touching.vertices_separated, 0u);
   EXPECT_GT(touching.remaining_intersecting_pairs, 0u);
   EXPECT_EQ(touching.remaining_intersecting_pairs, selfIntersectingPairs(touching.mesh, true));
@@ -287,7 +296,11 @@ split:
   EXPECT_EQ(r.degenerate_faces_before, 1u);
   EXPECT_EQ(r.collapses + r.flips, 1u);
   EXPECT_EQ(r.degenerate_faces_left, 0u);
-  EXPECT_EQ(r.mesh.fn, sphere.fn);
+  EXPECT_EQ(r.faces_kept, std::size_t(sphere.fn));  // the growing saw the collapsed mesh
+  // Nothing crosses and nothing is enclosed: nothing to remove, so the
+  // result is the input as it was (its zero-area face is its own).
+  EXPECT_TRUE(r.unchanged);
+  EXPECT_EQ(r.mesh.fn, degenerate.fn);
   expectValid(r);
   SelfIntersectionOptions off;
   off.pretreat = false;
@@ -320,6 +333,8 @@ TEST(RemoveSelfIntersections, RejectsBadInput) {
     FAIL() << "an inconsistently oriented mesh was accepted";
   } catch (const TopologyError& e) {
     EXPECT_NE(std::string(e.what()).find("Re-Orient all faces coherently"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("MeshMend: Close Gaps Between Borders"),
+              std::string::npos);
   }
   SelfIntersectionOptions o;
   o.degenerate_angle_deg = -1;
@@ -332,4 +347,143 @@ TEST(RemoveSelfIntersections, ReportHasTheDocumentedKeys) {
   for (const char* key : {"faces_kept", "faces_removed", "components_before", "components_after",
                           "remaining_intersecting_pairs", "time_ms", "genus_before", "genus_after"})
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key;
+}
+
+// ---- Contract, work bounds, cancellation -------------------------------------
+
+// The contract, checked here independently of the removal's own check:
+// inspect() counts what meshcheck counts.
+void expectContract(const SelfIntersectionResult& r, bool asFloat) {
+  ASSERT_GT(r.mesh.fn, 0);
+  const InspectResult shape = inspect(r.mesh);
+  EXPECT_EQ(selfIntersectingPairs(r.mesh, asFloat), 0u);
+  EXPECT_EQ(shape.non_manifold_edges, 0u);
+  EXPECT_EQ(shape.non_manifold_vertices, 0u);
+  EXPECT_EQ(shape.orientation_inconsistent_edges, 0u);
+  if (r.input_closed && r.fin_edges_before == 0) {
+    EXPECT_EQ(shape.border_edges, 0u);
+  }
+  EXPECT_TRUE(r.contract_met);
+  EXPECT_TRUE(r.contract_failures.empty());
+}
+
+TEST(RemoveSelfIntersections, EveryGeneratedClassIsValidOrRefusedCleanly) {
+  // Coordinates from 1e-30 to near FLT_MAX, coplanar contact, non-manifold
+  // and inconsistently oriented exports, soups with T-junctions, walls with
+  // holes, spindle and self-touching tori, an OpenSCAD-like export: in
+  // double and as a float host stores it, each result meets the contract
+  // or the removal throws one of the core's typed errors (the plugin then
+  // leaves the layer unchanged).
+  for (const auto& [name, mesh] : robustnessClasses())
+    for (bool asFloat : {false, true}) {
+      SCOPED_TRACE(name + (asFloat ? " (float)" : " (double)"));
+      SelfIntersectionOptions o;
+      o.round_to_float = asFloat;
+      try {
+        expectContract(removeSelfIntersections(mesh, o), asFloat);
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()), "");
+      }
+    }
+}
+
+TEST(RemoveSelfIntersections, ClassesThatMustComeOutValid) {
+  // These have an outer surface the removal finds: no refusal allowed. (The
+  // touching torus is not among them: its walls meet at a point where two
+  // vertices nearly coincide and cross along two curves through it; the
+  // removal leaves 3 pairs there and refuses, which the test above allows.)
+  for (const auto& [name, mesh] : robustnessClasses()) {
+    if (name != "tiny_1e-30" && name != "huge_1e37" && name != "part_in_flt_max_box" &&
+        name != "stl_soup_t_junctions" && name != "wall_with_hole" &&
+        name != "wall_with_open_hole" && name != "horn_torus")
+      continue;
+    SCOPED_TRACE(name);
+    try {
+      expectContract(removeSelfIntersections(mesh), false);
+    } catch (const Error& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+}
+
+TEST(RemoveSelfIntersections, PartInsideAFltMaxBoxGoes) {
+  // The box's corners at nearly +-FLT_MAX; the part inside does not touch it.
+  const Mesh part = torusOf(1.0, 0.4, 32, 16);
+  const Mesh box = boxAt({-0.99 * FLT_MAX, -0.99 * FLT_MAX, -0.99 * FLT_MAX},
+                         {0.99 * FLT_MAX, 0.99 * FLT_MAX, 0.99 * FLT_MAX});
+  SelfIntersectionOptions o;
+  o.round_to_float = true;
+  const SelfIntersectionResult r = removeSelfIntersections(combined({part, box}), o);
+  expectContract(r, true);
+  EXPECT_EQ(r.mesh.fn, 12);  // the box alone is the outer surface
+}
+
+TEST(RemoveSelfIntersections, InconsistentOrientationIsRefusedWithAMeshMendRemedy) {
+  try {
+    removeSelfIntersections(withFlippedFaces(box(), {0, 5}));
+    FAIL() << "accepted";
+  } catch (const TopologyError& e) {
+    EXPECT_NE(std::string(e.what()).find("MeshMend: Close Gaps Between Borders"),
+              std::string::npos);
+  }
+}
+
+TEST(RemoveSelfIntersections, SpindleTorusStopsAtItsWorkBound) {
+  // Every meridian passes through the two points where the tube meets the
+  // axis: thousands of curve crossings per face there. The removal stops at
+  // its bound on them, before cutting anything.
+  for (bool asFloat : {false, true}) {
+    SelfIntersectionOptions o;
+    o.round_to_float = asFloat;
+    try {
+      removeSelfIntersections(torusOf(0.3, 1.0, 64, 32), o);
+      FAIL() << "no bound reached";
+    } catch (const WorkLimitError& e) {
+      EXPECT_NE(std::string(e.what()).find("max_triple_points_per_face"), std::string::npos);
+    }
+  }
+}
+
+TEST(RemoveSelfIntersections, StopsAtItsBoundOnIntersectingPairs) {
+  const Mesh two = together(uvSphere(16, 24), uvSphere(16, 24, 0.8, {0.9, 0.2, 0.1}));
+  SelfIntersectionOptions o;
+  o.max_intersecting_pairs = 10;
+  try {
+    removeSelfIntersections(two, o);
+    FAIL() << "no bound reached";
+  } catch (const WorkLimitError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_intersecting_pairs"), std::string::npos);
+  }
+  o.max_intersecting_pairs = 0;  // no bound
+  expectContract(removeSelfIntersections(two, o), false);
+}
+
+TEST(RemoveSelfIntersections, CancelsAtEveryProgressReport) {
+  // Each report is a point where the user may cancel: asked to stop at the
+  // n-th report, for every n, the removal throws CancelledError.
+  const Mesh two = together(uvSphere(12, 16), uvSphere(12, 16, 0.8, {0.9, 0.2, 0.1}));
+  int reports = 0;
+  SelfIntersectionOptions o;
+  o.progress = [&](int, const char*) { return ++reports, true; };
+  removeSelfIntersections(two, o);
+  ASSERT_GT(reports, 5);
+  for (int stopAt = 1; stopAt <= reports; ++stopAt) {
+    int seen = 0;
+    o.progress = [&](int, const char*) { return ++seen < stopAt; };
+    EXPECT_THROW(removeSelfIntersections(two, o), CancelledError) << "report " << stopAt;
+  }
+}
+
+TEST(RemoveSelfIntersections, NothingEnclosedNothingCrossingIsUnchanged) {
+  // Two separate spheres, nothing crossing, nothing inside: unchanged.
+  const Mesh two = together(uvSphere(8, 12), uvSphere(8, 12, 1, {3, 0, 0}));
+  const SelfIntersectionResult r = removeSelfIntersections(two);
+  EXPECT_TRUE(r.unchanged);
+  EXPECT_EQ(r.mesh.fn, two.fn);
+  EXPECT_EQ(positionsOf(r.mesh), positionsOf(two));
+  EXPECT_EQ(trianglesOf(r.mesh), trianglesOf(two));
+  // An unwelded copy (an STL soup) touches at its seams: not "unchanged".
+  const SelfIntersectionResult soup = removeSelfIntersections(soupOf(uvSphere(8, 12)));
+  EXPECT_FALSE(soup.unchanged);
+  expectContract(soup, false);
 }

@@ -134,6 +134,13 @@ void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
         "max_iterations", ClearanceOptions().max_iterations, "Max iterations",
         "Gauss-Newton steps at most; each step re-detects the pairs closer than tau. The filter "
         "stops earlier when tau is reached."));
+    parameters.addParam(RichBool(
+        "keep_partial", false, "Keep a partial result",
+        "The result is checked as it will be stored: no intersecting pair, and no pair closer "
+        "than the closest was before (tau not reached within the cap, the locks or the "
+        "iterations is an outcome the log explains, not a failure). Where that does not hold "
+        "the layers stay unchanged; on, the result is written anyway, the layers' names ending "
+        "in '(partial)'."));
   }
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
@@ -461,7 +468,29 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
 
   // With matrices the verdict is the one on what the layers will hold.
   const bool reached = anyMatrix ? r.reached && pairsAfter == 0 : r.reached;
+  // The contract, on what the layers will hold: the surfaces do not cross,
+  // and no pair in scope ends closer than the closest was.
+  std::vector<std::string> failures;
+  if (r.new_intersecting_pairs > 0)
+    failures.push_back(std::to_string(r.new_intersecting_pairs) +
+                       " intersecting face pairs as stored");
+  if (minAfter < minBefore)
+    failures.push_back("the smallest distance fell from " + std::to_string(minBefore) + " to " +
+                       std::to_string(minAfter));
+  const bool keepPartial = parameters.getBool("keep_partial");
+  if (!failures.empty() && !keepPartial) {
+    std::string what;
+    for (const std::string& f : failures) what += (what.empty() ? "" : "; ") + f;
+    throw ContractError(
+        "Enforce Minimum Clearance could not make a valid result: " + what +
+        ". Nothing was changed. Try a smaller tau or a max displacement, or turn on 'Keep a "
+        "partial result' to see what was made");
+  }
   JsonObject report = toJson(r);
+  report.set("contract_met", failures.empty())
+      .set("contract_failures", failures)
+      .set("partial", !failures.empty())
+      .set("unchanged", pairsBefore == 0);
   if (reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
   report.set("scope", toString(options.scope))
       .set("layers", labels(layers))
@@ -487,8 +516,16 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   }
   publishReport(parameters, report);
 
+  if (pairsBefore == 0) {
+    Log("MeshMend: no pair of faces is closer than tau = %.6g (the closest: %.6g): nothing to "
+        "move; the layers are unchanged",
+        r.tau, minBefore);
+    reportProgress(options.progress, 100, "MeshMend: done");
+    return;
+  }
   // The only change to the document, made last: positions of moved vertices.
   for (std::size_t l = 0; l < layers.size(); ++l) {
+    if (!failures.empty()) layers[l]->setLabel(layers[l]->label() + " (partial)");
     if (moves[l].empty()) continue;
     CMeshO& cm = layers[l]->cm;
     for (const auto& [vertex, p] : moves[l]) cm.vert[vertex].P() = p;
@@ -541,6 +578,8 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   for (const std::string& w : r.warnings) Log("  warning: %s", w.c_str());
   if (r.new_intersecting_pairs)
     Log("  check: %zu intersecting pairs in the float result", r.new_intersecting_pairs);
+  for (const std::string& f : failures)
+    Log("  warning: PARTIAL result (kept as asked): %s", f.c_str());
   reportProgress(options.progress, 100, "MeshMend: done");
 }
 

@@ -372,12 +372,21 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   // otherwise nothing changed and nothing is written.
   const bool nothingMet =
       r.intersecting_pairs == 0 && r.vertices_welded == 0 && r.duplicate_faces_removed == 0;
-  if (nothingMet && mode == kWithinCurrent)
-    throw InvalidInputError(layerName(*layers[0]) + " does not intersect itself: nothing to split");
-  if (nothingMet && !merge)
-    throw InvalidInputError(
-        "the chosen layers do not intersect: nothing to split (to combine parts that do not "
-        "meet, nested or apart, for the boolean filters, choose the merged output)");
+  // Nothing to split is success (MeshLab's convention): logged, reported,
+  // and the layers stay as they were.
+  if (nothingMet && (mode == kWithinCurrent || !merge)) {
+    if (mode == kWithinCurrent)
+      Log("MeshMend: %s does not intersect itself: nothing to split; the layer is unchanged",
+          layerName(*layers[0]).c_str());
+    else
+      Log("MeshMend: the chosen layers do not intersect: nothing to split; the layers are "
+          "unchanged (to combine parts that do not meet, nested or apart, for the boolean "
+          "filters, choose the merged output)");
+    std::vector<std::string> names;
+    for (MeshModel* m : layers) names.push_back(toStd(m->label()));
+    publishReport(parameters, toJson(r).set("layers", names).set("unchanged", true));
+    return;
+  }
   // The output stage (output_stage.h): rounded to the host's scalar,
   // checked exactly on the stored values and repaired.
   OutputStageOptions stage;

@@ -28,11 +28,17 @@ QString SelfIntersectPlugin::filterInfo(FilterIDType) const {
          "continues on the sheet that keeps the surface closed; the kept faces are stitched "
          "into a manifold mesh. Parts that overlap merge, pieces turned inside out go, and "
          "hollow parts keep their inner walls.<br>"
-         "Needs consistent orientation (run <i>Re-Orient all faces coherently</i> first "
-         "otherwise). A closed mesh turned inside out is handled and stays so. On a mesh with "
-         "borders a seed must see nothing in front of it, and borders stay borders. Where the "
-         "result touches itself at a vertex or edge, each side gets its own copy of the "
-         "vertex, moved apart by 1/1000 of the local edge length.";
+         "Needs consistent orientation (run <i>MeshMend: Close Gaps Between Borders</i> or "
+         "<i>Re-Orient all faces coherently</i> first otherwise). A closed mesh turned inside "
+         "out is handled and stays so. On a mesh with borders a seed must see nothing in front "
+         "of it, and borders stay borders. Where the result touches itself at a vertex or edge, "
+         "each side gets its own copy of the vertex, moved apart by 1/1000 of the local edge "
+         "length.<br>"
+         "The result is checked exactly as it will be stored: no intersecting pair, every edge "
+         "with at most two faces, every vertex one fan, consistently oriented, closed where the "
+         "input was, no new zero-area face. Where that does not hold the layer stays unchanged "
+         "and the log says what failed and what to try. A mesh with nothing to remove stays "
+         "unchanged too.";
 }
 
 void SelfIntersectPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& parameters) {
@@ -70,6 +76,24 @@ void SelfIntersectPlugin::initParameters(QAction*, MeshDocument&, RichParameterL
                QString("Counts the intersecting face pairs left in the result, exactly, as "
                        "stored in %1 (remaining_intersecting_pairs in the log and report).")
                    .arg(kHostPrecision)));
+  parameters.addParam(RichBool(
+      "keep_partial", defaults.keep_partial, "Keep a partial result",
+      "Where the result does not pass the check (see the filter's description), write it anyway "
+      "so that it can be looked at: the layer's name then ends in '(partial)' and the report "
+      "says contract_met false and lists what failed. Off, the layer stays unchanged."));
+  parameters.addParam(RichInt(
+      "max_intersecting_pairs", int(defaults.max_intersecting_pairs),
+      "Work bound: intersecting pairs",
+      "More intersecting face pairs than this (found before anything is cut) and the filter "
+      "stops with a message, the layer unchanged: cutting costs about 0.1 ms per pair. 0 = no "
+      "bound."));
+  parameters.addParam(RichInt(
+      "max_triple_points_per_face", int(defaults.max_triple_points_per_face),
+      "Work bound: crossings within a face",
+      "A face where more than this many pairs of the faces crossing it cross each other too "
+      "(the surface passing many times through nearly one point, as in a spindle torus) stops "
+      "the filter with a message, the layer unchanged: the exact arithmetic there would take "
+      "minutes. Real meshes have a few. 0 = no bound."));
   parameters.addParam(RichString(
       "report_file", "", "Report file (JSON)",
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
@@ -89,21 +113,30 @@ void SelfIntersectPlugin::apply(QAction*, MeshDocument& md, const RichParameterL
   options.separate_touching = parameters.getBool("separate_touching");
   options.keep_removed = parameters.getBool("removed_to_layer");
   options.verify = parameters.getBool("verify");
+  options.keep_partial = parameters.getBool("keep_partial");
+  const int maxPairs = parameters.getInt("max_intersecting_pairs");
+  const int maxTriples = parameters.getInt("max_triple_points_per_face");
+  if (maxPairs < 0 || maxTriples < 0)
+    throw InvalidInputError("the work bounds must be 0 (no bound) or more");
+  options.max_intersecting_pairs = std::size_t(maxPairs);
+  options.max_triple_points_per_face = std::size_t(maxTriples);
   options.round_to_float = kHostStoresFloat;  // decide on what MeshLab will store
   options.progress = progressFrom(cb);
 
   reportProgress(options.progress, 0, "MeshMend: reading the layer");
   const Mesh core = toCore(model->cm);
   const SelfIntersectionResult r = removeSelfIntersections(core, options);
-  if (r.mesh.fn == 0)
-    throw TopologyError(
-        "no face of the mesh is outside with respect to its orientation, so nothing would be "
-        "kept: check the orientation (Filters > Normals > Invert Faces Orientation) and try "
-        "again; the layer is unchanged");
 
   JsonObject report = toJson(r);
-  report.set("layer", toStd(model->label()));
+  report.set("layer", toStd(model->label())).set("partial", !r.contract_met);
   publishReport(parameters, report);
+  if (r.unchanged) {
+    Log("MeshMend: %s has no self-intersection and nothing enclosed to remove (%.0f ms); the "
+        "layer is unchanged",
+        layerName(*model).c_str(), r.time_ms);
+    reportProgress(options.progress, 100, "MeshMend: done");
+    return;
+  }
 
   // The only changes to the document, made last.
   const std::vector<LayerAttributes> attributes{snapshot(*model)};
@@ -112,6 +145,7 @@ void SelfIntersectPlugin::apply(QAction*, MeshDocument& md, const RichParameterL
     writeMesh(r.removed, attributes, *rest);
   }
   writeMesh(r.mesh, attributes, *model);
+  if (!r.contract_met) model->setLabel(model->label() + " (partial)");
 
   Log("MeshMend: removed self-intersections of %s in %.0f ms", layerName(*model).c_str(),
       r.time_ms);
@@ -136,6 +170,11 @@ void SelfIntersectPlugin::apply(QAction*, MeshDocument& md, const RichParameterL
     Log("  note: snapping left crossings or non-manifold edges (sheets closer than its "
         "tolerance): the result was made again without snapping");
   if (r.verified) Log("  check: %zu intersecting pairs left", r.remaining_intersecting_pairs);
+  if (!r.contract_met) {
+    Log("  warning: PARTIAL result (kept as asked), the layer is now %s; what does not hold:",
+        layerName(*model).c_str());
+    for (const std::string& failure : r.contract_failures) Log("    %s", failure.c_str());
+  }
   reportProgress(options.progress, 100, "MeshMend: done");
 }
 

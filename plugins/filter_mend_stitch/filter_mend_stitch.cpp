@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/edit_contract.h"
 #include "common/stitch.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
@@ -244,6 +245,50 @@ QString StitchPlugin::filterInfo(FilterIDType id) const {
          paper;
 }
 
+// ------------------------------------------------------------------ contract
+
+namespace {
+
+RichBool keepPartialParameter() {
+  return RichBool(
+      "keep_partial", false, "Keep a partial result",
+      "The result is checked exactly as it will be stored: no new edge with more than two "
+      "faces, no new edge run the same way by both its faces, no new face without area, no "
+      "intersecting pair with a new or changed face. Where that does not hold the layers stay "
+      "unchanged; on, the result is written anyway, its layer's name ending in '(partial)' and "
+      "the report saying contract_met false.");
+}
+
+// The edit contract (common/edit_contract.h) of `after` against `before`;
+// throws ContractError, the layers unchanged, when it does not hold and no
+// partial result is asked for.
+EditContract requireEditContract(const Mesh& before, const Mesh& after, const std::string& filter,
+                                 const EditContractOptions& options, bool keepPartial,
+                                 const std::string& toTry) {
+  const EditContract c = checkEditContract(before, after, options);
+  if (!c.met && !keepPartial)
+    throw ContractError(filter + " could not make a valid result: " + describeFailures(c) +
+                        ". Nothing was changed. " + toTry);
+  return c;
+}
+
+void reportContract(JsonObject& report, const EditContract& c) {
+  report.set("contract_met", c.met)
+      .set("contract_failures", c.failures)
+      .set("partial", !c.met)
+      .set("changed_faces", c.changed_faces);
+}
+
+void logContract(FilterAdapter& plugin, const EditContract& c, MeshModel& layer) {
+  if (c.met) return;
+  layer.setLabel(layer.label() + " (partial)");
+  plugin.Log(
+      "  warning: PARTIAL result (kept as asked), the layer is now %s; what does not hold: %s",
+      layerName(layer).c_str(), describeFailures(c).c_str());
+}
+
+}  // namespace
+
 void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   const QString report =
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
@@ -343,6 +388,7 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
                  "layer receives the result and the second layer is removed from the document."));
     parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
                                  "Selects the stitched faces afterwards (and nothing else)."));
+    parameters.addParam(keepPartialParameter());
   } else {
     parameters.addParam(RichFloat(
         "merge_tolerance", 0, "Merge tolerance (fraction of the diagonal)",
@@ -384,6 +430,7 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "Off: the current layer, in place."));
     parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
                                  "Selects the stitched faces afterwards (and nothing else)."));
+    parameters.addParam(keepPartialParameter());
   }
   parameters.addParam(RichString("report_file", "", "Report file (JSON)", report));
 }
@@ -487,10 +534,19 @@ void StitchPlugin::trim(MeshDocument& md, const RichParameterList& parameters,
       if (!done) throw;
     }
   }
+  const Mesh before = toCore(model->cm);
   if (!done) r = trimAlongLoop(core, options);
+  EditContractOptions co;
+  co.as_float = kHostStoresFloat;
+  co.count_pairs = false;  // trimming only removes faces: none is new
+  const EditContract contract =
+      requireEditContract(before, core, "Trim Along Vertex Loop", co, false,
+                          "Trimming only removes faces, so this is a defect: please report it "
+                          "with the mesh and the loop");
 
   JsonObject report = toJson(r);
   report.set("layer", toStd(model->label())).set("loop_from", source);
+  reportContract(report, contract);
   publishReport(parameters, report);
 
   // The only changes to the document, made last.
@@ -567,6 +623,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
     requireFacesAndFiniteCoordinates(*core, layerName(*model));
   }
   MeshModel& current = *layers.front();
+  const Mesh before = *core;
 
   JsonObject report;
   std::vector<int> newFaces;
@@ -646,6 +703,16 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
       Log("  note: the %zu new vertices are stored in %s (computed in double)", r.vertices_added,
           kHostPrecision);
   }
+  EditContractOptions co;
+  co.as_float = kHostStoresFloat;
+  co.count_pairs = options.check_intersections;
+  co.allow_orientation_conflicts = options.allow_orientation_conflict;
+  co.progress = options.progress;
+  const EditContract contract = requireEditContract(
+      before, *core, "Stitch Boundaries", co, parameters.getBool("keep_partial"),
+      "Try paths that face each other, without subdivision (aspect ratio 0), or turn on 'Keep "
+      "a partial result' to see what was made");
+  reportContract(report, contract);
   const int output = parameters.getEnum("output");
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
@@ -677,6 +744,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
     writeMesh(*core, attributes, current);
   }
   if (parameters.getBool("select_new_faces")) selectOnly(target->cm, newFaces);
+  logContract(*this, contract, *target);
   reportProgress(options.progress, 100, "MeshMend: done");
 }
 
@@ -724,9 +792,24 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   const std::string what = allVisible ? "the visible layers" : layerName(*layers[0]);
   requireFacesAndFiniteCoordinates(*core, what);
   const std::size_t facesBefore = core->face.size();
+  const Mesh before = *core;
 
   const CloseGapsResult r = meshmend::closeGaps(*core, options);
+  const bool nothingDone = r.vertices_merged == 0 && r.faces_added == 0 && r.faces_flipped == 0 &&
+                           r.degenerate_faces_removed == 0;
+  EditContractOptions co;
+  co.as_float = kHostStoresFloat;
+  co.count_pairs = true;
+  co.progress = options.progress;
+  const EditContract contract =
+      nothingDone ? EditContract{}
+                  : requireEditContract(before, *core, "Close Gaps Between Borders", co,
+                                        parameters.getBool("keep_partial"),
+                                        "Try a smaller merge tolerance and max gap, with 'Check "
+                                        "intersections' on, or turn on 'Keep a partial result' "
+                                        "to see what was made");
   JsonObject report = toJson(r);
+  reportContract(report, contract);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names);
@@ -750,8 +833,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   if (r.vertices_added)
     Log("  note: the %zu new vertices are stored in %s (computed in double)", r.vertices_added,
         kHostPrecision);
-  if (r.vertices_merged == 0 && r.faces_added == 0 && r.faces_flipped == 0 &&
-      r.degenerate_faces_removed == 0 && !allVisible) {
+  if (nothingDone && !allVisible) {
     Log("MeshMend: nothing to merge or stitch; the layer is unchanged");
     return;
   }
@@ -773,6 +855,7 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
     for (std::size_t f = facesBefore; f < core->face.size(); ++f) added.push_back(int(f));
     selectOnly(target->cm, added);
   }
+  logContract(*this, contract, *target);
   reportProgress(options.progress, 100, "MeshMend: done");
 }
 

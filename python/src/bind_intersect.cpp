@@ -233,6 +233,19 @@ OptionTable<SelfIntersectionOptions> selfTable() {
   t.add(
       "verify", [](O& o) -> bool& { return o.verify; },
       "count the intersecting pairs left in the result (remaining_intersecting_pairs)");
+  t.add(
+      "keep_partial", [](O& o) -> bool& { return o.keep_partial; },
+      "return a result that misses the contract (report contract_met False, contract_failures) "
+      "instead of raising meshmend.Error");
+  t.add(
+      "max_intersecting_pairs", [](O& o) -> std::size_t& { return o.max_intersecting_pairs; },
+      "work bound: more intersecting pairs than this and the removal stops (meshmend.Error), "
+      "nothing changed; 0 = no bound");
+  t.add(
+      "max_triple_points_per_face",
+      [](O& o) -> std::size_t& { return o.max_triple_points_per_face; },
+      "work bound: a face where more pairs of its crossing faces cross each other stops the "
+      "removal (meshmend.Error), nothing changed; 0 = no bound");
   return t;
 }
 

@@ -133,17 +133,23 @@ def test_split_keeps_layers_separate_and_closed(tmp_path):
     assert inspect["faces"] > 12
 
 
-def test_split_refuses_layers_that_do_not_intersect(tmp_path):
-    """Kept separate, layers that do not meet have nothing to split: refused,
-    unchanged. Merged, the merged layer holds them as they are (the boolean
+def test_split_of_layers_that_do_not_intersect_succeeds_unchanged(tmp_path):
+    """Kept separate, layers that do not meet have nothing to split: that is
+    success (MeshLab's convention), logged and reported, the layers as they
+    were. Merged, the merged layer holds them as they are (the boolean
     filters take nested or separate parts from it)."""
     V, F = cube()
     a = write_off(tmp_path / "a.off", V, F)
     b = write_off(tmp_path / "b.off", shifted(V, 5.0), F)
+    kept = tmp_path / "b_kept.ply"
     run = run_server(tmp_path, [a, b], mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
-                                                    "output": 0, "report_file": "{report0}"})))
-    assert run.returncode != 0
-    assert "do not intersect" in run.log and "merged output" in run.log and not run.reports
+                                                    "output": 0, "report_file": "{report0}"})),
+                     outputs=[kept])
+    assert run.returncode == 0, run.log[-2000:]
+    assert "do not intersect" in run.log and "merged output" in run.log and "unchanged" in run.log
+    assert run.report["unchanged"] and run.report["intersecting_pairs"] == 0
+    check = meshcheck(kept)
+    assert check["faces"] == 12 and check["bbox"][0] == 5.0  # layer b as it was
     out = tmp_path / "merged.ply"
     run = run_server(tmp_path, [a, b], mlx((SPLIT, {"mode": 1, "first_layer": 0, "second_layer": 1,
                                                     "output": 1, "report_file": "{report0}"})),
@@ -296,3 +302,17 @@ def test_split_sample_runs(tmp_path):
     run = run_server(tmp_path, [a, b], (ROOT / "samples" / "intersect_split.mlx").read_text())
     assert run.returncode == 0, run.log
     assert "0 intersecting pairs remain" in run.log
+
+
+def test_split_self_intersections_sample_on_a_clean_mesh_succeeds_unchanged(tmp_path):
+    """Nothing to split is success: the sample script does not stop a batch
+    on a mesh that does not intersect itself, and the layer stays as it was."""
+    V, F = cube()
+    src = write_off(tmp_path / "cube.off", V, F)
+    out = tmp_path / "out.ply"
+    text = (ROOT / "samples" / "split_self_intersections.mlx").read_text()
+    run = run_server(tmp_path, [src], text, outputs=[out])
+    assert run.returncode == 0, run.log[-2000:]
+    assert "does not intersect itself" in run.log and "unchanged" in run.log
+    check = meshcheck(out)
+    assert check["faces"] == 12 and check["vertices"] == 8 and check["volume"] == 1

@@ -1046,6 +1046,30 @@ def test_core_errors_keep_their_messages():
     assert volume(inside_out.vertices, inside_out.faces) == pytest.approx(-volume(V, F), rel=1e-12)
 
 
+def test_removal_work_bounds_and_partial_results():
+    """The removal's work bounds stop it before anything is cut (the spindle
+    torus, every meridian through two points of the axis, in well under a
+    second); a result that misses the contract raises unless keep_partial."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    import robustness_shapes
+    V, F = robustness_shapes.classes()["spindle_torus"]
+    start = time.monotonic()
+    with pytest.raises(mm.Error, match="max_triple_points_per_face"):
+        mm.remove_self_intersections(V, F)
+    assert time.monotonic() - start < 10
+    with pytest.raises(mm.Error, match="max_intersecting_pairs"):
+        mm.remove_self_intersections(V, F, max_intersecting_pairs=3)
+    # Two cubes sharing an edge, left touching: intersecting pairs remain.
+    Vc = np.array([(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    Fc = np.array(robustness_shapes.BOX_FACES)
+    V2, F2 = np.vstack([Vc, Vc + (1, 1, 0)]), np.vstack([Fc, Fc + 8])
+    with pytest.raises(mm.Error, match="could not make a valid surface"):
+        mm.remove_self_intersections(V2, F2, separate_touching=False)
+    partial = mm.remove_self_intersections(V2, F2, separate_touching=False, keep_partial=True)
+    assert not partial.report["contract_met"] and partial.report["contract_failures"]
+    assert mm.remove_self_intersections(V2, F2).report["contract_met"]
+
+
 def test_progress_is_reported_and_can_stop_the_work(two_spheres):
     (V1, F1), (V2, F2) = two_spheres
     seen = []
