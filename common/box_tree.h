@@ -65,9 +65,14 @@ class BoxGrid {
   // the coordinate keeps overlapping boxes in overlapping cell ranges, as
   // marking and testing use this one. (Here, inlined: a call per axis was
   // a third of turning a large mesh's faces away.)
+  // Clamped before converting (a huge or NaN offset, from coordinates near
+  // the double range, has no int): a NaN start takes the first cell and a
+  // NaN end the last, so that such a box is never turned away.
   void cellRange(const Box& b, int k, int& lo, int& hi) const {
-    lo = std::clamp(int((b.lo[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
-    hi = std::clamp(int((b.hi[k] - bounds_.lo[k]) * cellsPerUnit_[k]), 0, kCells - 1);
+    const double from = (b.lo[k] - bounds_.lo[k]) * cellsPerUnit_[k];
+    const double to = (b.hi[k] - bounds_.lo[k]) * cellsPerUnit_[k];
+    lo = !(from > 0) ? 0 : from < kCells - 1 ? int(from) : kCells - 1;
+    hi = !(to < kCells - 1) ? kCells - 1 : to > 0 ? int(to) : 0;
   }
   bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
 

@@ -369,6 +369,10 @@ class ValidRegionGrowing {
     Point3 end = o;
     const double extent = double(bounds_.hi[k]) - double(bounds_.lo[k]) + 1;
     end[k] = n[k] > 0 ? double(bounds_.hi[k]) + extent : double(bounds_.lo[k]) - extent;
+    // Near the double range the centre or the ray's end overflow: a ray
+    // from or to infinity has no exact predicate, so it decides nothing.
+    for (int j = 0; j < 3; ++j)
+      if (!std::isfinite(o[j]) || !std::isfinite(end[j])) return RayVerdict::kUndecided;
     int winding = 0, hits = 0;
     bool undecided = false;
     facesOverlapping(boxOf(o, end, end), [&](std::uint32_t h) {

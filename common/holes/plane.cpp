@@ -81,8 +81,11 @@ Grid::Grid(Vec2 lo, Vec2 hi, double cell, std::size_t maxCells) : lo_(lo) {
   const double w = std::max(hi.x - lo.x, 1e-300), h = std::max(hi.y - lo.y, 1e-300);
   cell = std::max(cell, std::sqrt(w * h / double(std::max<std::size_t>(maxCells, 1))));
   inverse_ = 1 / cell;
-  nx_ = std::max(1, std::min(4096, int(w * inverse_) + 1));
-  ny_ = std::max(1, std::min(4096, int(h * inverse_) + 1));
+  // Clamped before converting: an extent near the double range makes the
+  // counts infinite or NaN, which have no int (they take the most cells).
+  auto cells = [](double extent) { return extent < 4095 ? int(extent) + 1 : 4096; };
+  nx_ = cells(w * inverse_);
+  ny_ = cells(h * inverse_);
   head_.assign(std::size_t(nx_) * std::size_t(ny_), -1);
   entries_.reserve(2 * head_.size());
 }
