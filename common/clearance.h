@@ -1,4 +1,5 @@
-// Minimum clearance between surfaces (self-intersection avoidance, papers/001):
+// Minimum clearance between surfaces (Aycheh & Kyung, "Self-intersection
+// avoidance for 3-D triangular mesh model"; docs/REFERENCES.md):
 // measuring the smallest distance between non-adjacent triangles, and moving
 // vertices as little as possible until every such pair is at least τ apart.
 //

@@ -1,4 +1,4 @@
-// Points known exactly by their construction from input doubles (DESIGN §4).
+// Points known exactly by their construction from input doubles.
 //
 // An intersection point (an edge crossing a plane, two coplanar edges
 // crossing) has rational coordinates whose exact value is costly to compute

@@ -1,5 +1,5 @@
-// Feature-preserving hole filling (Xu, Li, Tan: "Feature Based Hole Filling
-// Algorithm on Triangular Mesh", papers/004): border loops are found and their
+// Feature-preserving hole filling (Xu, Li, Tan 2013, "Feature Based Hole
+// Filling Algorithm on Triangular Mesh"; docs/REFERENCES.md): border loops are found and their
 // long edges split (§3.1), each hole is covered by an advancing-front patch
 // whose triangles take the size of the input's border edges (§3.2), and the
 // patch vertices are placed by a Poisson solve whose right-hand side is the

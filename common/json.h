@@ -1,5 +1,5 @@
 // A small ordered JSON object writer for the filters' machine-readable reports
-// (DESIGN §5: `report_file`). Values are rendered when set; keys keep their order.
+// (the filters' `report_file`). Values are rendered when set; keys keep their order.
 #pragma once
 
 #include <cstdint>

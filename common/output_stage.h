@@ -1,4 +1,4 @@
-// The output stage (DESIGN §4). A split's result is exact until it is
+// The output stage. A split's result is exact until it is
 // stored: its curve points are rationals, kept in double as approximations
 // within a proven error. Storing it in the host's scalar (float or double,
 // mesh.h: Scalar) rounds every coordinate, and near-coincident surfaces (CAD

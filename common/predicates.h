@@ -1,4 +1,4 @@
-// Exact geometric predicates on double coordinates (DESIGN §4).
+// Exact geometric predicates on double coordinates.
 //
 // Each predicate first evaluates in floating point with a static/semi-static
 // error bound (Shewchuk's bounds for the rounded determinant); only when the

@@ -283,7 +283,7 @@ class CurvePoints {
 // inserts the edges of each side into the other, so both re-triangulate the
 // overlap alike and, welded, their faces there coincide: the same three
 // vertices twice (either orientation). This keeps each such face once in
-// `merged` (the intersection paper's result is free of duplicate geometry)
+// `merged` (McLaurin 2012's result is free of duplicate geometry)
 // and returns how many it removed. Only faces whose corners are all curve
 // vertices (`onCurve`) can have a twin: other vertices belong to one mesh.
 // A curve edge inside an overlap (all its faces were twins) is then an

@@ -1,6 +1,6 @@
 // Trimming a mesh along a loop of its vertices and stitching borders across
-// gaps (Ekeberg et al., "Trimming and stitching of surface meshes for a
-// dynamic vocal tract", papers/002). Trimming (§2.1) removes the faces on one
+// gaps (Widing & Ekeberg 2015, "Tailoring biomechanical model meshes for
+// aero-acoustic simulations"; docs/REFERENCES.md). Trimming (§2.1) removes the faces on one
 // side of a closed vertex loop without creating vertices; stitching (§2.2)
 // fills the gap between two border paths with the merge-like triangulation
 // that always takes the shorter of the two next diagonals. Beyond the paper:

@@ -1,4 +1,4 @@
-// Exact triangle–triangle and segment–triangle intersection (DESIGN §4).
+// Exact triangle–triangle and segment–triangle intersection.
 //
 // Every decision is made by the filtered exact predicates of predicates.h on
 // the input doubles. Intersection points are described by their defining

@@ -1,7 +1,7 @@
 // Conversion between MeshLab's CMeshO (float in 2020.09, double in 2022.02;
 // optional components) and the core mesh (double, geometry + provenance). Attributes never enter the core:
 // they are snapshotted from the input layers and carried to the output through
-// the provenance every output element records (DESIGN §3).
+// the provenance every output element records.
 #pragma once
 
 #include <vector>
