@@ -113,6 +113,19 @@ def write_off(path, V, F):
     return _write_counted(path, f"OFF\n{len(V)} {len(F)} 0\n", V, F)
 
 
+def float_exact(src, dst):
+    """A copy of the triangle OFF file `src` whose coordinates are floats
+    (rounded once, written exactly): a float host (2020.09) and a double host
+    then read the same coordinates, so that their results differ only by
+    what each stores, not by the input's rounding on loading."""
+    words = Path(src).read_text().split()
+    nv, nf = int(words[1]), int(words[2])
+    V = np.array(words[4:4 + 3 * nv], float).astype(np.float32).astype(float).reshape(-1, 3)
+    F = np.array(words[4 + 3 * nv:4 + 3 * nv + 4 * nf], np.int64).reshape(-1, 4)
+    assert (F[:, 0] == 3).all(), f"{src}: not a triangle mesh"
+    return write_off(dst, V, F[:, 1:])
+
+
 def write_ply(path, V, F):
     return _write_counted(
         path, f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"

@@ -13,7 +13,7 @@ import time
 
 import pytest
 
-from conftest import DATA, Host, cube, filters, mlx, require_shared_data, run_server, write_off, write_ply
+from conftest import DATA, Host, cube, filters, float_exact, mlx, require_shared_data, run_server, write_off, write_ply
 from gui_driver import SEARCH, Dialog, MeshLabGui
 from test_clearance import nested_spheres
 from test_pymeshlab import NAMES, counts
@@ -70,7 +70,7 @@ def sessions(tmp_path):
             ("meshmend_remove_patches", {"keep": 0, "removed_to_layer": True}),
             ("meshmend_inspect_defects", {"select_defects": 3})]),
         "cow": ([DATA / "self_intersecting/cow.off"], [("meshmend_remove_self_intersections", {})]),
-        "shark": ([DATA / "holes/mech-holes-shark.off"], [
+        "shark": ([float_exact(DATA / "holes/mech-holes-shark.off", tmp_path / "shark.off")], [
             ("meshmend_fill_holes", {}), ("meshmend_prepare_shader_view", {"values": 2})]),
         "shell": ([shell], [("meshmend_measure_clearance", {"tau": 0.06}),
                             ("meshmend_enforce_minimum_clearance", {"tau": 0.06}),
@@ -118,8 +118,19 @@ def test_every_filter_runs_in_the_gui_with_the_counts_of_2020_09(host, tmp_path)
             theirs = json.loads(gui_reports[k].read_text())
             a, b = counts(ours[k]), counts(theirs)
             if host.double:  # the double build stores double: nothing is rounded to float
-                for key in ("rounded_to_float", "closest", "shortest", "pairs_split_after_rounding"):
+                for key in ("host_scalar", "rounded_to_float", "closest", "shortest",
+                            "pairs_split_after_rounding"):
                     a.pop(key, None), b.pop(key, None)
+                if f == "meshmend_fill_holes":
+                    # Patches decided on the stored coordinates may take a few
+                    # different refinement steps: each hole within 2 %.
+                    holes_a, holes_b = a.pop("holes"), b.pop("holes")
+                    assert len(holes_a) == len(holes_b), (name, f)
+                    for x, y in zip([a] + holes_a, [b] + holes_b):
+                        for key in ("faces_added", "vertices_added"):
+                            old, new = x.pop(key), y.pop(key)
+                            assert abs(old - new) <= 0.02 * old, (name, f, key, old, new)
+                    assert holes_a == holes_b, (name, f)
             assert a == b, (name, f, {key: (a.get(key), b.get(key)) for key in set(a) | set(b)
                                       if a.get(key) != b.get(key)})
             ran.add(f)
