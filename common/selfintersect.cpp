@@ -106,30 +106,6 @@ void pretreatInput(Removal& w) {
   w.degenerateIn = collinearFaces(w.in.points, w.in.triangles);
 }
 
-// The most triple points (pairs of a face's crossing faces that cross each
-// other) in one face, and that face; stops counting past `bound`.
-std::pair<std::size_t, int> mostTriplePoints(const std::vector<IntersectingPair>& pairs,
-                                             std::size_t faces, std::size_t bound) {
-  std::vector<std::vector<std::uint32_t>> crossing(faces);
-  for (const IntersectingPair& p : pairs) {
-    crossing[p.a.face].push_back(p.b.face);
-    crossing[p.b.face].push_back(p.a.face);
-  }
-  for (auto& list : crossing) std::sort(list.begin(), list.end());
-  auto cross = [&](std::uint32_t g, std::uint32_t h) {
-    return std::binary_search(crossing[g].begin(), crossing[g].end(), h);
-  };
-  std::pair<std::size_t, int> most{0, -1};
-  for (std::size_t f = 0; f < faces && most.first <= bound; ++f) {
-    const auto& list = crossing[f];
-    std::size_t triples = 0;
-    for (std::size_t i = 0; i < list.size() && triples <= bound; ++i)
-      for (std::size_t j = i + 1; j < list.size(); ++j) triples += cross(list[i], list[j]);
-    if (triples > most.first) most = {triples, int(f)};
-  }
-  return most;
-}
-
 // The work bounds, before anything is cut: the split's cost grows with the
 // intersecting pairs (about 0.1 ms each) and, within a face, with the
 // square of the curves crossing there.
@@ -150,10 +126,10 @@ void boundWork(Removal& w) {
         "and move it to its own layer)");
   const std::size_t tripleBound = w.options.max_triple_points_per_face;
   if (tripleBound == 0) return;
-  const auto [triples, face] = mostTriplePoints(found.pairs, w.in.triangles.size(), tripleBound);
-  if (triples > tripleBound)
+  const TriplePoints most = mostTriplePoints(found.pairs, {w.in.triangles.size()}, tripleBound);
+  if (most.count > tripleBound)
     throw WorkLimitError(
-        "in face " + std::to_string(w.faceOrigin[face]) + " more than " +
+        "in face " + std::to_string(w.faceOrigin[most.face.face]) + " more than " +
         std::to_string(tripleBound) +
         " pairs of the faces crossing it cross each other too (max_triple_points_per_face): the "
         "surface passes many times through nearly one point there, as the meridians of a "

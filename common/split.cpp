@@ -1389,6 +1389,35 @@ bool snaps(const SplitOptions& o) {
 
 }  // namespace
 
+TriplePoints mostTriplePoints(const std::vector<IntersectingPair>& pairs,
+                              const std::vector<std::size_t>& faces, std::size_t bound) {
+  std::vector<std::size_t> first(faces.size() + 1, 0);  // each mesh's first global face
+  for (std::size_t m = 0; m < faces.size(); ++m) first[m + 1] = first[m] + faces[m];
+  auto global = [&](const FaceRef& f) { return first[f.mesh] + f.face; };
+  std::vector<std::vector<std::size_t>> crossing(first.back());
+  for (const IntersectingPair& p : pairs) {
+    crossing[global(p.a)].push_back(global(p.b));
+    crossing[global(p.b)].push_back(global(p.a));
+  }
+  for (auto& list : crossing) std::sort(list.begin(), list.end());
+  auto cross = [&](std::size_t g, std::size_t h) {
+    return std::binary_search(crossing[g].begin(), crossing[g].end(), h);
+  };
+  std::size_t most = 0, at = 0;
+  for (std::size_t f = 0; f < crossing.size() && most <= bound; ++f) {
+    const auto& list = crossing[f];
+    std::size_t triples = 0;
+    for (std::size_t i = 0; i < list.size() && triples <= bound; ++i)
+      for (std::size_t j = i + 1; j < list.size(); ++j) triples += cross(list[i], list[j]);
+    if (triples > most) most = triples, at = f;
+  }
+  TriplePoints r;
+  r.count = most;
+  const std::size_t mesh = std::upper_bound(first.begin(), first.end(), at) - first.begin() - 1;
+  r.face = {std::uint32_t(mesh), std::uint32_t(at - first[mesh])};
+  return r;
+}
+
 SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
                                     const SplitOptions& options) {
   const auto start = Clock::now();
@@ -1442,6 +1471,23 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   };
   FindIntersectionsResult found = findIntersectionsInArrays(arrays, find);
   r.intersecting_pairs = found.pairs.size();
+  if (options.max_triple_points_per_face > 0) {
+    std::vector<std::size_t> faces;
+    for (const MeshArrays* a : arrays) faces.push_back(a->triangles.size());
+    const TriplePoints most =
+        mostTriplePoints(found.pairs, faces, options.max_triple_points_per_face);
+    if (most.count > options.max_triple_points_per_face)
+      throw WorkLimitError(
+          "in face " + std::to_string(most.face.face) + " of mesh " +
+          std::to_string(most.face.mesh) + " more than " +
+          std::to_string(options.max_triple_points_per_face) +
+          " pairs of the faces crossing it cross each other too (max_triple_points_per_face): "
+          "the surfaces pass many times through nearly one point there, as the meridians of a "
+          "spindle torus do near its axis, and cutting it would take the exact arithmetic "
+          "minutes. Nothing was changed. Remove the faces around that point (select them, "
+          "Filters > Selection > Delete Selected Faces) and close the hole with MeshMend: Fill "
+          "Holes, then split again");
+  }
   r.complete = options.self && (options.between_meshes || meshes.size() == 1);
 
   reportProgress(options.progress, 40, "Collecting curve points");

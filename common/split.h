@@ -56,8 +56,25 @@ struct SplitOptions {
   // rounding them to its scalar may make faces cross or collapse.
   double snap_host_steps = 0;
   Scalar host = Scalar::kDouble;  // the scalar whose steps snap_host_steps counts
-  Progress progress;              // called between stages
+  // Work bound: a face in which more than this many pairs of the faces
+  // crossing it cross each other too (three faces through one point) stops
+  // the split with WorkLimitError before anything is cut: the curves cross
+  // each other about as often in that face, each crossing an exact point of
+  // long numbers (a spindle torus near its axis: thousands; real meshes:
+  // under ten; CAD boxes overlapping in planes: a few hundred). 0 = no bound.
+  std::size_t max_triple_points_per_face = 1000;
+  Progress progress;  // called between stages
 };
+
+// The most triple points (pairs of a face's crossing faces that cross each
+// other) in one face of the meshes whose face counts are `faces`, and that
+// face; counting stops past `bound`.
+struct TriplePoints {
+  std::size_t count = 0;
+  FaceRef face;
+};
+TriplePoints mostTriplePoints(const std::vector<IntersectingPair>& pairs,
+                              const std::vector<std::size_t>& faces, std::size_t bound);
 
 struct SplitResult {
   // Per input mesh: the mesh with the curves inserted (input vertices first,
