@@ -131,6 +131,12 @@ def test_every_filter_runs_in_the_gui_with_the_counts_of_2020_09(host, tmp_path)
                             old, new = x.pop(key), y.pop(key)
                             assert abs(old - new) <= 0.02 * old, (name, f, key, old, new)
                     assert holes_a == holes_b, (name, f)
+                if f == "meshmend_prepare_shader_view" and "new_faces" in a:
+                    # The same patches, counted after Fill Holes: within 2 % of the new faces.
+                    bound = 0.02 * a["new_faces"]
+                    for key in ("faces", "new_faces"):
+                        old, new = a.pop(key), b.pop(key)
+                        assert abs(old - new) <= bound, (name, f, key, old, new)
             assert a == b, (name, f, {key: (a.get(key), b.get(key)) for key in set(a) | set(b)
                                       if a.get(key) != b.get(key)})
             ran.add(f)
