@@ -138,14 +138,3 @@ def drill_holes(count=10):
         V, F = tube(2, n=10, rings=1, r=1.2, h=8)
         drills.append((V + np.array([1e4 + 2.5 + 3.7 * i, 1e4 + 5 + 0.2 * i, 1e4 + 2]), F))
     return plate, drills
-
-
-def write_off(path, mesh):
-    V, F = mesh
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
-        for v in V:
-            f.write(" ".join(repr(float(c)) for c in v) + "\n")
-        for t in F:
-            f.write("3 " + " ".join(str(int(i)) for i in t) + "\n")
-    return path

@@ -23,26 +23,6 @@ Mesh together(const Mesh& a, const Mesh& b) {
   return appended(a, b);
 }
 
-// Torus around the z axis: major radius R, minor radius r; closed, genus 1,
-// outward normals.
-Mesh torus(double R, double r, int around = 48, int tube = 24) {
-  std::vector<Point3> p;
-  for (int i = 0; i < around; ++i)
-    for (int j = 0; j < tube; ++j) {
-      const double u = 2 * M_PI * i / around, v = 2 * M_PI * j / tube;
-      p.emplace_back((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u),
-                     r * std::sin(v));
-    }
-  auto at = [&](int i, int j) { return (i % around) * tube + (j % tube); };
-  std::vector<Triangle> t;
-  for (int i = 0; i < around; ++i)
-    for (int j = 0; j < tube; ++j) {
-      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return makeMesh(p, t);
-}
-
 // A closed tube of radius r swept along a helix of radius R around the z
 // axis, rising by `rise` per turn, over `degrees`, capped at both ends: past
 // one turn its end lies over its start, and overlaps it once r > rise / 2.
@@ -158,12 +138,12 @@ TEST(RemoveSelfIntersections, TorusWhoseHoleIsPinchedGetsTwoHoles) {
   // The left half of a torus (hole radius 0.3) pushed right across the hole
   // near y = 0, where its inner wall passes through the right inner wall:
   // the hole closes in the middle and two holes remain (genus 1 -> 2).
-  std::vector<Point3> p = positionsOf(torus(1, 0.7, 48, 24));
+  std::vector<Point3> p = positionsOf(torusOf(1, 0.7, 48, 24));
   for (Point3& q : p) {
     const double blend = std::clamp((0.3 - q[0]) / 0.6, 0.0, 1.0);
     q[0] += 0.75 * blend * std::exp(-q[1] * q[1] / 0.16);
   }
-  const Mesh closing = makeMesh(p, trianglesOf(torus(1, 0.7, 48, 24)));
+  const Mesh closing = makeMesh(p, trianglesOf(torusOf(1, 0.7, 48, 24)));
   const SelfIntersectionResult r = removeSelfIntersections(closing);
   expectValid(r);
   EXPECT_GT(r.intersecting_pairs_before, 0u);
@@ -179,9 +159,9 @@ TEST(RemoveSelfIntersections, TorusWhoseHoleClosesBecomesASphere) {
   // near the hole), strongly enough that near the hole's ends the surface
   // folds over itself: the walls pass through each other along the whole
   // hole, which closes (genus 1 -> 0).
-  std::vector<Point3> p = positionsOf(torus(1, 0.45, 96, 24));
+  std::vector<Point3> p = positionsOf(torusOf(1, 0.45, 96, 24));
   for (Point3& q : p) q[0] -= 0.75 * std::tanh(q[0] / 0.05) * std::exp(-q[1] * q[1] / 0.3);
-  const Mesh closing = makeMesh(p, trianglesOf(torus(1, 0.45, 96, 24)));
+  const Mesh closing = makeMesh(p, trianglesOf(torusOf(1, 0.45, 96, 24)));
   const SelfIntersectionResult r = removeSelfIntersections(closing);
   expectValid(r);
   EXPECT_GT(r.intersecting_pairs_before, 0u);

@@ -17,3 +17,14 @@ def tube(axis, n=24, rings=4, r=0.5, h=2.0):
         F += [(len(V) - 2, (j + 1) % n, j), (len(V) - 1, rings * n + j, rings * n + (j + 1) % n)]
     turn = {0: [2, 0, 1], 1: [1, 2, 0], 2: [0, 1, 2]}[axis]  # cyclic: orientation kept
     return np.array(V)[:, turn], np.array(F, dtype=np.int64)
+
+
+def write_off(path, V, F):
+    """A triangle mesh as an OFF file, coordinates written exactly (repr)."""
+    with open(path, "w") as f:
+        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
+        for v in V:
+            f.write(" ".join(repr(float(c)) for c in v) + "\n")
+        for t in F:
+            f.write("3 " + " ".join(str(int(i)) for i in t) + "\n")
+    return path

@@ -27,7 +27,7 @@ sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared wit
 
 import meshmend as mm  # noqa: E402
 from environment import MESHCHECK, Host, need, require_meshcheck  # noqa: E402
-from shapes import tube  # noqa: E402
+from shapes import tube, write_off  # noqa: E402
 import cad_cases  # noqa: E402
 
 
@@ -124,16 +124,6 @@ def border_vertices(F):
 def volume(V, F):
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
-
-
-def write_off(path, V, F):
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
-        for v in V:
-            f.write(" ".join(repr(float(c)) for c in v) + "\n")
-        for t in F:
-            f.write("3 " + " ".join(str(int(i)) for i in t) + "\n")
-    return path
 
 
 def meshcheck(path, *args):
