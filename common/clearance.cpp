@@ -10,6 +10,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <sstream>
 
 #include "common/box_tree.h"
 #include "common/errors.h"
@@ -630,6 +631,21 @@ Eigen::VectorXd minimumNormStep(const SparseRows& J, const Eigen::VectorXd& d, d
   return delta;
 }
 
+// The work bound on the input's short pairs (ClearanceOptions::max_short_pairs).
+void boundShortPairs(std::size_t shortPairs, std::size_t bound, double tau, double closest) {
+  if (bound == 0 || shortPairs <= bound) return;
+  std::ostringstream message;
+  message << shortPairs << " face pairs are closer than tau = " << tau
+          << ", more than the work bound of " << bound
+          << " (max_short_pairs): separating them all would take minutes, and so many mean a "
+             "tau larger than the parts or than a few edge lengths, not gaps to open. Nothing "
+             "was changed. Try a smaller tau (the closest pair is "
+          << closest
+          << " apart), more exclusion rings, or raise the bound if the parts really are that "
+             "close everywhere";
+  throw WorkLimitError(message.str());
+}
+
 }  // namespace
 
 const char* toString(ClearanceScope scope) {
@@ -836,6 +852,8 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
     }
   };
   minimumOf(near, &result.min_distance_before, &result.violating_pairs_before);
+  boundShortPairs(result.violating_pairs_before, options.max_short_pairs, tau,
+                  result.min_distance_before);
   if (near.empty() && anyPairInScope(soup)) {
     // Nothing close: the minimum comes from a growing search.
     double used = 0;

@@ -106,6 +106,12 @@ struct ClearanceOptions {
   // A vertex that reaches it stays there, and the others go on without it.
   double max_displacement = 0;
   int max_iterations = 100;  // Gauss-Newton steps at most
+  // Work bound: more face pairs closer than tau than this in the input, and
+  // nothing is moved (WorkLimitError). Each step's cost grows with them (a
+  // torus with 130,000 short pairs takes 40 s); so many mean a tau larger
+  // than the parts or than a few edge lengths (see exclusion_rings), not
+  // gaps to open. 0 = no bound.
+  std::size_t max_short_pairs = 100000;
   // Pairs closer than tau × (1 + active_margin) take part in each step, the
   // ones beyond tau as inequalities, so that the step does not push them
   // below tau.

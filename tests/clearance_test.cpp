@@ -427,6 +427,29 @@ TEST(EnforceClearance, ThinPlateThinnerThanTauIsReportedNotTorn) {
   EXPECT_GT(hi - lo, 0.05);
 }
 
+TEST(EnforceClearance, TooManyShortPairsIsAWorkBoundAndNothingMoves) {
+  // Two 8 x 8 grids 0.3 apart and a tau of 1: every face of one is closer
+  // than tau to most of the other's (about 8,000 pairs).
+  Mesh a = gridSquare(8, 0), b = gridSquare(8, 0.3, false);
+  const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);
+  std::vector<Mesh*> layers{&a, &b};
+  ClearanceOptions o;
+  o.tau = 1;
+  o.scope = ClearanceScope::kBetweenLayers;
+  o.max_short_pairs = 1000;
+  try {
+    enforceClearance(layers, o);
+    ADD_FAILURE() << "no work bound";
+  } catch (const WorkLimitError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_short_pairs"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("smaller tau"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(positionsOf(a), pa);
+  EXPECT_EQ(positionsOf(b), pb);
+  o.max_short_pairs = 0;  // no bound
+  EXPECT_GT(enforceClearance(layers, o).violating_pairs_before, 1000u);
+}
+
 TEST(EnforceClearance, CancelledLeavesTheLayersUntouched) {
   Mesh a = gridSquare(3, 0), b = gridSquare(3, 0.3, false);
   const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);

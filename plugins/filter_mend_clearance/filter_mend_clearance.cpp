@@ -134,6 +134,11 @@ void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
         "max_iterations", ClearanceOptions().max_iterations, "Max iterations",
         "Gauss-Newton steps at most; each step re-detects the pairs closer than tau. The filter "
         "stops earlier when tau is reached."));
+    parameters.addParam(RichInt(
+        "max_short_pairs", int(ClearanceOptions().max_short_pairs), "Max pairs closer than tau",
+        "Work bound: with more face pairs closer than tau than this, nothing is moved and the "
+        "filter says so (so many mean a tau larger than the parts or than a few edge lengths; "
+        "each one costs time in every step). 0: no bound."));
     parameters.addParam(RichBool(
         "keep_partial", false, "Keep a partial result",
         "The result is checked as it will be stored: no intersecting pair, and no pair closer "
@@ -345,6 +350,9 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
       distanceParameter(parameters, "max_displacement", "the max vertex displacement");
   options.max_iterations = parameters.getInt("max_iterations");
   if (options.max_iterations < 1) throw InvalidInputError("max iterations must be at least 1");
+  const int maxShortPairs = parameters.getInt("max_short_pairs");
+  if (maxShortPairs < 0) throw InvalidInputError("max pairs closer than tau must be >= 0");
+  options.max_short_pairs = std::size_t(maxShortPairs);
   options.exclusion_rings = parameters.getInt("exclusion_rings");
   options.round_to_float = kHostStoresFloat;  // reach tau in what MeshLab will store
   options.progress = progressFrom(cb);

@@ -118,6 +118,9 @@ OptionTable<ClearanceOptions> enforceTable() {
       "max_iterations", [](O& o) -> int& { return o.max_iterations; },
       "Gauss-Newton steps at most");
   t.add(
+      "max_short_pairs", [](O& o) -> std::size_t& { return o.max_short_pairs; },
+      "work bound: more face pairs closer than tau than this, and nothing moves; 0 = none");
+  t.add(
       "active_margin", [](O& o) -> double& { return o.active_margin; },
       "pairs closer than tau * (1 + active_margin) take part in each step");
   t.add(

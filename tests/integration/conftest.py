@@ -114,16 +114,18 @@ def write_off(path, V, F):
 
 
 def float_exact(src, dst):
-    """A copy of the triangle OFF file `src` whose coordinates are floats
-    (rounded once, written exactly): a float host (2020.09) and a double host
-    then read the same coordinates, so that their results differ only by
-    what each stores, not by the input's rounding on loading."""
-    words = Path(src).read_text().split()
-    nv, nf = int(words[1]), int(words[2])
-    V = np.array(words[4:4 + 3 * nv], float).astype(np.float32).astype(float).reshape(-1, 3)
-    F = np.array(words[4 + 3 * nv:4 + 3 * nv + 4 * nf], np.int64).reshape(-1, 4)
-    assert (F[:, 0] == 3).all(), f"{src}: not a triangle mesh"
-    return write_off(dst, V, F[:, 1:])
+    """A copy of the OFF file `src` whose coordinates are floats (rounded
+    once, written exactly), faces (triangles or polygons) as they are: a float
+    host (2020.09) and a double host then read the same coordinates, so that
+    their results differ only by what each stores, not by the input's
+    rounding on loading."""
+    lines = [l.split("#")[0].split() for l in Path(src).read_text().splitlines()]
+    lines = [l for l in lines if l]
+    assert lines[0][0].endswith("OFF"), f"{src}: not an OFF file"
+    nv, nf = int(lines[1][0]), int(lines[1][1])
+    V = np.array([l[:3] for l in lines[2:2 + nv]], float).astype(np.float32).astype(float)
+    F = [[int(w) for w in l[1:1 + int(l[0])]] for l in lines[2 + nv:2 + nv + nf]]
+    return write_off(dst, V, F)
 
 
 def write_ply(path, V, F):
