@@ -12,7 +12,7 @@
 #include "common/errors.h"
 #include "common/intersections.h"
 #include "common/predicates.h"
-#include "common/split_detail.h"
+#include "common/split/detail.h"
 
 namespace meshmend {
 
