@@ -1,4 +1,4 @@
-// Surface patches (intersection paper §2.6, §3.1): after intersect-and-split
+// Surface patches (McLaurin 2012, §2.6, §3.1): after intersect-and-split
 // the meshes are cut into patches bounded by the intersection curves. This
 // paints them (flood fill bounded by curves, borders, non-manifold edges and
 // optional surface-group boundaries), classifies each against every input

@@ -1,4 +1,4 @@
-// Local re-triangulation of one triangle (intersection paper §2.3–2.4): the
+// Local re-triangulation of one triangle (McLaurin 2012, §2.3–2.4): the
 // points that lie on it become vertices (a point on an edge splits the edge),
 // the constraint segments between them become edges (recovered by flips;
 // two crossing constraints meet at their exact crossing point, which is

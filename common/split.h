@@ -1,4 +1,4 @@
-// Intersect and split (intersection paper §2): the curves where meshes
+// Intersect and split (McLaurin 2012, §2): the curves where meshes
 // intersect are inserted into every mesh they cross, in place: each crossed
 // face is re-triangulated on its own with its curve segments as constraints
 // (retriangulate.h), points on an edge split that edge in both faces that
@@ -25,7 +25,7 @@ struct SplitOptions {
   bool remove_duplicate_faces = false;
   // Where surfaces overlap in a plane, both sides' faces there coincide
   // (same three vertices): keep each such face once in `merged` (the
-  // intersection paper's result is free of duplicate geometry), and the
+  // McLaurin 2012's result is free of duplicate geometry), and the
   // curve edges inside the overlap become ordinary edges. Off, `merged`
   // keeps both: each input part stays a whole surface there, as the patch
   // classification of booleans needs (patches.h).
@@ -37,7 +37,7 @@ struct SplitOptions {
   // loops, slivers) are the same; roundToFloat and remainingIntersections
   // need it. At least one of the two outputs must be asked for.
   bool merged_output = true;
-  // Quality snapping (intersection paper §2.7), 0 = off. A new curve vertex
+  // Quality snapping (McLaurin 2012, §2.7), 0 = off. A new curve vertex
   // closer than snap_tolerance × the longest edge around it to an input
   // vertex it shares an edge with, or to the next curve vertex along its
   // curve, is merged into that vertex, and a new
