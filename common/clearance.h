@@ -172,6 +172,18 @@ struct ClearanceResult {
 // still short); on an exception the layers are untouched.
 ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOptions& options);
 
+// The contract of an enforced clearance, on what will be stored (the
+// caller's values where it stores otherwise, e.g. through layer matrices):
+// the surfaces do not cross (no intersecting pair), and no pair in scope ends
+// closer than the closest was before. Tau not reached within the cap, the
+// locks or the iterations is an outcome the result explains, not a failure.
+// What does not hold, one item each (for requireContract, edit_contract.h).
+std::vector<std::string> clearanceContractFailures(double minDistanceBefore,
+                                                   double minDistanceAfter,
+                                                   std::size_t intersectingPairs);
+// The same on the result's own values (its positions as stored).
+std::vector<std::string> clearanceContractFailures(const ClearanceResult& result);
+
 // The report_file keys: tau, min_distance_before/after, violating_pairs_before/after,
 // max_displacement, mean_displacement, time_ms, ... For a measurement, the
 // "before" and "after" keys both hold the measured values.

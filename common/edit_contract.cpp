@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "common/errors.h"
 #include "common/inspect.h"
 #include "common/intersections.h"
 #include "common/predicates.h"
@@ -82,10 +83,39 @@ EditContract checkEditContract(const Mesh& before, const Mesh& after,
   return c;
 }
 
-std::string describeFailures(const EditContract& contract) {
+std::string describeFailures(const std::vector<std::string>& failures) {
   std::string s;
-  for (const std::string& f : contract.failures) s += (s.empty() ? "" : "; ") + f;
+  for (const std::string& f : failures) s += (s.empty() ? "" : "; ") + f;
   return s;
+}
+
+std::string describeFailures(const EditContract& contract) {
+  return describeFailures(contract.failures);
+}
+
+void requireContract(const std::vector<std::string>& failures, const std::string& filter,
+                     bool keepPartial, const std::string& toTry) {
+  if (failures.empty() || keepPartial) return;
+  throw ContractError(filter + " could not make a valid result: " + describeFailures(failures) +
+                      ". Nothing was changed. " + toTry);
+}
+
+EditContract requireEditContract(const Mesh& before, const Mesh& after, const std::string& filter,
+                                 const EditContractOptions& options, const std::string& toTry) {
+  EditContract c = checkEditContract(before, after, options);
+  requireContract(c.failures, filter, options.keep_partial, toTry);
+  return c;
+}
+
+void reportContract(JsonObject& report, const std::vector<std::string>& failures) {
+  report.set("contract_met", failures.empty())
+      .set("contract_failures", failures)
+      .set("partial", !failures.empty());
+}
+
+void reportContract(JsonObject& report, const EditContract& contract) {
+  reportContract(report, contract.failures);
+  report.set("changed_faces", contract.changed_faces);
 }
 
 }  // namespace meshmend

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/json.h"
 #include "common/mesh.h"
 #include "common/progress.h"
 
@@ -25,6 +26,11 @@ struct EditContractOptions {
   // oppositely oriented sides: StitchOptions::allow_orientation_conflict).
   bool allow_orientation_conflicts = false;
   Progress progress;  // called once, before the pair count
+  // A result that misses the contract (the filters' "Keep a partial result"):
+  // off, requireEditContract throws ContractError and the caller changes
+  // nothing; on, the result is returned with met false, for the caller to
+  // store marked as partial. checkEditContract does not read it.
+  bool keep_partial = false;
 };
 
 struct EditContract {
@@ -44,6 +50,25 @@ EditContract checkEditContract(const Mesh& before, const Mesh& after,
                                const EditContractOptions& options = {});
 
 // The failures as one sentence ("a; b; c").
+std::string describeFailures(const std::vector<std::string>& failures);
 std::string describeFailures(const EditContract& contract);
+
+// The end of an edit whose contract lists `failures` (what does not hold,
+// one item each): none, or keepPartial, returns; else throws ContractError
+// "<filter> could not make a valid result: a; b. Nothing was changed.
+// <toTry>" (the caller has changed nothing yet).
+void requireContract(const std::vector<std::string>& failures, const std::string& filter,
+                     bool keepPartial, const std::string& toTry);
+
+// checkEditContract, required as requireContract does (options.keep_partial).
+EditContract requireEditContract(const Mesh& before, const Mesh& after, const std::string& filter,
+                                 const EditContractOptions& options, const std::string& toTry);
+
+// The report keys of a contract, as the filters' report_file and the
+// module's report hold them: contract_met, contract_failures, partial (a
+// result kept although it misses the contract) and, for an edit,
+// changed_faces.
+void reportContract(JsonObject& report, const std::vector<std::string>& failures);
+void reportContract(JsonObject& report, const EditContract& contract);
 
 }  // namespace meshmend

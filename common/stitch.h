@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "common/edit_contract.h"
 #include "common/json.h"
 #include "common/mesh.h"
 #include "common/output_stage.h"
@@ -288,6 +289,20 @@ CloseGapsResult closeGaps(Mesh& mesh, const CloseGapsOptions& options = {});
 
 // Edges used by exactly one face.
 std::size_t countBorderEdges(const Mesh& mesh);
+
+// The end-of-edit contract (edit_contract.h) each operation's result is
+// held to, with keep_partial as given. Trimming only removes faces: no pair
+// is counted. A stitch is checked as stored (round_to_float), its pairs
+// counted with check_intersections, and the edges run one way that
+// allow_orientation_conflict permits are not failures. Closing gaps is
+// checked as stored, its pairs always counted.
+EditContractOptions editContractOptions(const TrimOptions& options, bool keepPartial);
+EditContractOptions editContractOptions(const StitchOptions& options, bool keepPartial);
+EditContractOptions editContractOptions(const CloseGapsOptions& options, bool keepPartial);
+
+// closeGaps merged, stitched, flipped or removed something: a result that
+// did not is the input as it was (and meets the contract unchecked).
+bool changedAnything(const CloseGapsResult& result);
 
 // The report_file keys: border_edges_before, border_edges_after,
 // faces_added, vertices_merged (0 where not applicable), time_ms, and the

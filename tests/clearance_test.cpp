@@ -614,3 +614,21 @@ TEST(EnforceClearance, QuantisedScanFromTheCorpus) {
   EXPECT_GE(r.max_displacement, r.displacement_lower_bound);
   EXPECT_LE(r.max_displacement, 1.5 * r.displacement_lower_bound);
 }
+
+TEST(ClearanceContract, IntersectionsAndAClosestPairCloserThanBeforeFail) {
+  // Tau not reached is no failure: only crossing surfaces and a smallest
+  // distance below the one before.
+  EXPECT_TRUE(clearanceContractFailures(0.1, 0.1, 0).empty());
+  EXPECT_TRUE(clearanceContractFailures(0.1, 0.2, 0).empty());
+  const std::vector<std::string> fell = clearanceContractFailures(0.15, 0.1, 0);
+  ASSERT_EQ(fell.size(), 1u);
+  EXPECT_EQ(fell[0], "the smallest distance fell from 0.150000 to 0.100000");
+  const std::vector<std::string> both = clearanceContractFailures(0.15, 0.1, 3);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0], "3 intersecting face pairs as stored");
+  ClearanceResult r;
+  r.min_distance_before = 0.2;
+  r.min_distance_after = 0.3;
+  r.new_intersecting_pairs = 1;
+  EXPECT_EQ(clearanceContractFailures(r).size(), 1u);
+}

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/errors.h"
+
 #include <string>
 #include <vector>
 
@@ -128,4 +130,32 @@ TEST(EditContract, AMovedFaceIsChanged) {
   after.vert[4].P() = Point3(0, 0, 1.5);
   const EditContract c = checkEditContract(b.mesh(), after);
   EXPECT_GT(c.changed_faces, 2u);
+}
+
+TEST(EditContract, RequiredItThrowsNamingWhatFailedUnlessAPartialResultIsKept) {
+  // A face turned the wrong way: refused, the message naming the filter, the
+  // failure and what to try; kept, returned with met false and reported so.
+  const OpenBox b;
+  const Mesh after = b.with({{4, 6, 5}, {5, 7, 6}});
+  EditContractOptions o;
+  try {
+    requireEditContract(b.mesh(), after, "Stitch Boundaries", o, "Try again.");
+    FAIL() << "no ContractError";
+  } catch (const ContractError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("Stitch Boundaries could not make a valid result: ", 0), 0u) << what;
+    EXPECT_NE(what.find("run the same way"), std::string::npos) << what;
+    EXPECT_NE(what.find(". Nothing was changed. Try again."), std::string::npos) << what;
+  }
+  o.keep_partial = true;
+  const EditContract kept = requireEditContract(b.mesh(), after, "Stitch Boundaries", o, "");
+  EXPECT_FALSE(kept.met);
+  JsonObject report;
+  reportContract(report, kept);
+  const std::string json = report.str();
+  EXPECT_NE(json.find("\"contract_met\": false"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"partial\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"changed_faces\": 2"), std::string::npos) << json;
+  EXPECT_NE(json.find("run the same way"), std::string::npos) << json;
+  EXPECT_NO_THROW(requireContract({}, "Stitch Boundaries", false, ""));
 }

@@ -149,6 +149,23 @@ JsonObject toJson(const ClearanceMeasure& m) {
   return j;
 }
 
+std::vector<std::string> clearanceContractFailures(double minDistanceBefore,
+                                                   double minDistanceAfter,
+                                                   std::size_t intersectingPairs) {
+  std::vector<std::string> failures;
+  if (intersectingPairs > 0)
+    failures.push_back(std::to_string(intersectingPairs) + " intersecting face pairs as stored");
+  if (minDistanceAfter < minDistanceBefore)
+    failures.push_back("the smallest distance fell from " + std::to_string(minDistanceBefore) +
+                       " to " + std::to_string(minDistanceAfter));
+  return failures;
+}
+
+std::vector<std::string> clearanceContractFailures(const ClearanceResult& r) {
+  return clearanceContractFailures(r.min_distance_before, r.min_distance_after,
+                                   r.new_intersecting_pairs);
+}
+
 JsonObject toJson(const ClearanceResult& r) {
   auto finite = [](double x) { return std::isfinite(x) ? std::optional<double>(x) : std::nullopt; };
   JsonObject j;

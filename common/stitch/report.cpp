@@ -1,4 +1,4 @@
-// The report keys of trimming, stitching and gap closing.
+// The contracts and report keys of trimming, stitching and gap closing.
 #include "common/stitch.h"
 
 namespace meshmend {
@@ -46,6 +46,38 @@ JsonObject toJson(const StitchSequenceResult& r) {
       .set("steps", steps)
       .set("time_ms", r.time_ms);
   return j;
+}
+
+EditContractOptions editContractOptions(const TrimOptions& options, bool keepPartial) {
+  EditContractOptions c;
+  c.count_pairs = false;  // trimming only removes faces: none is new
+  c.keep_partial = keepPartial;
+  c.progress = options.progress;
+  return c;
+}
+
+EditContractOptions editContractOptions(const StitchOptions& options, bool keepPartial) {
+  EditContractOptions c;
+  c.as_float = options.round_to_float;
+  c.count_pairs = options.check_intersections;
+  c.allow_orientation_conflicts = options.allow_orientation_conflict;
+  c.keep_partial = keepPartial;
+  c.progress = options.progress;
+  return c;
+}
+
+EditContractOptions editContractOptions(const CloseGapsOptions& options, bool keepPartial) {
+  EditContractOptions c;
+  c.as_float = options.round_to_float;
+  c.count_pairs = true;
+  c.keep_partial = keepPartial;
+  c.progress = options.progress;
+  return c;
+}
+
+bool changedAnything(const CloseGapsResult& r) {
+  return r.vertices_merged > 0 || r.faces_added > 0 || r.faces_flipped > 0 ||
+         r.degenerate_faces_removed > 0;
 }
 
 JsonObject toJson(const CloseGapsResult& r) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/clearance.h"
+#include "common/edit_contract.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 
@@ -140,7 +141,7 @@ void ClearancePlugin::initParameters(QAction* a, MeshDocument& md, RichParameter
         "filter says so (so many mean a tau larger than the parts or than a few edge lengths; "
         "each one costs time in every step). 0: no bound."));
     parameters.addParam(RichBool(
-        "keep_partial", false, "Keep a partial result",
+        "keep_partial", EditContractOptions().keep_partial, "Keep a partial result",
         "The result is checked as it will be stored: no intersecting pair, and no pair closer "
         "than the closest was before (tau not reached within the cap, the locks or the "
         "iterations is an outcome the log explains, not a failure). Where that does not hold "
@@ -476,29 +477,15 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
 
   // With matrices the verdict is the one on what the layers will hold.
   const bool reached = anyMatrix ? r.reached && pairsAfter == 0 : r.reached;
-  // The contract, on what the layers will hold: the surfaces do not cross,
-  // and no pair in scope ends closer than the closest was.
-  std::vector<std::string> failures;
-  if (r.new_intersecting_pairs > 0)
-    failures.push_back(std::to_string(r.new_intersecting_pairs) +
-                       " intersecting face pairs as stored");
-  if (minAfter < minBefore)
-    failures.push_back("the smallest distance fell from " + std::to_string(minBefore) + " to " +
-                       std::to_string(minAfter));
-  const bool keepPartial = parameters.getBool("keep_partial");
-  if (!failures.empty() && !keepPartial) {
-    std::string what;
-    for (const std::string& f : failures) what += (what.empty() ? "" : "; ") + f;
-    throw ContractError(
-        "Enforce Minimum Clearance could not make a valid result: " + what +
-        ". Nothing was changed. Try a smaller tau or a max displacement, or turn on 'Keep a "
-        "partial result' to see what was made");
-  }
+  // The contract (clearance.h), on what the layers will hold.
+  const std::vector<std::string> failures =
+      clearanceContractFailures(minBefore, minAfter, r.new_intersecting_pairs);
+  requireContract(failures, "Enforce Minimum Clearance", parameters.getBool("keep_partial"),
+                  "Try a smaller tau or a max displacement, or turn on 'Keep a partial result' "
+                  "to see what was made");
   JsonObject report = toJson(r);
-  report.set("contract_met", failures.empty())
-      .set("contract_failures", failures)
-      .set("partial", !failures.empty())
-      .set("unchanged", pairsBefore == 0);
+  reportContract(report, failures);
+  report.set("unchanged", pairsBefore == 0);
   if (reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
   report.set("scope", toString(options.scope))
       .set("layers", labels(layers))

@@ -251,32 +251,12 @@ namespace {
 
 RichBool keepPartialParameter() {
   return RichBool(
-      "keep_partial", false, "Keep a partial result",
+      "keep_partial", EditContractOptions().keep_partial, "Keep a partial result",
       "The result is checked exactly as it will be stored: no new edge with more than two "
       "faces, no new edge run the same way by both its faces, no new face without area, no "
       "intersecting pair with a new or changed face. Where that does not hold the layers stay "
       "unchanged; on, the result is written anyway, its layer's name ending in '(partial)' and "
       "the report saying contract_met false.");
-}
-
-// The edit contract (common/edit_contract.h) of `after` against `before`;
-// throws ContractError, the layers unchanged, when it does not hold and no
-// partial result is asked for.
-EditContract requireEditContract(const Mesh& before, const Mesh& after, const std::string& filter,
-                                 const EditContractOptions& options, bool keepPartial,
-                                 const std::string& toTry) {
-  const EditContract c = checkEditContract(before, after, options);
-  if (!c.met && !keepPartial)
-    throw ContractError(filter + " could not make a valid result: " + describeFailures(c) +
-                        ". Nothing was changed. " + toTry);
-  return c;
-}
-
-void reportContract(JsonObject& report, const EditContract& c) {
-  report.set("contract_met", c.met)
-      .set("contract_failures", c.failures)
-      .set("partial", !c.met)
-      .set("changed_faces", c.changed_faces);
 }
 
 void logContract(FilterAdapter& plugin, const EditContract& c, MeshModel& layer) {
@@ -536,11 +516,10 @@ void StitchPlugin::trim(MeshDocument& md, const RichParameterList& parameters,
   }
   const Mesh before = toCore(model->cm);
   if (!done) r = trimAlongLoop(core, options);
-  EditContractOptions co;
+  EditContractOptions co = editContractOptions(options, false);
   co.as_float = kHostStoresFloat;
-  co.count_pairs = false;  // trimming only removes faces: none is new
   const EditContract contract =
-      requireEditContract(before, core, "Trim Along Vertex Loop", co, false,
+      requireEditContract(before, core, "Trim Along Vertex Loop", co,
                           "Trimming only removes faces, so this is a defect: please report it "
                           "with the mesh and the loop");
 
@@ -703,13 +682,9 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
       Log("  note: the %zu new vertices are stored in %s (computed in double)", r.vertices_added,
           kHostPrecision);
   }
-  EditContractOptions co;
-  co.as_float = kHostStoresFloat;
-  co.count_pairs = options.check_intersections;
-  co.allow_orientation_conflicts = options.allow_orientation_conflict;
-  co.progress = options.progress;
   const EditContract contract = requireEditContract(
-      before, *core, "Stitch Boundaries", co, parameters.getBool("keep_partial"),
+      before, *core, "Stitch Boundaries",
+      editContractOptions(options, parameters.getBool("keep_partial")),
       "Try paths that face each other, without subdivision (aspect ratio 0), or turn on 'Keep "
       "a partial result' to see what was made");
   reportContract(report, contract);
@@ -795,19 +770,15 @@ void StitchPlugin::closeGaps(MeshDocument& md, const RichParameterList& paramete
   const Mesh before = *core;
 
   const CloseGapsResult r = meshmend::closeGaps(*core, options);
-  const bool nothingDone = r.vertices_merged == 0 && r.faces_added == 0 && r.faces_flipped == 0 &&
-                           r.degenerate_faces_removed == 0;
-  EditContractOptions co;
-  co.as_float = kHostStoresFloat;
-  co.count_pairs = true;
-  co.progress = options.progress;
+  const bool nothingDone = !changedAnything(r);
   const EditContract contract =
-      nothingDone ? EditContract{}
-                  : requireEditContract(before, *core, "Close Gaps Between Borders", co,
-                                        parameters.getBool("keep_partial"),
-                                        "Try a smaller merge tolerance and max gap, with 'Check "
-                                        "intersections' on, or turn on 'Keep a partial result' "
-                                        "to see what was made");
+      nothingDone
+          ? EditContract{}
+          : requireEditContract(before, *core, "Close Gaps Between Borders",
+                                editContractOptions(options, parameters.getBool("keep_partial")),
+                                "Try a smaller merge tolerance and max gap, with 'Check "
+                                "intersections' on, or turn on 'Keep a partial result' "
+                                "to see what was made");
   JsonObject report = toJson(r);
   reportContract(report, contract);
   std::vector<std::string> names;

@@ -12,9 +12,15 @@ The inputs are never modified.
 
 Bad input raises ``InvalidInputError`` (a ``ValueError``) or
 ``TopologyError`` (also a ``ValueError``) with a message saying what to fix;
-a wrong option type raises ``TypeError``. Long operations release the GIL
-and stop on Ctrl-C; ``progress=callable(percent, stage)`` reports progress,
-and returning ``False`` from it stops the operation (``CancelledError``).
+a wrong option type raises ``TypeError``. A result that misses its
+contract (checked exactly on what is returned, as the filters check theirs:
+remove_self_intersections, stitch_boundaries, stitch_sequence, close_gaps,
+enforce_clearance) raises ``Error`` saying what does not hold, unless
+``keep_partial=True``: then it is returned with ``report['contract_met']``
+False and ``report['contract_failures']`` listing what failed. Long
+operations release the GIL and stop on Ctrl-C; ``progress=callable(percent,
+stage)`` reports progress, and returning ``False`` from it stops the
+operation (``CancelledError``).
 
 Output arrays: vertices float64 ``(n, 3)``, faces and indices int32.
 """

@@ -1,6 +1,7 @@
 // Measuring and enforcing a minimum clearance between the faces of meshes,
 // on arrays.
 #include "common/clearance.h"
+#include "common/edit_contract.h"
 #include "python/src/bindings.h"
 #include "python/src/options.h"
 
@@ -76,9 +77,14 @@ py::dict measureArrays(py::handle meshes, py::kwargs kwargs) {
   return out;
 }
 
-OptionTable<ClearanceOptions> enforceTable() {
+// Enforcing's options and what to do with a result that misses the contract.
+struct EnforceCall : ClearanceOptions {
+  bool keep_partial = EditContractOptions().keep_partial;
+};
+
+OptionTable<EnforceCall> enforceTable() {
   using O = ClearanceOptions;
-  OptionTable<O> t;
+  OptionTable<EnforceCall> t;
   t.add(
       "tau", [](O& o) -> double& { return o.tau; },
       "the clearance to reach (mesh units); must be more than 0");
@@ -129,23 +135,35 @@ OptionTable<ClearanceOptions> enforceTable() {
   t.add(
       "max_listed_pairs", [](O& o) -> std::size_t& { return o.max_listed_pairs; },
       "pairs still short listed in the report (short_pairs)");
+  t.add(
+      "keep_partial", [](EnforceCall& c) -> bool& { return c.keep_partial; },
+      "a result that misses the contract (no intersecting pair, no pair closer than the closest "
+      "was before; tau not reached is not a failure) is returned with report['partial'] True; "
+      "False raises meshmend.Error, nothing returned");
   return t;
 }
 
 py::dict enforceArrays(py::handle meshes, py::kwargs kwargs) {
   CoreCall call(takeProgress(kwargs));
   std::vector<Mesh> layers = meshesFrom(meshes);
-  ClearanceOptions options = enforceTable().parse("enforce_clearance", kwargs, boundsOf(layers));
+  EnforceCall options = enforceTable().parse("enforce_clearance", kwargs, boundsOf(layers));
   if (options.max_iterations < 1) throw InvalidInputError("max_iterations must be at least 1");
   options.progress = call.progress();
   std::vector<Mesh*> pointers;
   for (Mesh& m : layers) pointers.push_back(&m);
   const ClearanceResult r = call([&] { return enforceClearance(pointers, options); });
+  const std::vector<std::string> failures = clearanceContractFailures(r);
+  requireContract(failures, "enforce_clearance", options.keep_partial,
+                  "Try a smaller tau or a max_displacement, or keep_partial=True to see what was "
+                  "made");
   std::size_t locked = 0;
   for (const auto& flags : options.locked)
     for (char f : flags) locked += f != 0;
   JsonObject report = toJson(r);
-  report.set("scope", toString(options.scope)).set("locked_vertices", locked);
+  reportContract(report, failures);
+  report.set("unchanged", r.violating_pairs_before == 0)
+      .set("scope", toString(options.scope))
+      .set("locked_vertices", locked);
   py::list out;
   for (const Mesh& m : layers) out.append(meshTuple(m));
   py::dict result;

@@ -1,5 +1,6 @@
 // Hole filling, trimming along a vertex loop, stitching border paths and
 // closing gaps between borders, on arrays.
+#include "common/edit_contract.h"
 #include "common/holes.h"
 #include "common/stitch.h"
 #include "python/src/bindings.h"
@@ -10,6 +11,12 @@ namespace meshmend::python {
 namespace {
 
 const MeshArgument kOneMesh;
+
+// The filters' "Keep a partial result", with their default.
+const char* kKeepPartialDoc =
+    "a result that misses the end-of-edit contract (no new edge with more than two faces or run "
+    "the same way by both its faces, no new face without area, no intersecting pair with a new "
+    "face) is returned with report['partial'] True; False raises meshmend.Error, nothing returned";
 
 // ---------------------------------------------------------------- holes
 
@@ -143,9 +150,16 @@ py::dict trimArrays(py::handle vertices, py::handle faces, py::kwargs kwargs) {
                          : !options.picked_vertices.empty()   ? "picked_vertices"
                                                               : "";
   options.progress = call.progress();
+  const Mesh before = mesh;
   const TrimResult r = call([&] { return trimAlongLoop(mesh, options); });
+  const EditContract contract = call([&] {
+    return requireEditContract(before, mesh, "trim_along_loop", editContractOptions(options, false),
+                               "Trimming only removes faces, so this is a defect: please report "
+                               "it with the mesh and the loop");
+  });
   JsonObject report = toJson(r);
   report.set("loop_from", loopFrom);
+  reportContract(report, contract);
   py::dict out;
   out["mesh"] = meshTuple(mesh);
   out["vertex_index"] = intArray(r.vertex_index);
@@ -161,6 +175,10 @@ const std::vector<std::pair<const char*, BorderPath::Shape>> kShapes{
     {"auto", BorderPath::Shape::Auto},
     {"open", BorderPath::Shape::Open},
     {"closed", BorderPath::Shape::Closed}};
+
+const char* kStitchToTry =
+    "Try paths that face each other, without subdivision (max_aspect_ratio=0), or "
+    "keep_partial=True to see what was made";
 
 // The options every stitch shares (StitchOptions but the paths).
 template <class Call, class Access>
@@ -181,8 +199,13 @@ void addStitchOptions(OptionTable<Call>& t, Access stitch) {
       "count, exactly, the pairs a new face makes intersect");
 }
 
-OptionTable<StitchOptions> stitchTable() {
-  OptionTable<StitchOptions> t;
+// A stitch's options and what to do with a result that misses the contract.
+struct StitchCall : StitchOptions {
+  bool keep_partial = EditContractOptions().keep_partial;
+};
+
+OptionTable<StitchCall> stitchTable() {
+  OptionTable<StitchCall> t;
   t.addChoice(
       "a_shape", [](StitchOptions& o) -> BorderPath::Shape& { return o.a.shape; }, kShapes,
       "path a: 'open', 'closed' or 'auto' (closed when its first vertex is repeated at the end or "
@@ -191,6 +214,8 @@ OptionTable<StitchOptions> stitchTable() {
       "b_shape", [](StitchOptions& o) -> BorderPath::Shape& { return o.b.shape; }, kShapes,
       "path b, like a_shape");
   addStitchOptions(t, [](StitchOptions& o) -> StitchOptions& { return o; });
+  t.add(
+      "keep_partial", [](StitchCall& c) -> bool& { return c.keep_partial; }, kKeepPartialDoc);
   return t;
 }
 
@@ -199,22 +224,30 @@ py::dict stitchArrays(py::handle vertices, py::handle faces, py::handle a, py::h
   CoreCall call(takeProgress(kwargs));
   Mesh mesh;
   readArrays(mesh, vertices, faces, kOneMesh);
-  StitchOptions options =
+  StitchCall options =
       stitchTable().parse("stitch_boundaries", kwargs, {mesh.vert.size(), mesh.face.size()});
   options.a.vertices = vertexIndices(a, "a", mesh.vert.size());
   options.b.vertices = vertexIndices(b, "b", mesh.vert.size());
   options.progress = call.progress();
+  const Mesh before = mesh;
   const StitchResult r = call([&] { return stitchPaths(mesh, options); });
+  const EditContract contract = call([&] {
+    return requireEditContract(before, mesh, "stitch_boundaries",
+                               editContractOptions(options, options.keep_partial), kStitchToTry);
+  });
+  JsonObject report = toJson(r);
+  reportContract(report, contract);
   py::dict out;
   out["mesh"] = meshTuple(mesh);
   out["new_faces"] = intArray(r.new_faces);
   out["new_vertices"] = intArray(r.new_vertices);
-  out["report"] = dictOf(toJson(r));
+  out["report"] = dictOf(report);
   return out;
 }
 
 struct SequenceCall {
   StitchSequenceOptions core;
+  bool keep_partial = EditContractOptions().keep_partial;
 };
 
 OptionTable<SequenceCall> sequenceTable() {
@@ -224,6 +257,8 @@ OptionTable<SequenceCall> sequenceTable() {
       "concatenate remaining paths joined by a stitch, so that a later stitch covers the "
       "junction");
   addStitchOptions(t, [](SequenceCall& c) -> StitchOptions& { return c.core.stitch; });
+  t.add(
+      "keep_partial", [](SequenceCall& c) -> bool& { return c.keep_partial; }, kKeepPartialDoc);
   return t;
 }
 
@@ -270,7 +305,14 @@ py::dict stitchSequenceArrays(py::handle vertices, py::handle faces, py::handle 
     throw InvalidInputError("the sequence needs at least two paths (" +
                             std::to_string(c.core.paths.size()) + " given)");
   c.core.stitch.progress = call.progress();
+  const Mesh before = mesh;
   const StitchSequenceResult r = call([&] { return stitchPathsSequence(mesh, c.core); });
+  const EditContract contract = call([&] {
+    return requireEditContract(before, mesh, "stitch_sequence",
+                               editContractOptions(c.core.stitch, c.keep_partial), kStitchToTry);
+  });
+  JsonObject report = toJson(r);
+  reportContract(report, contract);
   std::vector<int> newFaces, newVertices;
   for (const StitchResult& s : r.steps) {
     newFaces.insert(newFaces.end(), s.new_faces.begin(), s.new_faces.end());
@@ -280,7 +322,7 @@ py::dict stitchSequenceArrays(py::handle vertices, py::handle faces, py::handle 
   out["mesh"] = meshTuple(mesh);
   out["new_faces"] = intArray(newFaces);
   out["new_vertices"] = intArray(newVertices);
-  out["report"] = dictOf(toJson(r));
+  out["report"] = dictOf(report);
   return out;
 }
 
@@ -296,9 +338,14 @@ py::list borderPathsArrays(py::handle vertices, py::handle faces, py::handle sel
 
 // ---------------------------------------------------------------- gap closing
 
-OptionTable<CloseGapsOptions> gapsTable() {
+// Closing gaps' options and what to do with a result that misses the contract.
+struct GapsCall : CloseGapsOptions {
+  bool keep_partial = EditContractOptions().keep_partial;
+};
+
+OptionTable<GapsCall> gapsTable() {
   using O = CloseGapsOptions;
-  OptionTable<O> t;
+  OptionTable<GapsCall> t;
   t.add(
       "absolute_distances", [](O& o) -> bool& { return o.absolute_distances; },
       "merge_tolerance and max_gap are in mesh units (else fractions of the bounding box "
@@ -329,6 +376,8 @@ OptionTable<CloseGapsOptions> gapsTable() {
   t.add(
       "verify", [](O& o) -> bool& { return o.verify; },
       "count the output's intersecting pairs that involve a merged or stitched face");
+  t.add(
+      "keep_partial", [](GapsCall& c) -> bool& { return c.keep_partial; }, kKeepPartialDoc);
   return t;
 }
 
@@ -336,14 +385,22 @@ py::dict closeGapsArrays(py::handle vertices, py::handle faces, py::kwargs kwarg
   CoreCall call(takeProgress(kwargs));
   Mesh mesh;
   readArrays(mesh, vertices, faces, kOneMesh);
-  CloseGapsOptions options =
-      gapsTable().parse("close_gaps", kwargs, {mesh.vert.size(), mesh.face.size()});
+  GapsCall options = gapsTable().parse("close_gaps", kwargs, {mesh.vert.size(), mesh.face.size()});
   options.progress = call.progress();
+  const Mesh before = mesh;
   const CloseGapsResult r = call([&] { return closeGaps(mesh, options); });
+  const EditContract contract = !changedAnything(r) ? EditContract{} : call([&] {
+    return requireEditContract(
+        before, mesh, "close_gaps", editContractOptions(options, options.keep_partial),
+        "Try a smaller merge_tolerance and max_gap, with check_intersections=True, or "
+        "keep_partial=True to see what was made");
+  });
+  JsonObject report = toJson(r);
+  reportContract(report, contract);
   py::dict out;
   out["mesh"] = meshTuple(mesh);
   out["vertex_index"] = intArray(r.vertex_index);
-  out["report"] = dictOf(toJson(r));
+  out["report"] = dictOf(report);
   return out;
 }
 

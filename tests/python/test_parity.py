@@ -116,11 +116,7 @@ DOCUMENT = {
 
 # Options the module does not have yet, each an open item of the project
 # (listed, so the test fails strictly once one is added: remove it here then).
-NO_CONTRACT_YET = ("the module returns the edit as computed: the filters' end-of-edit contract "
-                   "(common/edit_contract.h, enforced in the stitch and clearance plugins) and its "
-                   "'Keep a partial result' are not in the module yet")
-NOT_YET = {(function, "keep_partial"): NO_CONTRACT_YET
-           for function in ("stitch_boundaries", "stitch_sequence", "close_gaps", "enforce_clearance")}
+NOT_YET = {}
 
 
 def declared_filters():
