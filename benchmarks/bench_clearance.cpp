@@ -12,8 +12,8 @@
 #include <memory>
 
 #include "benchmarks/harness.h"
-#include "common/clearance.h"
-#include "common/mesh_io.h"
+#include "common/repair/clearance/clearance.h"
+#include "common/io/mesh_io.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

@@ -53,9 +53,9 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/holes.h"
-#include "common/mesh_io.h"
-#include "common/parallel.h"
+#include "common/repair/holes/holes.h"
+#include "common/io/mesh_io.h"
+#include "common/base/parallel.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

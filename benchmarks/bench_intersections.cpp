@@ -19,10 +19,10 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/intersections.h"
-#include "common/mesh_io.h"
-#include "common/parallel.h"
-#include "common/triangle_intersection.h"
+#include "common/exact/intersections.h"
+#include "common/io/mesh_io.h"
+#include "common/base/parallel.h"
+#include "common/exact/triangle_intersection.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

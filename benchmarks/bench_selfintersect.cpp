@@ -44,8 +44,8 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/mesh_io.h"
-#include "common/selfintersect.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/selfintersect/selfintersect.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

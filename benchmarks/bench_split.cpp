@@ -34,9 +34,9 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/mesh_io.h"
-#include "common/output_stage.h"
-#include "common/split.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/output_stage.h"
+#include "common/repair/split/split.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

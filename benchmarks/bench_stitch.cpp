@@ -26,8 +26,8 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/mesh_io.h"
-#include "common/stitch.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/stitch/stitch.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;

@@ -8,7 +8,7 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Surface_mesh.h>
 
-#include "common/mesh.h"
+#include "common/base/mesh.h"
 
 namespace meshmend::bench {
 

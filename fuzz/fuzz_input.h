@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "common/mesh.h"
+#include "common/base/mesh.h"
 
 namespace meshmend::fuzz {
 

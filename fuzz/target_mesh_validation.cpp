@@ -3,10 +3,10 @@
 // refused with InvalidInputError, and the counts agree with each other.
 #include <cmath>
 
-#include "common/errors.h"
-#include "common/inspect.h"
-#include "common/intersections.h"
-#include "common/mesh.h"
+#include "common/base/errors.h"
+#include "common/repair/inspect/inspect.h"
+#include "common/exact/intersections.h"
+#include "common/base/mesh.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "common/errors.h"
-#include "common/obj_reader.h"
+#include "common/base/errors.h"
+#include "common/io/obj_reader.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

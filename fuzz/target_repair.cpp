@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <map>
 
-#include "common/clearance.h"
-#include "common/errors.h"
-#include "common/holes.h"
-#include "common/inspect.h"
-#include "common/intersections.h"
-#include "common/selfintersect.h"
-#include "common/stitch.h"
+#include "common/repair/clearance/clearance.h"
+#include "common/base/errors.h"
+#include "common/repair/holes/holes.h"
+#include "common/repair/inspect/inspect.h"
+#include "common/exact/intersections.h"
+#include "common/repair/selfintersect/selfintersect.h"
+#include "common/repair/stitch/stitch.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

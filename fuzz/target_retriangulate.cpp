@@ -7,10 +7,10 @@
 #include <cmath>
 #include <set>
 
-#include "common/errors.h"
-#include "common/exact_point.h"
-#include "common/predicates.h"
-#include "common/retriangulate.h"
+#include "common/base/errors.h"
+#include "common/exact/exact_point.h"
+#include "common/exact/predicates.h"
+#include "common/exact/retriangulate.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

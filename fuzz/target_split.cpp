@@ -2,11 +2,11 @@
 // (common/patches.h) on one or two small random meshes: they finish, or
 // refuse with the core's typed errors; in double, the split leaves no
 // intersecting pair among the faces it made.
-#include "common/errors.h"
-#include "common/intersections.h"
-#include "common/output_stage.h"
-#include "common/patches.h"
-#include "common/split.h"
+#include "common/base/errors.h"
+#include "common/exact/intersections.h"
+#include "common/repair/output_stage.h"
+#include "common/repair/patches/patches.h"
+#include "common/repair/split/split.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

@@ -4,9 +4,9 @@
 // and every contact point, checked exactly against both triangles.
 #include <cmath>
 
-#include "common/exact_point.h"
-#include "common/predicates.h"
-#include "common/triangle_intersection.h"
+#include "common/exact/exact_point.h"
+#include "common/exact/predicates.h"
+#include "common/exact/triangle_intersection.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {

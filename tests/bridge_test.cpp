@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 #include <QCoreApplication>
 
-#include "common/errors.h"
+#include "common/base/errors.h"
 #include "plugins/bridge/filter_support.h"
 
 namespace meshmend::bridge {

@@ -6,7 +6,7 @@
 #include <map>
 #include <vector>
 
-#include "common/mesh.h"
+#include "common/base/mesh.h"
 
 namespace meshmend::testing {
 

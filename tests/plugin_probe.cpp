@@ -13,7 +13,7 @@
 #include <cstdio>
 #include <string>
 
-#include "common/json.h"
+#include "common/base/json.h"
 
 int main(int argc, char** argv) {
   qputenv("QT_QPA_PLATFORM", "offscreen");

@@ -42,11 +42,11 @@
 #include <string>
 #include <vector>
 
-#include "common/clearance.h"
-#include "common/errors.h"
-#include "common/intersections.h"
-#include "common/mesh_io.h"
-#include "common/patches.h"
+#include "common/repair/clearance/clearance.h"
+#include "common/base/errors.h"
+#include "common/exact/intersections.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/patches/patches.h"
 
 using namespace meshmend;
 

@@ -21,7 +21,7 @@
 #include <QAction>
 #include <QVariant>
 
-#include "common/json.h"
+#include "common/base/json.h"
 #include "plugins/bridge/meshlab_host.h"
 
 #if MESHMEND_MESHLAB_API == 2022

@@ -10,9 +10,9 @@
 
 #include <QString>
 
-#include "common/errors.h"
-#include "common/json.h"
-#include "common/progress.h"
+#include "common/base/errors.h"
+#include "common/base/json.h"
+#include "common/base/progress.h"
 #include "plugins/bridge/meshlab_host.h"
 
 namespace meshmend::bridge {

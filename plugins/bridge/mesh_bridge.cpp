@@ -1,7 +1,7 @@
 #include "plugins/bridge/mesh_bridge.h"
 
-#include "common/errors.h"
-#include "common/huge_pages.h"
+#include "common/base/errors.h"
+#include "common/base/huge_pages.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "common/mesh.h"
+#include "common/base/mesh.h"
 #include "plugins/bridge/meshlab_host.h"
 
 namespace meshmend::bridge {

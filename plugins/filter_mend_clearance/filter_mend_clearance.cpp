@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "common/clearance.h"
-#include "common/edit_contract.h"
+#include "common/repair/clearance/clearance.h"
+#include "common/repair/edit_contract.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "common/holes.h"
+#include "common/repair/holes/holes.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

@@ -2,7 +2,7 @@
 
 #include <QElapsedTimer>
 
-#include "common/inspect.h"
+#include "common/repair/inspect/inspect.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

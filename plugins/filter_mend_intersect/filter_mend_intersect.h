@@ -2,8 +2,8 @@
 // Faces" and "MeshMend: Intersect and Split Layers".
 #pragma once
 
-#include "common/output_stage.h"
-#include "common/split.h"
+#include "common/repair/output_stage.h"
+#include "common/repair/split/split.h"
 #include "plugins/bridge/filter_plugin.h"
 
 class IntersectPlugin : public QObject, public meshmend::bridge::FilterAdapter {

@@ -4,12 +4,12 @@
 #include <cmath>
 #include <sstream>
 
-#include "common/inspect.h"
-#include "common/intersections.h"
-#include "common/output_stage.h"
-#include "common/patch_ops.h"
-#include "common/patches.h"
-#include "common/split.h"
+#include "common/repair/inspect/inspect.h"
+#include "common/exact/intersections.h"
+#include "common/repair/output_stage.h"
+#include "common/repair/patches/patch_ops.h"
+#include "common/repair/patches/patches.h"
+#include "common/repair/split/split.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <set>
 
-#include "common/patches.h"
-#include "common/render_channels.h"
+#include "common/repair/patches/patches.h"
+#include "common/render/render_channels.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

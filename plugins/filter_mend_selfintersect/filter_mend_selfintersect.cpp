@@ -1,6 +1,6 @@
 #include "filter_mend_selfintersect.h"
 
-#include "common/selfintersect.h"
+#include "common/repair/selfintersect/selfintersect.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "common/edit_contract.h"
-#include "common/stitch.h"
+#include "common/repair/edit_contract.h"
+#include "common/repair/stitch/stitch.h"
 #include "plugins/bridge/filter_support.h"
 #include "plugins/bridge/mesh_bridge.h"
 

@@ -7,7 +7,7 @@
 #include <wrap/io_trimesh/io_mask.h>
 #include <QFileInfo>
 
-#include "common/obj_reader.h"
+#include "common/io/obj_reader.h"
 #include "plugins/bridge/filter_support.h"
 
 using namespace meshmend;

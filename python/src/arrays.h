@@ -13,10 +13,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include "common/errors.h"
-#include "common/json.h"
-#include "common/mesh.h"
-#include "common/progress.h"
+#include "common/base/errors.h"
+#include "common/base/json.h"
+#include "common/base/mesh.h"
+#include "common/base/progress.h"
 
 namespace meshmend::python {
 

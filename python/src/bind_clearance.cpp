@@ -1,7 +1,7 @@
 // Measuring and enforcing a minimum clearance between the faces of meshes,
 // on arrays.
-#include "common/clearance.h"
-#include "common/edit_contract.h"
+#include "common/repair/clearance/clearance.h"
+#include "common/repair/edit_contract.h"
 #include "python/src/bindings.h"
 #include "python/src/options.h"
 

@@ -2,12 +2,12 @@
 // removal on arrays; reading and writing mesh files.
 #include <chrono>
 
-#include "common/inspect.h"
-#include "common/intersections.h"
-#include "common/mesh_io.h"
-#include "common/output_stage.h"
-#include "common/selfintersect.h"
-#include "common/split.h"
+#include "common/repair/inspect/inspect.h"
+#include "common/exact/intersections.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/output_stage.h"
+#include "common/repair/selfintersect/selfintersect.h"
+#include "common/repair/split/split.h"
 #include "python/src/bindings.h"
 #include "python/src/options.h"
 

@@ -3,11 +3,11 @@
 // on arrays.
 #include <chrono>
 
-#include "common/inspect.h"
-#include "common/intersections.h"
-#include "common/patch_ops.h"
-#include "common/patches.h"
-#include "common/split.h"
+#include "common/repair/inspect/inspect.h"
+#include "common/exact/intersections.h"
+#include "common/repair/patches/patch_ops.h"
+#include "common/repair/patches/patches.h"
+#include "common/repair/split/split.h"
 #include "python/src/bindings.h"
 #include "python/src/options.h"
 

@@ -1,8 +1,8 @@
 // Hole filling, trimming along a vertex loop, stitching border paths and
 // closing gaps between borders, on arrays.
-#include "common/edit_contract.h"
-#include "common/holes.h"
-#include "common/stitch.h"
+#include "common/repair/edit_contract.h"
+#include "common/repair/holes/holes.h"
+#include "common/repair/stitch/stitch.h"
 #include "python/src/bindings.h"
 #include "python/src/options.h"
 

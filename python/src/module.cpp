@@ -4,8 +4,8 @@
 // typed errors into Python exceptions carrying the core's messages.
 #include <pybind11/pybind11.h>
 
-#include "common/errors.h"
-#include "common/parallel.h"
+#include "common/base/errors.h"
+#include "common/base/parallel.h"
 #include "python/src/bindings.h"
 
 namespace py = pybind11;

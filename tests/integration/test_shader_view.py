@@ -1,5 +1,5 @@
 """MeshMend: Prepare Shader View through meshlabserver: the values the
-shaders in shaders/ read (common/render_channels.h), written as per-wedge
+shaders in shaders/ read (common/render/render_channels.h), written as per-wedge
 texture coordinates, saved to PLY and decoded here as the shaders decode
 them, against values computed independently (vertex quality, face quality,
 boundaries from the saved faces, the faces a filter added)."""

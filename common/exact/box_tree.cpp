@@ -1,0 +1,393 @@
+#include "common/exact/box_tree.h"
+#include "common/base/huge_pages.h"
+#include "common/base/parallel.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <thread>
+
+namespace meshmend {
+
+namespace {
+
+// x rounded to float toward -infinity (down) or +infinity (up): the
+// conversion, or the float next to it, one step of its bits (toward zero
+// or away from it by its sign, across zero from either zero, from an
+// infinity to the largest finite float). The two are chosen by a mask, not
+// a branch: whether a conversion rounded the wrong way is as good as
+// random, and the mispredicted branches were a sixth of a search between
+// two small meshes.
+float down(double x) {
+  const float f = float(x);
+  std::uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  std::uint32_t stepped = bits + 2 * (bits >> 31) - 1;       // negative: away from zero
+  if (bits == 0) stepped = 0x80000001u;                      // +0: the negative float next to it
+  const std::uint32_t take = -std::uint32_t(double(f) > x);  // all ones or zero
+  bits = (bits & ~take) | (stepped & take);
+  float rounded;
+  std::memcpy(&rounded, &bits, sizeof rounded);
+  return rounded;
+}
+
+float up(double x) {
+  const float f = float(x);
+  std::uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  std::uint32_t stepped = bits + 1 - 2 * (bits >> 31);  // negative: toward zero
+  if (bits == 0x80000000u) stepped = 1;                 // -0: the positive float next to it
+  const std::uint32_t take = -std::uint32_t(double(f) < x);
+  bits = (bits & ~take) | (stepped & take);
+  float rounded;
+  std::memcpy(&rounded, &bits, sizeof rounded);
+  return rounded;
+}
+
+void grow(Box& b, const Box& x) {
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = std::min(b.lo[k], x.lo[k]);
+    b.hi[k] = std::max(b.hi[k], x.hi[k]);
+  }
+}
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+}  // namespace
+
+Box boxOf(const Point3& a, const Point3& b, const Point3& c) {
+  Box box;
+  for (int k = 0; k < 3; ++k) {
+    box.lo[k] = down(std::min({a[k], b[k], c[k]}));
+    box.hi[k] = up(std::max({a[k], b[k], c[k]}));
+  }
+  return box;
+}
+
+Box boxOf(const Point3& p) {
+  Box box;
+  for (int k = 0; k < 3; ++k) {
+    box.lo[k] = down(p[k]);
+    box.hi[k] = up(p[k]);
+  }
+  return box;
+}
+
+BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kCells, 0) {
+  if (boxes.empty()) return;
+  bounds_ = boxes[0];
+  for (const Box& b : boxes)
+    for (int k = 0; k < 3; ++k) {
+      bounds_.lo[k] = std::min(bounds_.lo[k], b.lo[k]);
+      bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
+    }
+  for (int k = 0; k < 3; ++k)
+    cellsPerUnit_[k] = 1 / std::max((bounds_.hi[k] - bounds_.lo[k]) / kCells, 1e-30f);
+  for (const Box& b : boxes) {
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+    for (int x = lo[0]; x <= hi[0]; ++x)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z) occupied_[(x * kCells + y) * kCells + z] = 1;
+  }
+}
+
+bool BoxGrid::inside(const Box& b) const {
+  for (int k = 0; k < 3; ++k)
+    if (!(b.lo[k] >= bounds_.lo[k] && b.hi[k] <= bounds_.hi[k])) return false;
+  return true;
+}
+
+bool BoxGrid::touches(const Box& b) const {
+  if (!overlap(b, bounds_)) return false;
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        if (occupied(x, y, z)) return true;
+  return false;
+}
+
+bool BoxGrid::covers(const Box& b) const {
+  if (!inside(b)) return false;
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        if (!occupied(x, y, z)) return false;
+  return true;
+}
+
+HashedBoxGrid::HashedBoxGrid(std::vector<Box> boxes) : boxes_(std::move(boxes)) {
+  if (boxes_.empty()) return;
+  bounds_ = boxes_[0];
+  double extent[3] = {0, 0, 0};
+  for (const Box& b : boxes_) {
+    grow(bounds_, b);
+    for (int k = 0; k < 3; ++k) extent[k] += double(b.hi[k]) - b.lo[k];
+  }
+  // Cells twice as large as the boxes along each axis on average (a box
+  // lists in about three; as large as them, eight, and the search took
+  // longer), at most kAxisCells along one.
+  for (int k = 0; k < 3; ++k) {
+    const double size = std::max(2 * extent[k] / double(boxes_.size()),
+                                 (double(bounds_.hi[k]) - bounds_.lo[k]) / kAxisCells);
+    cellsPerUnit_[k] = size > 0 ? float(1 / size) : 0;  // flat along k: one cell
+  }
+  firstCell_.resize(boxes_.size());
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < boxes_.size(); ++i) {
+    for (int k = 0; k < 3; ++k) firstCell_[i][k] = std::uint16_t(cell(boxes_[i].lo[k], k));
+    const std::size_t cells = cellsOf(boxes_[i]);
+    if (cells > kMostCells) {  // boxes of very different sizes: a tree's case
+      usable_ = false;
+      firstCell_ = {};
+      return;
+    }
+    total += cells;
+  }
+  // About one bucket per entry (a power of two, the hash's top bits).
+  int bits = 1;
+  while ((std::size_t(1) << bits) < total && bits < 30) ++bits;
+  shift_ = 32 - bits;
+  start_.assign((std::size_t(1) << bits) + 1, 0);
+  auto forEachCell = [&](std::uint32_t i, auto&& f) {
+    const Box& b = boxes_[i];
+    const int hx = cell(b.hi[0], 0), hy = cell(b.hi[1], 1), hz = cell(b.hi[2], 2);
+    for (int x = firstCell_[i][0]; x <= hx; ++x)
+      for (int y = firstCell_[i][1]; y <= hy; ++y)
+        for (int z = firstCell_[i][2]; z <= hz; ++z) f(key(x, y, z));
+  };
+  for (std::uint32_t i = 0; i < boxes_.size(); ++i)
+    forEachCell(i, [&](std::uint32_t k) { ++start_[bucket(k) + 1]; });
+  for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+  entries_.resize(total);
+  std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+  for (std::uint32_t i = 0; i < boxes_.size(); ++i)
+    forEachCell(i, [&](std::uint32_t k) { entries_[fill[bucket(k)]++] = {k, i}; });
+}
+
+bool HashedBoxGrid::suits(const std::vector<Box>& queries) const {
+  if (!usable_) return false;
+  std::size_t wide = 0;
+  for (const Box& q : queries) wide += cellsOf(q) > kMostCells;
+  // A wide query tests every box: worth it while those tests cost no more
+  // than the cell visits of all the queries, a few dozen tests each.
+  return wide * boxes_.size() <= 64 * queries.size();
+}
+
+BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes)) {
+  resizeInHugePages(order_, boxes_.size());
+  std::iota(order_.begin(), order_.end(), 0u);
+  if (boxes_.empty()) return;
+  if (layout == Layout::kMorton) {
+    sortByMorton();
+    buildParallel(false);
+    return;
+  }
+  resizeInHugePages(centres_, boxes_.size());
+  for (std::size_t i = 0; i < boxes_.size(); ++i) {
+    const Box& b = boxes_[i];
+    centres_[i] = {{b.lo[0] + b.hi[0], b.lo[1] + b.hi[1], b.lo[2] + b.hi[2]}, std::uint32_t(i)};
+  }
+  buildParallel(true);
+  for (std::size_t i = 0; i < centres_.size(); ++i) order_[i] = centres_[i].index;
+  centres_ = {};
+}
+
+// Builds the two halves of the root in parallel (for large inputs), then joins
+// them under the root. With `splitByMedian`, the halves are the two sides of
+// the median along the widest axis; otherwise the current order is kept.
+void BoxTree::buildParallel(bool splitByMedian) {
+  const std::uint32_t n = std::uint32_t(boxes_.size());
+  auto one = [&](std::uint32_t b, std::uint32_t e, std::vector<Node>& out) {
+    if (splitByMedian)
+      build(b, e, out);
+    else
+      buildInOrder(b, e, out);
+  };
+  // Leaves hold two to four boxes, so a tree over m boxes has fewer than m
+  // nodes: each part's room is made once.
+  if (n < 20000) {
+    reserveInHugePages(nodes_, n);
+    one(0, n, nodes_);
+    return;
+  }
+  Box all{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  Box centers = all;
+  for (const Box& b : boxes_) {
+    grow(all, b);
+    for (int k = 0; k < 3; ++k) {
+      const float c = 0.5f * (b.lo[k] + b.hi[k]);
+      centers.lo[k] = std::min(centers.lo[k], c);
+      centers.hi[k] = std::max(centers.hi[k], c);
+    }
+  }
+  const std::uint32_t mid = n / 2;
+  if (splitByMedian) {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (centers.hi[k] - centers.lo[k] > centers.hi[axis] - centers.lo[axis]) axis = k;
+    std::nth_element(
+        centres_.begin(), centres_.begin() + mid, centres_.end(),
+        [axis](const Centre& x, const Centre& y) { return x.sum[axis] < y.sum[axis]; });
+  }
+  std::vector<Node> left, right;
+  reserveInHugePages(left, mid);
+  reserveInHugePages(right, n - mid);
+  TaskAlongside worker([&] { one(0, mid, left); });
+  one(mid, n, right);
+  worker.wait();
+  reserveInHugePages(nodes_, 1 + left.size() + right.size());
+  nodes_.push_back({all, 1, std::uint32_t(1 + left.size())});
+  auto append = [&](const std::vector<Node>& part) {
+    const std::uint32_t offset = std::uint32_t(nodes_.size());
+    for (Node node : part) {
+      if (!leaf(node)) {
+        node.a += offset;
+        node.b += offset;
+      }
+      nodes_.push_back(node);
+    }
+  };
+  append(left);
+  append(right);
+}
+
+namespace {
+
+// Spreads the low 10 bits of x to every third bit.
+std::uint32_t spread(std::uint32_t x) {
+  x &= 0x3ff;
+  x = (x | (x << 16)) & 0x030000ff;
+  x = (x | (x << 8)) & 0x0300f00f;
+  x = (x | (x << 4)) & 0x030c30c3;
+  x = (x | (x << 2)) & 0x09249249;
+  return x;
+}
+
+}  // namespace
+
+// Orders the primitives along a Morton curve through their box centres
+// (10 bits per axis, least-significant-digit radix sort).
+void BoxTree::sortByMorton() {
+  Box centers{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  for (const Box& b : boxes_)
+    for (int k = 0; k < 3; ++k) {
+      const float c = 0.5f * (b.lo[k] + b.hi[k]);
+      centers.lo[k] = std::min(centers.lo[k], c);
+      centers.hi[k] = std::max(centers.hi[k], c);
+    }
+  const std::size_t n = boxes_.size();
+  std::vector<std::uint32_t> code(n), tmpCode(n), tmpOrder(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t q[3];
+    for (int k = 0; k < 3; ++k) {
+      const float extent = centers.hi[k] - centers.lo[k];
+      const float c = 0.5f * (boxes_[i].lo[k] + boxes_[i].hi[k]);
+      const float t = extent > 0 ? (c - centers.lo[k]) / extent : 0.f;
+      q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, t * 1023.f)));
+    }
+    code[i] = spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2);
+  }
+  for (int shift = 0; shift < 30; shift += 10) {  // three passes of 10 bits
+    std::vector<std::uint32_t> count(1025, 0);
+    for (std::size_t i = 0; i < n; ++i) ++count[((code[i] >> shift) & 1023) + 1];
+    for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t slot = count[(code[i] >> shift) & 1023]++;
+      tmpCode[slot] = code[i];
+      tmpOrder[slot] = order_[i];
+    }
+    code.swap(tmpCode);
+    order_.swap(tmpOrder);
+  }
+}
+
+// A balanced hierarchy over the current order: split every range at its middle.
+void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const {
+  const std::uint32_t self = std::uint32_t(out.size());
+  out.push_back({});
+  if (end - begin <= kLeafSize) {
+    Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+    for (std::uint32_t i = begin; i < end; ++i) grow(box, boxes_[order_[i]]);
+    out[self] = {box, begin, (end - begin) | kLeaf};
+    return;
+  }
+  const std::uint32_t mid = begin + (end - begin) / 2;
+  const std::uint32_t left = std::uint32_t(out.size());
+  buildInOrder(begin, mid, out);
+  const std::uint32_t right = std::uint32_t(out.size());
+  buildInOrder(mid, end, out);
+  Box box = out[left].box;
+  grow(box, out[right].box);
+  out[self] = {box, left, right};
+}
+
+// Median split along the longest axis of the box centres; children indices
+// are relative to `out`.
+void BoxTree::build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) {
+  const std::uint32_t self = std::uint32_t(out.size());
+  out.push_back({});
+  if (end - begin <= kLeafSize) {
+    Box box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+    for (std::uint32_t i = begin; i < end; ++i) grow(box, boxes_[centres_[i].index]);
+    out[self] = {box, begin, (end - begin) | kLeaf};
+    return;
+  }
+  // The centres' extent, in locals: kept in a Box, every step stored its
+  // bounds and loaded them again (a third of the build).
+  float lo0 = kInf, lo1 = kInf, lo2 = kInf, hi0 = -kInf, hi1 = -kInf, hi2 = -kInf;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const float* sum = centres_[i].sum;
+    const float c0 = 0.5f * sum[0], c1 = 0.5f * sum[1], c2 = 0.5f * sum[2];
+    lo0 = std::min(lo0, c0), lo1 = std::min(lo1, c1), lo2 = std::min(lo2, c2);
+    hi0 = std::max(hi0, c0), hi1 = std::max(hi1, c1), hi2 = std::max(hi2, c2);
+  }
+  const float extent[3] = {hi0 - lo0, hi1 - lo1, hi2 - lo2};
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (extent[k] > extent[axis]) axis = k;
+  const std::uint32_t mid = begin + (end - begin) / 2;
+  std::nth_element(centres_.begin() + begin, centres_.begin() + mid, centres_.begin() + end,
+                   [axis](const Centre& x, const Centre& y) { return x.sum[axis] < y.sum[axis]; });
+  const std::uint32_t left = std::uint32_t(out.size());
+  build(begin, mid, out);
+  const std::uint32_t right = std::uint32_t(out.size());
+  build(mid, end, out);
+  // A node's box is its children's together (the same as over its boxes).
+  Box box = out[left].box;
+  grow(box, out[right].box);
+  out[self] = {box, left, right};
+}
+
+void BoxTree::tasks(std::uint32_t n, int depth,
+                    std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const {
+  const Node& node = nodes_[n];
+  if (depth == 0 || leaf(node)) {
+    out.emplace_back(n, n);
+    return;
+  }
+  tasks(node.a, depth - 1, out);
+  tasks(node.b, depth - 1, out);
+  pairTasks(node.a, node.b, depth - 1, out);
+}
+
+void BoxTree::pairTasks(std::uint32_t x, std::uint32_t y, int depth,
+                        std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const {
+  const Node &nx = nodes_[x], &ny = nodes_[y];
+  if (!overlap(nx.box, ny.box)) return;
+  if (depth <= 0 || leaf(nx) || leaf(ny)) {
+    out.emplace_back(x, y);
+    return;
+  }
+  pairTasks(nx.a, ny.a, depth - 1, out);
+  pairTasks(nx.a, ny.b, depth - 1, out);
+  pairTasks(nx.b, ny.a, depth - 1, out);
+  pairTasks(nx.b, ny.b, depth - 1, out);
+}
+
+}  // namespace meshmend

@@ -1,0 +1,661 @@
+#include "common/exact/intersections.h"
+#include "common/base/timing.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+
+#include "common/base/errors.h"
+#include "common/base/huge_pages.h"
+#include "common/base/parallel.h"
+#include "common/exact/box_tree.h"
+#include "common/exact/predicates.h"
+
+namespace meshmend {
+
+namespace {
+
+// A mesh flattened for the inner loops (the caller's arrays, not a copy).
+struct Soup {
+  const std::vector<Point3>& points;
+  const std::vector<Triangle>& triangles;
+  // Per face: collinear. With `withTree` known for every face; otherwise
+  // only for those the search between meshes looks at (facesTouching()),
+  // the rest stay 0: most of a mesh lies far from the others, and asking
+  // each of its faces cost as much as the search.
+  std::vector<char> degenerate;
+  bool degenerateKnown = false;
+  Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
+  // Only for the search within the mesh (`withTree`): every face's box
+  // (moved into the mesh's tree) and the filter of its exact plane sides
+  // (side()).
+  std::vector<Box> boxes;
+  std::vector<PlaneFilter> planes;
+
+  explicit Soup(const MeshArrays& mesh) : points(mesh.points), triangles(mesh.triangles) {}
+  // The bounds, and with `withTree` the degenerate faces, boxes and planes.
+  void prepare(bool withTree) {
+    Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
+    for (const Point3& p : points)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], p[k]);
+        hi[k] = std::max(hi[k], p[k]);
+      }
+    if (!points.empty()) bounds = boxOf(lo, hi, hi);
+    resizeInHugePages(degenerate, triangles.size());
+    degenerateKnown = withTree;
+    if (!withTree) return;
+    // Each point rounded to float once (about six faces share it), then
+    // each face's box from its corners'.
+    std::vector<Box> pointBoxes;
+    resizeInHugePages(pointBoxes, points.size());
+    parallelChunks(points.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t v = begin; v < end; ++v) pointBoxes[v] = boxOf(points[v]);
+    });
+    resizeInHugePages(boxes, triangles.size());
+    resizeInHugePages(planes, triangles.size());
+    parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const Triangle& t = triangles[f];
+        const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
+        boxes[f] = hull(pointBoxes[t[0]], pointBoxes[t[1]], pointBoxes[t[2]]);
+        degenerate[f] = collinear(a, b, c);
+        planes[f] = PlaneFilter(a, b, c);
+      }
+    });
+  }
+  const Point3& corner(std::uint32_t f, int i) const { return points[triangles[f][i]]; }
+  // orient3d of face f's corners and p.
+  int side(std::uint32_t f, const Point3& p) const {
+    const Triangle& t = triangles[f];
+    return planes[f].side(points[t[0]], points[t[1]], points[t[2]], p);
+  }
+  TrianglePoints at(std::uint32_t f) const {
+    const Triangle& t = triangles[f];
+    return {points[t[0]], points[t[1]], points[t[2]]};
+  }
+};
+
+// The faces of a mesh that may meet another mesh: not degenerate, their box
+// overlapping the other's bounds. Only these enter the search between the
+// two; on small pairs that meet along a curve they are a small part of each.
+struct Candidates {
+  std::vector<std::uint32_t> faces;
+  std::vector<Box> boxes;  // parallel to faces
+};
+
+Candidates facesTouching(Soup& s, const Box& other) {
+  // A face whose corners all lie beyond the float next to a side of `other`
+  // has its box (rounded outward, never past that float) beyond the side:
+  // turned away in double, by one bit per corner and side, its box is never
+  // made. The rest are decided on their boxes, as the search sees them.
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::nextafter(other.lo[k], -INFINITY);
+    hi[k] = std::nextafter(other.hi[k], INFINITY);
+  }
+  std::vector<std::uint8_t> beyond(s.points.size());
+  // In chunks, each keeping its own candidates, then joined in order.
+  std::vector<Candidates> parts(workerCount());
+  parallelChunks(
+      s.points.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t v = begin; v < end; ++v) {
+          const Point3& p = s.points[v];
+          beyond[v] = std::uint8_t((p[0] < lo[0]) | (p[0] > hi[0]) << 1 | (p[1] < lo[1]) << 2 |
+                                   (p[1] > hi[1]) << 3 | (p[2] < lo[2]) << 4 | (p[2] > hi[2]) << 5);
+        }
+      },
+      4096);
+  parallelChunks(
+      s.triangles.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        // A large mesh's chunk makes room for every face at once (the first
+        // chunk's for all, as the others join it): mapped memory, of which
+        // only what is written becomes pages, where growing copied each
+        // array a few times into new memory. A small mesh's (under a few
+        // hundred KiB) grow as they fill: room for all its faces, most of it
+        // unused, would take the heap's top, which a fresh process hands
+        // back to the system after every run.
+        Candidates& c = parts[worker];
+        const std::size_t room = worker == 0 ? s.triangles.size() : end - begin;
+        if (room * sizeof(Box) >= (std::size_t(256) << 10)) {
+          reserveInHugePages(c.faces, room);
+          reserveInHugePages(c.boxes, room);
+        }
+        for (std::size_t f = begin; f < end; ++f) {
+          const Triangle& t = s.triangles[f];
+          if (beyond[t[0]] & beyond[t[1]] & beyond[t[2]]) continue;
+          const Point3 &p = s.points[t[0]], &q = s.points[t[1]], &r = s.points[t[2]];
+          const Box box = boxOf(p, q, r);
+          if (!overlap(box, other)) continue;
+          if (!s.degenerateKnown) s.degenerate[f] = collinear(p, q, r);
+          if (s.degenerate[f]) continue;
+          c.faces.push_back(std::uint32_t(f));
+          c.boxes.push_back(box);
+        }
+      },
+      1024);
+  for (std::size_t w = 1; w < parts.size(); ++w) {
+    parts[0].faces.insert(parts[0].faces.end(), parts[w].faces.begin(), parts[w].faces.end());
+    parts[0].boxes.insert(parts[0].boxes.end(), parts[w].boxes.begin(), parts[w].boxes.end());
+  }
+  return std::move(parts[0]);
+}
+
+// Are all three corners of face g of `gs` strictly on one side of the plane
+// of face f of `fs`?
+bool strictlyBeside(const Soup& fs, std::uint32_t f, const Soup& gs, std::uint32_t g) {
+  const int s0 = fs.side(f, gs.corner(g, 0));
+  if (s0 == 0) return false;
+  return fs.side(f, gs.corner(g, 1)) == s0 && fs.side(f, gs.corner(g, 2)) == s0;
+}
+
+// Exact: can the segment from corner i to corner j of face g meet face f?
+// False when both ends lie strictly on one side of f's plane.
+bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
+  return s.side(f, s.corner(g, i)) * s.side(f, s.corner(g, j)) <= 0;
+}
+
+// The self-intersection rule for two faces of one mesh. Cheap exact plane
+// tests settle almost every pair of neighbours; the rest get the full test.
+bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
+  const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
+  switch (c.count) {
+    case 0:
+      if (strictlyBeside(s, f, s, g) || strictlyBeside(s, g, s, f)) return false;
+      break;
+    case 1:
+      // When either face's edge opposite the shared corner lies strictly on
+      // one side of the other's plane, that face meets the plane only at the
+      // shared corner: nothing beyond it. Both edges must reach the plane.
+      if (!edgeMayMeet(s, f, (c.ia + 1) % 3, (c.ia + 2) % 3, g) ||
+          !edgeMayMeet(s, g, (c.ib + 1) % 3, (c.ib + 2) % 3, f))
+        return false;
+      break;
+    case 2:  // folded faces are coplanar: the other's apex must lie in the plane
+      if (s.side(f, s.corner(g, c.ib)) != 0) return false;
+      break;
+    default:
+      return true;
+  }
+  return intersectBeyondShared(s.at(f), s.at(g), c.count, c.ia, c.ib);
+}
+
+}  // namespace
+
+FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
+                                          const FindIntersectionsOptions& options) {
+  for (std::size_t m = 0; m < meshes.size(); ++m)
+    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+  std::vector<MeshArrays> arrays;
+  for (const Mesh* mesh : meshes) arrays.push_back(arraysOf(*mesh));
+  std::vector<const MeshArrays*> pointers;
+  for (const MeshArrays& a : arrays) pointers.push_back(&a);
+  return findIntersectionsInArrays(pointers, options);
+}
+
+std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat, bool sameVertices) {
+  return selfIntersectingPairs(mesh, asFloat ? Scalar::kFloat : Scalar::kDouble, sameVertices);
+}
+
+std::size_t selfIntersectingPairs(const Mesh& mesh, Scalar scalar, bool sameVertices) {
+  MeshArrays arrays = arraysOf(mesh);
+  if (scalar != Scalar::kDouble)
+    for (Point3& p : arrays.points) p = storedAs(p, scalar);
+  FindIntersectionsOptions o;
+  o.cross = false;
+  o.same_vertices = sameVertices;
+  return findIntersectionsInArrays({&arrays}, o).self_pairs[0];
+}
+
+FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
+                                                  const FindIntersectionsOptions& options) {
+  const auto start = Clock::now();
+  FindIntersectionsResult r;
+  const std::size_t n = meshes.size();
+  for (std::size_t m = 0; m < n; ++m) {
+    if (meshes[m]->triangles.empty())
+      throw InvalidInputError("mesh " + std::to_string(m) + " has no faces");
+    for (const Point3& p : meshes[m]->points)
+      if (!isFinite(p))
+        throw InvalidInputError("mesh " + std::to_string(m) + " has a non-finite coordinate");
+  }
+  reportProgress(options.progress, 0, "Preparing boxes");
+  // Each mesh gets a tree (and every face's box and plane) only for its
+  // self-intersections; the search between meshes builds its own over the
+  // faces near the other mesh.
+  std::vector<Soup> soups;
+  soups.reserve(n);
+  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m]);
+  // Each mesh on its own, side by side (a large mesh's own stages take the
+  // threads a small one leaves).
+  parallelChunks(
+      n,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t m = begin; m < end; ++m) soups[m].prepare(options.self);
+      },
+      1);
+  // A pair found between meshes keeps the plane sides its test computed:
+  // the contact classification needs the same ones.
+  struct Found {
+    IntersectingPair pair;
+    std::int8_t side[2][3];  // as PlaneSides, for (pair.a, pair.b)
+    bool sidesKnown;
+  };
+  // Per-worker results, each on its own cache line (no false sharing).
+  struct alignas(64) WorkerFindings {
+    std::vector<Found> pairs;
+    std::size_t candidates = 0;
+  };
+  std::vector<WorkerFindings> found(workerCount());
+
+  const auto buildStart = Clock::now();
+  std::vector<BoxTree> trees;
+  if (options.self) {
+    trees.reserve(n);
+    for (std::size_t m = 0; m < n; ++m)
+      trees.emplace_back(std::move(soups[m].boxes), options.layout == 1
+                                                        ? BoxTree::Layout::kMorton
+                                                        : BoxTree::Layout::kMedianSplit);
+  }
+  r.build_ms = msSince(buildStart);
+
+  const auto searchStart = Clock::now();
+  if (options.self)
+    for (std::size_t m = 0; m < n; ++m) {
+      reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
+      const Soup& s = soups[m];
+      trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
+        if (s.degenerate[f] || s.degenerate[g]) return;
+        ++found[worker].candidates;
+        if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
+            selfIntersect(s, f, g))
+          found[worker].pairs.push_back(
+              {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
+      });
+    }
+  if (options.cross)
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = m + 1; k < n; ++k) {
+        reportProgress(options.progress, 50, "Intersections between meshes");
+        if (!overlap(soups[m].bounds, soups[k].bounds)) continue;
+        // One mesh after the other, each on every thread: side by side, the
+        // smaller one's thread idled while the larger one's did most of the work.
+        const Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
+                                    facesTouching(soups[k], soups[m].bounds)};
+        // A tree over the smaller set of candidates, queried by the other's.
+        const bool swap = near[0].faces.size() > near[1].faces.size();
+        const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];
+        const std::uint32_t small = std::uint32_t(swap ? k : m),
+                            large = std::uint32_t(swap ? m : k);
+        if (sc.faces.empty()) continue;
+        const Soup &s = soups[small], &l = soups[large];
+        const auto treeStart = Clock::now();
+        // Many faces of a large mesh lie inside the smaller one's bounds but
+        // far from its faces: a coarse grid of those turns them away before
+        // a tree descent (for a small mesh, its set-up would cost more).
+        std::unique_ptr<BoxGrid> nearSmall;
+        if (lc.faces.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(sc.boxes);
+        // The candidates near a curve are faces of similar sizes: a hashed
+        // grid finds their overlaps in less time than a tree (about as many
+        // instructions, but no median selections, whose comparisons are as
+        // good as random, to build it). A tree where the sizes differ too
+        // much for a grid.
+        std::optional<HashedBoxGrid> grid;
+        std::optional<BoxTree> tree;
+        std::vector<PlaneSide> planes(sc.faces.size());
+        {
+          // The planes on a second thread while this one builds.
+          TaskAlongside planesAside([&] {
+            for (std::size_t i = 0; i < sc.faces.size(); ++i) {
+              const TrianglePoints t = s.at(sc.faces[i]);
+              planes[i] = PlaneSide(t[0], t[1], t[2]);
+            }
+          });
+          if (options.layout == 0) grid.emplace(sc.boxes);
+          if (!grid || !grid->suits(lc.boxes)) {
+            grid.reset();
+            tree.emplace(sc.boxes, options.layout == 1 ? BoxTree::Layout::kMorton
+                                                       : BoxTree::Layout::kMedianSplit);
+          }
+          planesAside.wait();
+        }
+        r.build_ms += msSince(treeStart);
+        // A query face costs about a microsecond (a descent and its
+        // candidates' tests): a second thread from a few hundred each.
+        parallelChunks(
+            lc.faces.size(),
+            [&](std::size_t begin, std::size_t end, unsigned worker) {
+              for (std::size_t i = begin; i < end; ++i) {
+                if (nearSmall && !nearSmall->touches(lc.boxes[i])) continue;
+                const std::uint32_t g = lc.faces[i];
+                const TrianglePoints tg = l.at(g);
+                PlaneSide planeOfG;  // made when a face first reaches g's plane
+                bool planeOfGMade = false;
+                auto candidate = [&](std::uint32_t j, unsigned w) {
+                  ++found[w].candidates;
+                  // side[0]: f's corners against g's plane; side[1]: g's against f's.
+                  PlaneSides side;
+                  for (int c = 0; c < 3; ++c) side[1][c] = planes[j](tg[c]);
+                  if (side[1][0] != 0 && side[1][1] == side[1][0] && side[1][2] == side[1][0])
+                    return;
+                  if (!planeOfGMade) {
+                    planeOfG = PlaneSide(tg[0], tg[1], tg[2]);
+                    planeOfGMade = true;
+                  }
+                  const std::uint32_t f = sc.faces[j];
+                  const TrianglePoints tf = s.at(f);
+                  for (int c = 0; c < 3; ++c) side[0][c] = planeOfG(tf[c]);
+                  if (!trianglesIntersect(tf, tg, side)) return;
+                  Found x{{{small, f}, {large, g}}, {}, true};
+                  const bool flip = x.pair.b < x.pair.a;
+                  if (flip) std::swap(x.pair.a, x.pair.b);
+                  for (int t = 0; t < 2; ++t)
+                    for (int c = 0; c < 3; ++c)
+                      x.side[t][c] = std::int8_t(side[flip ? 1 - t : t][c]);
+                  found[w].pairs.push_back(x);
+                };
+                if (grid)
+                  grid->query(lc.boxes[i], [&](std::uint32_t j) { candidate(j, worker); });
+                else
+                  tree->query(lc.boxes[i], worker, candidate);
+              }
+            },
+            256);
+      }
+  r.search_ms = msSince(searchStart);
+
+  std::vector<Found> all;
+  for (std::size_t w = 0; w < found.size(); ++w) {
+    all.insert(all.end(), found[w].pairs.begin(), found[w].pairs.end());
+    r.candidate_pairs += found[w].candidates;
+  }
+  std::sort(all.begin(), all.end(), [](const Found& x, const Found& y) {
+    return x.pair.a < y.pair.a || (x.pair.a == y.pair.a && x.pair.b < y.pair.b);
+  });
+  r.pairs.reserve(all.size());
+  for (const Found& x : all) r.pairs.push_back(x.pair);
+
+  r.self_pairs.assign(n, 0);
+  r.self_faces.assign(n, 0);
+  r.cross_faces.assign(n, 0);
+  r.face_involved.resize(n);
+  std::vector<std::vector<bool>> inSelf(n), inCross(n);
+  for (std::size_t m = 0; m < n; ++m) {
+    const std::size_t faces = soups[m].triangles.size();
+    r.face_involved[m].assign(faces, false);
+    inSelf[m].assign(faces, false);
+    inCross[m].assign(faces, false);
+    r.degenerate_faces.push_back(
+        std::size_t(std::count(soups[m].degenerate.begin(), soups[m].degenerate.end(), true)));
+  }
+  // Distinct faces are counted as they are first met (counting the bits
+  // afterwards walked every face of every mesh).
+  for (const IntersectingPair& p : r.pairs) {
+    const bool self = p.a.mesh == p.b.mesh;
+    auto& flags = self ? inSelf : inCross;
+    auto& distinct = self ? r.self_faces : r.cross_faces;
+    if (self)
+      ++r.self_pairs[p.a.mesh];
+    else
+      ++r.cross_pairs;
+    for (const FaceRef& f : {p.a, p.b}) {
+      if (!flags[f.mesh][f.face]) {
+        flags[f.mesh][f.face] = true;
+        ++distinct[f.mesh];
+      }
+      r.face_involved[f.mesh][f.face] = true;
+    }
+  }
+
+  if (options.contacts) {
+    reportProgress(options.progress, 80, "Intersection segments");
+    r.contacts.resize(all.size());
+    // A pair takes some ten thousand instructions (a few microseconds): a
+    // second thread, which takes tens of microseconds to start, pays for
+    // itself from a few dozen pairs each on.
+    parallelChunks(
+        all.size(),
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const Found& x = all[i];
+            const TrianglePoints a = soups[x.pair.a.mesh].at(x.pair.a.face);
+            const TrianglePoints b = soups[x.pair.b.mesh].at(x.pair.b.face);
+            if (!x.sidesKnown) {
+              r.contacts[i] = classifyContact(a, b);
+              continue;
+            }
+            PlaneSides side;
+            for (int t = 0; t < 2; ++t)
+              for (int c = 0; c < 3; ++c) side[t][c] = x.side[t][c];
+            r.contacts[i] = classifyContact(a, b, side);
+          }
+        },
+        48);
+  }
+  reportProgress(options.progress, 100, "Done");
+  r.time_ms = msSince(start);
+  return r;
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(const std::vector<Point3>& P,
+                                                                const std::vector<Triangle>& T,
+                                                                const std::vector<char>& changed,
+                                                                int widenSteps) {
+  std::vector<Box> changedBoxes;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (!changed[f]) continue;
+    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);  // float bounds
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < widenSteps; ++i) {
+        b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
+        b.hi[k] = std::nextafter(b.hi[k], INFINITY);
+      }
+    changedBoxes.push_back(b);
+  }
+  return pairsWithChangedBoxes(P, T, changed, changedBoxes);
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T, const std::vector<char>& changed,
+    const std::vector<Box>& changedBoxes) {
+  std::vector<int> changedIndex(T.size(), -1);
+  std::vector<std::uint32_t> changedFaces;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (changed[f]) {
+      changedIndex[f] = int(changedFaces.size());
+      changedFaces.push_back(std::uint32_t(f));
+    }
+  if (changedFaces.empty()) return {};
+  const BoxTree tree(changedBoxes);
+  const BoxGrid nearChanged(changedBoxes);
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  // Two changed faces: one traversal of the tree against itself (a descent
+  // per changed face cost twice as much).
+  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
+    const std::uint32_t f = changedFaces[i], g = changedFaces[j];
+    found[worker].push_back({std::min(f, g), std::max(f, g)});
+  });
+  // The others: those near a changed face descend the tree.
+  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t g = begin; g < end; ++g) {
+      if (changedIndex[g] >= 0) continue;
+      const Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
+      if (!nearChanged.touches(b)) continue;
+      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
+        found[worker].push_back({changedFaces[i], std::uint32_t(g)});
+      });
+    }
+  });
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (const auto& w : found) pairs.insert(pairs.end(), w.begin(), w.end());
+  return pairs;
+}
+
+namespace {
+
+// Exact and sufficient for "faces f and g meet at most in the corners they
+// share": in the projection dropping the axis of f's largest normal
+// component, the line through an edge of one face has the other face
+// strictly beyond it, but for shared corners on the line. Neighbours in a
+// smooth surface (most box-overlapping pairs of a mesh) are settled by these
+// 2-D tests, coplanar ones included.
+bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                           const TrianglePoints& b) {
+  const int axis = projectionAxis(a[0], a[1], a[2]);
+  for (int pass = 0; pass < 2; ++pass) {
+    const Triangle& t = pass == 0 ? ta : tb;
+    const TrianglePoints& p = pass == 0 ? a : b;
+    const Triangle& other = pass == 0 ? tb : ta;
+    const TrianglePoints& q = pass == 0 ? b : a;
+    if (orient2dDropping(p[0], p[1], p[2], axis) == 0) continue;
+    for (int e = 0; e < 3; ++e) {
+      const int u = e, w = (e + 1) % 3, o = (e + 2) % 3;
+      const int inside = orient2dDropping(p[u], p[w], p[o], axis);
+      bool separated = true;
+      for (int k = 0; k < 3 && separated; ++k) {
+        if (other[k] == t[u] || other[k] == t[w]) continue;
+        separated = orient2dDropping(p[u], p[w], q[k], axis) == -inside;
+      }
+      if (separated) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+namespace {
+
+// facesIntersect with the degeneracy of the two faces known (`knownFlat`:
+// -1 not known, 0 neither is degenerate); faces with the same three
+// vertices meet unless `sameVertices` is false.
+bool facesMeet(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+               const TrianglePoints& b, int knownFlat, bool sameVertices = true) {
+  // Apart along an axis (exact): most candidates of a widened box search.
+  for (int k = 0; k < 3; ++k)
+    if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
+        std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
+      return false;
+  if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
+  const SharedCorners c = sharedCorners(ta, tb);
+  if (c.count == 3 && !sameVertices) return false;
+  if (c.count < 3 && separatedInProjection(ta, a, tb, b)) return false;
+  return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+}
+
+// The same for faces f and g of a mesh.
+bool facesMeet(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+               std::uint32_t g, int knownFlat, bool sameVertices = true) {
+  const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]};
+  const TrianglePoints b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+  return facesMeet(T[f], a, T[g], b, knownFlat, sameVertices);
+}
+
+}  // namespace
+
+bool facesIntersect(const std::vector<Point3>& P, const std::vector<Triangle>& T, std::uint32_t f,
+                    std::uint32_t g) {
+  return facesMeet(P, T, f, g, -1);
+}
+
+bool facesIntersect(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
+                    const TrianglePoints& b) {
+  return facesMeet(ta, a, tb, b, -1);
+}
+
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs) {
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+  parallelChunks(
+      pairs.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (facesIntersect(P, T, pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
+      },
+      1024);
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+  return all;
+}
+
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T,
+    const std::vector<std::array<std::uint32_t, 2>>& pairs, const std::vector<char>& degenerate,
+    bool sameVertices) {
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+  parallelChunks(
+      pairs.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto [f, g] = pairs[i];
+          if (!degenerate[f] && !degenerate[g] && facesMeet(P, T, f, g, 0, sameVertices))
+            hits[worker].push_back(pairs[i]);
+        }
+      },
+      1024);
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+  return all;
+}
+
+SegmentSoup contactSegments(const FindIntersectionsResult& result) {
+  SegmentSoup soup;
+  std::map<std::array<double, 3>, int> index;
+  auto at = [&](const Point3& p) {
+    const auto [it, added] =
+        index.emplace(std::array<double, 3>{p[0], p[1], p[2]}, int(soup.points.size()));
+    if (added) soup.points.push_back(p);
+    return it->second;
+  };
+  std::set<std::array<int, 2>> seen;
+  auto add = [&](const Point3& p, const Point3& q) {
+    std::array<int, 2> e{at(p), at(q)};
+    if (e[0] == e[1]) return;
+    if (e[0] > e[1]) std::swap(e[0], e[1]);
+    if (seen.insert(e).second) soup.edges.push_back(e);
+  };
+  for (const TriangleContact& c : result.contacts) {
+    const std::size_t n = c.points.size();
+    if (n == 2) add(c.points[0].position, c.points[1].position);
+    if (n > 2)
+      for (std::size_t i = 0; i < n; ++i) add(c.points[i].position, c.points[(i + 1) % n].position);
+  }
+  return soup;
+}
+
+JsonObject toJson(const FindIntersectionsResult& r) {
+  std::size_t selfPairs = 0, selfFaces = 0, crossFaces = 0;
+  std::vector<double> perMeshPairs, perMeshFaces, perMeshCross, degenerate;
+  for (std::size_t m = 0; m < r.self_pairs.size(); ++m) {
+    selfPairs += r.self_pairs[m];
+    selfFaces += r.self_faces[m];
+    crossFaces += r.cross_faces[m];
+    perMeshPairs.push_back(double(r.self_pairs[m]));
+    perMeshFaces.push_back(double(r.self_faces[m]));
+    perMeshCross.push_back(double(r.cross_faces[m]));
+    degenerate.push_back(double(r.degenerate_faces[m]));
+  }
+  JsonObject j;
+  j.set("self_intersecting_pairs", selfPairs)
+      .set("self_intersecting_faces", selfFaces)
+      .set("cross_intersecting_pairs", r.cross_pairs)
+      .set("cross_intersecting_faces", crossFaces)
+      .set("self_intersecting_pairs_per_layer", perMeshPairs)
+      .set("self_intersecting_faces_per_layer", perMeshFaces)
+      .set("cross_intersecting_faces_per_layer", perMeshCross)
+      .set("degenerate_faces_skipped_per_layer", degenerate)
+      .set("candidate_pairs", r.candidate_pairs)
+      .set("build_ms", r.build_ms)
+      .set("search_ms", r.search_ms)
+      .set("time_ms", r.time_ms);
+  return j;
+}
+
+}  // namespace meshmend

@@ -1,0 +1,98 @@
+// Exact geometric predicates on double coordinates.
+//
+// Each predicate first evaluates in floating point with a static/semi-static
+// error bound (Shewchuk's bounds for the rounded determinant); only when the
+// bound cannot certify the sign does it fall back to exact rational arithmetic
+// (GMP). The sign returned is always the sign of the exact determinant of the
+// given doubles.
+#pragma once
+
+#include <cmath>
+
+#include "common/base/mesh.h"
+
+namespace meshmend {
+
+// Sign of the 2-D orientation determinant of (a, b, c): +1 when c lies to the
+// left of the directed line a->b (counter-clockwise), -1 right, 0 collinear.
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
+
+// Sign of det[b-a, c-a, d-a]: +1 when d lies on the side of the plane through
+// a, b, c that the normal (b-a)x(c-a) points to, -1 on the other side, 0 when
+// the four points are coplanar.
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+
+// Exact: are the three points collinear (including coincident points)?
+bool collinear(const Point3& a, const Point3& b, const Point3& c);
+
+// Exact: the coordinate axis (0, 1, 2) to drop so that the projection of the
+// non-degenerate triangle (a, b, c) onto the other two axes is non-degenerate;
+// among the valid axes, the one along which its normal is largest. -1 when
+// the triangle is degenerate.
+int projectionAxis(const Point3& a, const Point3& b, const Point3& c);
+
+// orient2d of the projections of a, b, c onto the plane that drops `axis`
+// (coordinates (axis+1)%3, (axis+2)%3).
+inline int orient2dDropping(const Point3& a, const Point3& b, const Point3& c, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  return orient2d(a[u], a[v], b[u], b[v], c[u], c[v]);
+}
+
+// orient3d(a, b, c, p) for one triangle (a, b, c) against many points p: the
+// triangle's edge cross products are computed once. It evaluates the same
+// determinant with the same error bound (expanded along p's row), so its
+// sign is exact: the filter falls back to orient3d when it cannot decide.
+// PlaneFilter keeps only those products, for a caller that has the corners
+// at hand (a mesh's faces: a third of the memory); PlaneSide keeps the
+// corners too.
+class PlaneFilter {
+ public:
+  PlaneFilter() = default;
+  PlaneFilter(const Point3& a, const Point3& b, const Point3& c);
+  // orient3d(a, b, c, p) for the corners this filter was made from. Inline:
+  // the search between meshes asks it some ten times per candidate pair,
+  // and a call cost as much as the filter (orient3d only when it cannot
+  // decide).
+  int side(const Point3& a, const Point3& b, const Point3& c, const Point3& p) const {
+    const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
+    const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
+    const double permanent =
+        std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
+    const double bound = kOrient3dBound * permanent;
+    if (std::isfinite(det) && permanent > kUnderflowGuard) {
+      if (det > bound) return 1;
+      if (-det > bound) return -1;
+    }
+    return orient3d(a, b, c, p);
+  }
+
+  // Shewchuk's forward error bound for orient3d's rounded determinant, and
+  // the magnitude below which products may underflow and it no longer holds.
+  static constexpr double kEpsilon = 0x1p-53;
+  static constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+  static constexpr double kUnderflowGuard = 1e-250;
+
+ private:
+  double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded
+  double nAbs_[3] = {0, 0, 0};  // the matching sums of absolute products
+};
+
+class PlaneSide {
+ public:
+  PlaneSide() = default;
+  PlaneSide(const Point3& a, const Point3& b, const Point3& c)
+      : a_(a), b_(b), c_(c), filter_(a, b, c) {}
+  int operator()(const Point3& p) const { return filter_.side(a_, b_, c_, p); }
+
+ private:
+  Point3 a_, b_, c_;
+  PlaneFilter filter_;
+};
+
+namespace exact {
+// Pure-GMP evaluations, used as the fallback and as the reference in tests.
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+}  // namespace exact
+
+}  // namespace meshmend

@@ -1,0 +1,972 @@
+#include "common/repair/output_stage.h"
+#include "common/base/timing.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+#include "common/base/errors.h"
+#include "common/exact/intersections.h"
+#include "common/exact/predicates.h"
+#include "common/repair/split/detail.h"
+
+namespace meshmend {
+
+using namespace split_detail;
+
+namespace {
+
+// Rounding and the check work on the merged output: where the meshes meet
+// it holds each curve point once, so all meshes round it alike.
+void requireMergedOutput(const SplitResult& result, const char* operation) {
+  if (result.merged.fn == 0 && !result.meshes.empty())
+    throw InvalidInputError(std::string(operation) +
+                            " needs the merged output: split with SplitOptions::merged_output");
+}
+
+}  // namespace
+
+std::size_t degenerateNewFaces(const SplitResult& result) {
+  requireMergedOutput(result, "counting degenerate faces");
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < result.merged.face.size(); ++f) {
+    if (!result.merged_new_face[f]) continue;
+    const Face& face = result.merged.face[f];
+    n += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) || face.cV(2) == face.cV(0) ||
+         collinear(face.cP(0), face.cP(1), face.cP(2));
+  }
+  return n;
+}
+
+namespace {
+void separateFromMerged(SplitResult& r);
+}  // namespace
+
+std::size_t mendCollinearNewFaces(SplitResult& r) {
+  requireMergedOutput(r, "mending collinear faces");
+  Mesh& m = r.merged;
+  FaceOriginHandle origin = faceOrigins(m);
+  std::vector<Triangle> T = trianglesOf(m);
+  auto isFlat = [&](std::size_t f) {
+    const Triangle& t = T[f];
+    const Point3 &p0 = m.vert[t[0]].cP(), &p1 = m.vert[t[1]].cP(), &p2 = m.vert[t[2]].cP();
+    return r.merged_new_face[f] && t[0] != t[1] && t[1] != t[2] && t[2] != t[0] && p0 != p1 &&
+           p1 != p2 && p2 != p0 && collinear(p0, p1, p2);
+  };
+  // The faces along each side of a flat face, found in one pass (a pass per
+  // flat face would be quadratic where rounding leaves many). A flip below
+  // adds its two faces to the sides they take; entries it makes stale are
+  // told apart by the faces' current corners.
+  auto key = [](int u, int v) { return std::array<int, 2>{std::min(u, v), std::max(u, v)}; };
+  std::map<std::array<int, 2>, std::vector<int>> along;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (isFlat(f))
+      for (int i = 0; i < 3; ++i) along[key(T[f][i], T[f][(i + 1) % 3])];
+  if (along.empty()) return 0;
+  auto link = [&](int h) {
+    for (int i = 0; i < 3; ++i) {
+      const auto side = along.find(key(T[h][i], T[h][(i + 1) % 3]));
+      if (side != along.end() &&
+          std::find(side->second.begin(), side->second.end(), h) == side->second.end())
+        side->second.push_back(h);
+    }
+  };
+  for (std::size_t h = 0; h < T.size(); ++h) link(int(h));
+  std::set<std::array<int, 2>> curves;
+  for (const auto& e : r.merged_curve_edges) curves.insert(key(e[0], e[1]));
+  std::size_t mended = 0;
+  std::vector<char> removed(T.size(), 0);
+  std::vector<int> near;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    if (!isFlat(f)) continue;
+    const Triangle t = T[f];
+    // The corner strictly between the other two: the one opposite the
+    // longest side (distinct collinear points; compared along an axis on
+    // which they differ, exactly).
+    int k = 0;
+    const Point3 &p0 = m.vert[t[0]].cP(), &p1 = m.vert[t[1]].cP();
+    const int axis = p0[0] != p1[0] ? 0 : p0[1] != p1[1] ? 1 : 2;
+    for (int i = 0; i < 3; ++i) {
+      const double x = m.vert[t[i]].cP()[axis], y = m.vert[t[(i + 1) % 3]].cP()[axis],
+                   z = m.vert[t[(i + 2) % 3]].cP()[axis];
+      if ((y < x && x < z) || (z < x && x < y)) k = i;
+    }
+    const int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+    // Per side of the flat face, the other faces along it running the same
+    // way and the other way (a closed surface has as many of each, curves
+    // included); g: the face running c to b beyond the long side.
+    int g = -1, d = -1, same[3] = {0, 0, 0}, reverse[3] = {0, 0, 0};
+    const int side[3][2] = {{a, b}, {b, c}, {c, a}};
+    near.clear();
+    for (const auto& s : side) {
+      const std::vector<int>& faces = along.at(key(s[0], s[1]));
+      near.insert(near.end(), faces.begin(), faces.end());
+    }
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    for (int h : near) {
+      if (h == int(f) || removed[h]) continue;
+      for (int i = 0; i < 3; ++i) {
+        const int u = T[h][i], v = T[h][(i + 1) % 3];
+        for (int e = 0; e < 3; ++e) {
+          same[e] += u == side[e][0] && v == side[e][1];
+          reverse[e] += u == side[e][1] && v == side[e][0];
+        }
+        if (u == c && v == b) g = h, d = T[h][(i + 2) % 3];
+      }
+    }
+    const int others = same[1] + reverse[1];
+    // Nothing beyond the long side: the flat face only fills a gap of no
+    // area between faces that already meet along the short sides (a split
+    // there put a on that side). It goes where that leaves its sides
+    // closer to closed.
+    if (others == 0) {
+      int before = 0, after = 0;
+      for (int e = 0; e < 3; ++e) {
+        before += std::abs(1 + same[e] - reverse[e]);
+        after += std::abs(same[e] - reverse[e]);
+      }
+      if (after < before) {
+        removed[f] = 1;
+        ++mended;
+      }
+      continue;
+    }
+    if (others != 1 || g < 0 || d == a) continue;
+    const Point3& pd = m.vert[d].cP();
+    if (collinear(m.vert[a].cP(), m.vert[b].cP(), pd) ||
+        collinear(m.vert[a].cP(), pd, m.vert[c].cP()))
+      continue;
+    T[f] = {a, b, d};
+    T[g] = {a, d, c};
+    for (int i = 0; i < 3; ++i) {
+      m.face[f].V(i) = &m.vert[T[f][i]];
+      m.face[g].V(i) = &m.vert[T[g][i]];
+    }
+    origin[f] = origin[g];
+    r.merged_new_face[g] = 1;
+    if (!r.merged_snapped_face.empty()) r.merged_snapped_face[f] = r.merged_snapped_face[g];
+    if (curves.erase(key(b, c)))  // the curve now runs through a
+      curves.insert(key(a, b)), curves.insert(key(a, c));
+    link(int(f));
+    link(g);
+    ++mended;
+  }
+  if (std::find(removed.begin(), removed.end(), 1) != removed.end()) {
+    std::size_t kept = 0;
+    for (std::size_t f = 0; f < T.size(); ++f) {
+      if (removed[f]) {
+        vcg::tri::Allocator<Mesh>::DeleteFace(m, m.face[f]);
+        continue;
+      }
+      r.merged_new_face[kept] = r.merged_new_face[f];
+      if (!r.merged_snapped_face.empty()) r.merged_snapped_face[kept] = r.merged_snapped_face[f];
+      ++kept;
+    }
+    vcg::tri::Allocator<Mesh>::CompactFaceVector(m);  // in order; attributes follow
+    r.merged_new_face.resize(kept);
+    if (!r.merged_snapped_face.empty()) r.merged_snapped_face.resize(kept);
+    r.collapsed_faces_removed += T.size() - kept;
+  }
+  if (mended) {
+    r.merged_curve_edges.assign(curves.begin(), curves.end());
+    if (!r.meshes.empty() && r.coincident_faces_removed == 0) separateFromMerged(r);
+  }
+  return mended;
+}
+
+namespace {
+
+// The stored values of `scalar` around x: the largest at most x and the
+// smallest at least x (the same when x is stored exactly, always so for a
+// double), and the neighbour of a stored value towards +-infinity.
+double storedBelow(double x, Scalar scalar) {
+  if (scalar == Scalar::kDouble) return x;
+  const float f = float(x);
+  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+double storedAbove(double x, Scalar scalar) {
+  if (scalar == Scalar::kDouble) return x;
+  const float f = float(x);
+  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+double storedNext(double v, double towards, Scalar scalar) {
+  return scalar == Scalar::kDouble ? std::nextafter(v, towards)
+                                   : double(std::nextafter(float(v), float(towards)));
+}
+
+// How many stored values away from its unrounded value roundForHost may put
+// a coordinate of a new vertex (the nearest below or above is one away).
+// The choices grow as its cube; what two values each way cannot keep apart
+// is for snapping and splitStoredAgain.
+constexpr int kFarthestRounding = 2;
+
+constexpr std::size_t kNoLimit = std::numeric_limits<std::size_t>::max();
+
+// The values a coordinate x may take at `reach`, nearest first: those
+// below and above x (one each at reach 1, then the next out), and x itself
+// when it is a stored value.
+std::vector<double> roundingChoices(double x, int reach, Scalar scalar) {
+  double lo = storedBelow(x, scalar), hi = storedAbove(x, scalar);
+  std::vector<double> out;
+  if (lo == hi) {
+    out.push_back(x);
+  } else {
+    out.push_back(lo);
+    out.push_back(hi);
+    --reach;
+  }
+  for (int j = 0; j < reach; ++j) {
+    lo = storedNext(lo, -INFINITY, scalar);
+    hi = storedNext(hi, INFINITY, scalar);
+    if (std::isfinite(lo)) out.push_back(lo);
+    if (std::isfinite(hi)) out.push_back(hi);
+  }
+  return out;
+}
+
+// The faces around each vertex (compressed rows) and, per changed face, its
+// candidate pairs both ways.
+struct Rows {
+  std::vector<std::uint32_t> offsets, items;
+  std::pair<const std::uint32_t*, const std::uint32_t*> row(std::size_t i) const {
+    return {items.data() + offsets[i], items.data() + offsets[i + 1]};
+  }
+};
+
+// Step 1 on arrays: `reference` (the unrounded positions: input vertices
+// exactly, curve points within their error), `newFace` and `movable`
+// (vertices that may be re-rounded: the new ones) given; `P` receives the
+// stored positions. Returns the crossing pairs left.
+class Rounder {
+ public:
+  Rounder(const std::vector<Point3>& reference, const std::vector<Triangle>& T,
+          const std::vector<char>& newFace, const std::vector<char>& movable, Scalar scalar,
+          std::vector<Point3>& P)
+      : ref_(reference), T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
+    P_ = reference;
+    for (Point3& p : P_) p = storedAs(p, scalar);
+  }
+
+  // Re-rounds while defects are left, at most `passes` passes per reach and
+  // `budget` exact pair tests in all (bounded: the budget stopped it).
+  // Gives up at once, leaving the nearest rounding, where that has more
+  // than `giveUpAbove` defects.
+  std::size_t run(int passes, std::size_t budget, std::size_t giveUpAbove, const Progress& progress,
+                  std::size_t& rerounded, bool& bounded) {
+    if (!findChanged()) return 0;
+    findCandidates();
+    crossing_ = intersectingOf(P_, T_, pairs_, degenerate_, false);
+    budget_ = budget;
+    if (crossing_.size() > giveUpAbove) return crossing_.size();
+    if (crossing_.empty() && collapsedFaces().empty()) return 0;
+    buildRows();                            // only re-rounding needs them
+    std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
+    const std::vector<Point3> nearest = P_;
+    // Each coordinate goes to one of the `reach` values below its unrounded
+    // value or the `reach` above. One each way first (the two nearest);
+    // where faces meet at a very small angle, neither may keep them apart,
+    // and the next value out may.
+    int reach = 1, passesAtReach = 0;
+    std::size_t before = std::numeric_limits<std::size_t>::max();  // defects before the last pass
+    for (int pass = 0;; ++pass) {
+      if (pass > 0) recheck(moved);
+      const std::vector<std::uint32_t> flat = collapsedFaces();
+      const std::size_t defects = crossing_.size() + flat.size();
+      if (defects == 0 || tests_ >= budget_) break;
+      if (passesAtReach == passes || defects >= before) {  // this reach has done what it can
+        if (reach == kFarthestRounding) break;
+        ++reach;
+        passesAtReach = 0;
+      }
+      before = defects;
+      ++passesAtReach;
+      reportProgress(progress, 96, "Rounding again where faces cross");
+      std::set<int> candidates;
+      auto addCorners = [&](std::uint32_t f) {
+        for (int v : T_[f])
+          if (movable_[v]) candidates.insert(v);
+      };
+      for (const auto& p : crossing_)
+        for (std::uint32_t f : p) addCorners(f);
+      for (std::uint32_t f : flat) addCorners(f);
+      for (int v : candidates) moved[v] = reround(v, reach);
+    }
+    bounded = tests_ >= budget_ && !crossing_.empty();
+    rerounded = 0;
+    for (std::size_t v = 0; v < P_.size(); ++v) rerounded += P_[v] != nearest[v];
+    return crossing_.size();
+  }
+
+ private:
+  // Faces that are new or that rounding moved: only those can cross
+  // anything they did not cross before (every other face is an input face,
+  // exactly as it was).
+  bool findChanged() {
+    std::vector<char> moved(P_.size(), 0);
+    if (scalar_ != Scalar::kDouble)
+      for (std::size_t v = 0; v < P_.size(); ++v) moved[v] = P_[v] != ref_[v];
+    isChanged_.assign(T_.size(), 0);
+    for (std::size_t f = 0; f < T_.size(); ++f) {
+      const Triangle& t = T_[f];
+      isChanged_[f] =
+          (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
+      if (isChanged_[f]) changed_.push_back(std::uint32_t(f));
+    }
+    return !changed_.empty();
+  }
+
+  // Candidates: boxes widened by more steps than re-rounding moves a vertex
+  // (at most kFarthestRounding from its unrounded position; the boxes are
+  // float, so a float step covers double steps too).
+  void findCandidates() {
+    pairs_ = pairsWithChangedFaces(P_, T_, isChanged_, kFarthestRounding + 2);
+    // Whether each face of a pair is degenerate as stored, tested once.
+    degenerate_.assign(T_.size(), 0);
+    std::vector<char>& inPair = degenerate_;  // marks first, then the answer
+    for (const auto& [f, g] : pairs_) inPair[f] = inPair[g] = 1;
+    for (std::uint32_t f : changed_) inPair[f] = 1;
+    for (std::size_t f = 0; f < T_.size(); ++f)
+      if (inPair[f]) degenerate_[f] = isFlat(std::uint32_t(f));
+  }
+
+  // Per changed face, its candidates both ways, and per vertex the changed
+  // faces around it (compressed rows).
+  void buildRows() {
+    changedIndex_.assign(T_.size(), -1);
+    for (std::size_t i = 0; i < changed_.size(); ++i) changedIndex_[changed_[i]] = int(i);
+    // Faces with the same three vertices (a planar overlap kept in each
+    // part) coincide however their vertices are rounded: never a crossing.
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                [&](const auto& p) { return sameVertices(T_[p[0]], T_[p[1]]); }),
+                 pairs_.end());
+    others_.offsets.assign(changed_.size() + 1, 0);
+    for (const auto& [f, g] : pairs_) {
+      ++others_.offsets[changedIndex_[f] + 1];
+      if (changedIndex_[g] >= 0) ++others_.offsets[changedIndex_[g] + 1];
+    }
+    for (std::size_t i = 0; i < changed_.size(); ++i) others_.offsets[i + 1] += others_.offsets[i];
+    others_.items.resize(others_.offsets.back());
+    {
+      std::vector<std::uint32_t> next(others_.offsets.begin(), others_.offsets.end() - 1);
+      for (const auto& [f, g] : pairs_) {
+        others_.items[next[changedIndex_[f]]++] = g;
+        if (changedIndex_[g] >= 0) others_.items[next[changedIndex_[g]]++] = f;
+      }
+    }
+    around_.offsets.assign(P_.size() + 1, 0);
+    for (std::uint32_t f : changed_)
+      for (int v : T_[f]) ++around_.offsets[v + 1];
+    for (std::size_t v = 0; v < P_.size(); ++v) around_.offsets[v + 1] += around_.offsets[v];
+    around_.items.resize(around_.offsets.back());
+    std::vector<std::uint32_t> next(around_.offsets.begin(), around_.offsets.end() - 1);
+    for (std::uint32_t f : changed_)
+      for (int v : T_[f]) around_.items[next[v]++] = f;
+  }
+
+  bool isFlat(std::uint32_t f) const {
+    const Triangle& t = T_[f];
+    return collinear(P_[t[0]], P_[t[1]], P_[t[2]]);
+  }
+
+  // Only pairs with a face at a vertex that moved can have changed: the
+  // others keep what the last check found.
+  void recheck(std::vector<char>& moved) {
+    auto touches = [&](std::uint32_t f) {
+      return moved[T_[f][0]] | moved[T_[f][1]] | moved[T_[f][2]];
+    };
+    std::vector<std::array<std::uint32_t, 2>> again, still;
+    for (const auto& p : pairs_)
+      if (touches(p[0]) || touches(p[1])) again.push_back(p);
+    for (const auto& p : crossing_)
+      if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
+    for (std::size_t v = 0; v < moved.size(); ++v)
+      if (moved[v])
+        for (auto [f, end] = around_.row(v); f != end; ++f) degenerate_[*f] = isFlat(*f);
+    crossing_ = intersectingOf(P_, T_, again, degenerate_, false);
+    crossing_.insert(crossing_.end(), still.begin(), still.end());
+    std::fill(moved.begin(), moved.end(), 0);
+  }
+
+  // A changed face whose corners rounding made collinear is worse than a
+  // crossing: it has no normal, a checker takes it for a hole in the
+  // surface, and a crossing elsewhere is still split again. New faces are
+  // never collinear exactly; an input face only when it was already.
+  bool collapsed(std::uint32_t f) const {
+    const Triangle& t = T_[f];
+    return isFlat(f) &&
+           ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]]));
+  }
+  // The same from the degeneracy kept per face (degenerate_).
+  std::vector<std::uint32_t> collapsedFaces() const {
+    std::vector<std::uint32_t> flat;
+    for (std::uint32_t f : changed_) {
+      const Triangle& t = T_[f];
+      if (degenerate_[f] &&
+          ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]])))
+        flat.push_back(f);
+    }
+    return flat;
+  }
+
+  // How many crossings (and collapsed faces, as two each) the changed faces
+  // around v take part in, counted up to `enough` (a position is only worth
+  // knowing while it beats the best).
+  std::size_t localCrossings(int v, std::size_t enough) {
+    std::size_t n = 0;
+    for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
+      if ((n += 2 * collapsed(*f)) >= enough) return n;
+      for (auto [g, last] = others_.row(std::size_t(changedIndex_[*f])); g != last; ++g) {
+        ++tests_;
+        if ((n += facesIntersect(P_, T_, *f, *g)) >= enough) return n;
+      }
+    }
+    return n;
+  }
+
+  // Moves new vertex v to the rounding choice under which the faces around
+  // it take part in the fewest crossings, trying the choices nearest its
+  // unrounded position first; true when it moved.
+  bool reround(int v, int reach) {
+    const Point3 start = P_[v];
+    std::array<std::vector<double>, 3> choices;
+    for (int k = 0; k < 3; ++k) choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
+    std::vector<std::array<std::uint8_t, 3>> order;
+    for (std::size_t i = 0; i < choices[0].size(); ++i)
+      for (std::size_t j = 0; j < choices[1].size(); ++j)
+        for (std::size_t k = 0; k < choices[2].size(); ++k)
+          order.push_back({std::uint8_t(i), std::uint8_t(j), std::uint8_t(k)});
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+      return a[0] + a[1] + a[2] < b[0] + b[1] + b[2];
+    });
+    Point3 best = start;
+    std::size_t bestCount = localCrossings(v, std::numeric_limits<std::size_t>::max());
+    for (const auto& [i, j, k] : order) {
+      if (bestCount == 0 || tests_ >= budget_) break;
+      P_[v] = Point3(choices[0][i], choices[1][j], choices[2][k]);
+      if (P_[v] == start) continue;
+      const std::size_t count = localCrossings(v, bestCount);
+      if (count < bestCount) best = P_[v], bestCount = count;
+    }
+    P_[v] = best;
+    return best != start;
+  }
+
+  const std::vector<Point3>& ref_;
+  const std::vector<Triangle>& T_;
+  const std::vector<char>& newFace_;
+  const std::vector<char>& movable_;
+  const Scalar scalar_;
+  std::vector<Point3>& P_;
+  std::vector<char> isChanged_, degenerate_;
+  std::vector<int> changedIndex_;
+  std::vector<std::uint32_t> changed_;
+  std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
+  Rows others_, around_;
+  std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
+
+ public:
+  std::size_t tests() const { return tests_; }
+};
+
+}  // namespace
+
+std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, StoredOutput* out,
+                         std::size_t giveUpAbove) {
+  requireMergedOutput(r, "rounding for the host");
+  Mesh& merged = r.merged;
+  if (merged.fn == 0) return 0;
+  const std::vector<Point3> reference = positionsOf(merged);
+  const std::vector<Triangle> T = trianglesOf(merged);
+  VertexOriginHandle vo = vertexOrigins(merged);
+  std::vector<char> movable(reference.size(), 0);  // new vertices: inputs stay as they are
+  for (std::size_t v = 0; v < reference.size(); ++v) movable[v] = vo[v].vertex < 0;
+  std::vector<Point3> P;
+  std::size_t moved = 0;
+  bool bounded = false;
+  const std::size_t used = out ? out->rounding_tests : 0;
+  Rounder rounder(reference, T, r.merged_new_face, movable, stage.scalar, P);
+  const std::size_t remaining = rounder.run(
+      stage.rounding_passes, stage.max_rounding_tests > used ? stage.max_rounding_tests - used : 0,
+      giveUpAbove, stage.progress, moved, bounded);
+  if (out) {
+    out->vertices_rerounded += moved;
+    out->bounded |= bounded;
+    out->rounding_tests += rounder.tests();
+  }
+  // The stored positions, to the merged output and to each mesh.
+  for (std::size_t v = 0; v < P.size(); ++v) merged.vert[v].P() = P[v];
+  for (std::size_t m = 0; m < r.meshes.size(); ++m)
+    for (std::size_t v = 0; v < r.merged_vertex[m].size(); ++v)
+      r.meshes[m].vert[v].P() = P[r.merged_vertex[m][v]];
+  return remaining;
+}
+
+StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+                            const std::vector<char>& movable, const std::vector<char>& changed,
+                            const OutputStageOptions& stage) {
+  const auto start = std::chrono::steady_clock::now();
+  StoredOutput out;
+  out.scalar = stage.scalar;
+  const std::vector<Point3> reference = points;
+  Rounder rounder(reference, triangles, changed, movable, stage.scalar, points);
+  out.crossing = rounder.run(stage.rounding_passes, stage.max_rounding_tests, kNoLimit,
+                             stage.progress, out.vertices_rerounded, out.bounded);
+  out.rounding_tests = rounder.tests();
+  for (std::size_t f = 0; f < triangles.size() && f < changed.size(); ++f) {
+    const Triangle& t = triangles[f];
+    out.degenerate_new_faces += changed[f] && collinear(points[t[0]], points[t[1]], points[t[2]]);
+  }
+  out.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::size_t crossingsLeft(const SplitResult& result, Scalar scalar) {
+  requireMergedOutput(result, "counting the crossings left");
+  return result.merged.fn == 0 ? 0 : selfIntersectingPairs(result.merged, scalar, false);
+}
+
+std::size_t storedIntersectingPairs(const Mesh& mesh, Scalar scalar) {
+  return mesh.fn == 0 ? 0 : selfIntersectingPairs(mesh, scalar, true);
+}
+
+namespace {
+
+// Pairs of non-degenerate faces of `mesh` with the same three vertices.
+// Faces are bucketed by their smallest vertex (a counting sort: linear in
+// the faces), and only faces in a group of equal ones are tested for
+// degeneracy.
+std::size_t sameVertexPairs(const Mesh& mesh) {
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  std::vector<std::uint32_t> start(mesh.vert.size() + 1, 0);
+  auto sorted = [&](std::size_t f) {
+    Triangle t = T[f];
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  for (const Triangle& t : T) ++start[*std::min_element(t.begin(), t.end()) + 1];
+  for (std::size_t v = 0; v < mesh.vert.size(); ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> byVertex(T.size());
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < T.size(); ++f)
+      byVertex[next[*std::min_element(T[f].begin(), T[f].end())]++] = std::uint32_t(f);
+  }
+  std::size_t pairs = 0;
+  std::vector<std::pair<Triangle, std::uint32_t>> bucket;
+  for (std::size_t v = 0; v < mesh.vert.size(); ++v) {
+    if (start[v + 1] - start[v] < 2) continue;
+    bucket.clear();
+    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k)
+      bucket.push_back({sorted(byVertex[k]), byVertex[k]});
+    std::sort(bucket.begin(), bucket.end());
+    for (std::size_t i = 0, j; i < bucket.size(); i = j) {
+      std::size_t flat = 0;
+      for (j = i + 1; j < bucket.size() && bucket[j].first == bucket[i].first;) ++j;
+      if (j - i < 2) continue;
+      for (std::size_t k = i; k < j; ++k) {
+        const Face& f = mesh.face[bucket[k].second];
+        flat += collinear(f.cP(0), f.cP(1), f.cP(2));
+      }
+      const std::size_t n = j - i - flat;
+      pairs += n * (n - 1) / 2;
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+std::size_t storedIntersectingPairs(const SplitResult& r, const StoredOutput& stored,
+                                    bool separate) {
+  const bool complete = r.complete || stored.rounds_split_again > 0;
+  if (!separate) {
+    if (!complete || r.merged.fn == 0) return storedIntersectingPairs(r.merged, stored.scalar);
+    return stored.crossing + sameVertexPairs(r.merged);
+  }
+  std::size_t n = 0;
+  for (const Mesh& m : r.meshes)
+    n += complete && stored.crossing == 0 ? sameVertexPairs(m)
+                                          : storedIntersectingPairs(m, stored.scalar);
+  return n;
+}
+
+std::size_t storedIntersectingPairs(MeshArrays mesh, Scalar scalar) {
+  if (mesh.triangles.empty()) return 0;
+  for (Point3& p : mesh.points) p = storedAs(p, scalar);
+  FindIntersectionsOptions o;
+  o.cross = false;
+  o.same_vertices = true;
+  return findIntersectionsInArrays({&mesh}, o).self_pairs[0];
+}
+
+namespace {
+
+// The curve edge a-b of a merged output split again, in the new output:
+// the edge itself, or the path the split put on it (the shortest through
+// vertices that split made and that lie on the segment, within a step or so
+// of `scalar`: they were rounded).
+void carryCurveEdge(int a, int b, const Mesh& mesh, Scalar scalar,
+                    const std::unordered_map<int, std::vector<int>>& changed,
+                    const std::vector<char>& isNew, std::vector<std::array<int, 2>>& curves) {
+  const auto around = changed.find(a);
+  if (around == changed.end() || changed.find(b) == changed.end() ||
+      std::find(around->second.begin(), around->second.end(), b) != around->second.end()) {
+    curves.push_back({std::min(a, b), std::max(a, b)});  // untouched, or still an edge
+    return;
+  }
+  const Point3 &pa = mesh.vert[a].cP(), &pb = mesh.vert[b].cP(), ab = pb - pa;
+  auto onSegment = [&](int v) {
+    const Point3 av = mesh.vert[v].cP() - pa;
+    const double t = (av * ab) / ab.SquaredNorm();
+    return t > 0 && t < 1 &&
+           (av - ab * t).Norm() <= 1e-5 * ab.Norm() + 4 * scalarStep(mesh.vert[v].cP(), scalar);
+  };
+  std::unordered_map<int, int> from{{a, -1}};
+  std::vector<int> layer{a};
+  for (int depth = 0; depth < 8 && !layer.empty() && !from.count(b); ++depth) {
+    std::vector<int> next;
+    for (int v : layer) {
+      const auto n = changed.find(v);
+      if (n == changed.end()) continue;
+      for (int w : n->second)
+        if ((w == b || (isNew[w] && onSegment(w))) && from.emplace(w, v).second) next.push_back(w);
+    }
+    layer = std::move(next);
+  }
+  if (!from.count(b)) return;  // gone (points merged by snapping)
+  for (int v = b; from.at(v) >= 0; v = from.at(v))
+    curves.push_back({std::min(v, from.at(v)), std::max(v, from.at(v))});
+}
+
+}  // namespace
+
+namespace {
+
+// Each input's own output again from the merged output (after
+// splitRoundedAgain changed it): its vertices in their order, each at its
+// merged vertex (of two that became one, the first is used by the faces),
+// then the new vertices its faces use; its faces as the merged output has them; its curve edges,
+// those of the merged output along its faces.
+void separateFromMerged(SplitResult& r) {
+  Mesh& merged = r.merged;
+  FaceOriginHandle mergedFace = faceOrigins(merged);
+  VertexOriginHandle mergedVertex = vertexOrigins(merged);
+  std::set<std::array<int, 2>> curves(r.merged_curve_edges.begin(), r.merged_curve_edges.end());
+  for (std::size_t m = 0; m < r.meshes.size(); ++m) {
+    VertexOriginHandle oldVertex = vertexOrigins(r.meshes[m]);
+    const std::vector<int>& globalOf = r.merged_vertex[m];
+    OutputArrays out;
+    std::vector<int> newGlobalOf;
+    std::unordered_map<int, int> localOf;                // merged vertex -> its vertex here
+    for (std::size_t u = 0; u < globalOf.size(); ++u) {  // each in its place, also two that met
+      const int g = globalOf[u];
+      if (g >= 0) localOf.emplace(g, int(u));  // the first of them takes the faces
+      out.positions.push_back(g >= 0 ? merged.vert[g].cP() : r.meshes[m].vert[u].cP());
+      out.vertex_origin.push_back(oldVertex[u]);
+      newGlobalOf.push_back(g);
+    }
+    std::set<std::array<int, 2>> meshCurves;
+    for (std::size_t f = 0; f < merged.face.size(); ++f) {
+      if (mergedFace[f].layer != int(m)) continue;
+      Triangle global, local;
+      for (int k = 0; k < 3; ++k) {
+        global[k] = int(vcg::tri::Index(merged, merged.face[f].cV(k)));
+        auto [it, added] = localOf.emplace(global[k], int(out.positions.size()));
+        if (added) {
+          out.positions.push_back(merged.vert[global[k]].cP());
+          out.vertex_origin.push_back(mergedVertex[global[k]]);
+          newGlobalOf.push_back(global[k]);
+        }
+        local[k] = it->second;
+      }
+      out.triangles.push_back(local);
+      out.face_origin.push_back(mergedFace[f]);
+      for (int k = 0; k < 3; ++k) {
+        const int a = global[k], b = global[(k + 1) % 3];
+        if (curves.count({std::min(a, b), std::max(a, b)}))
+          meshCurves.insert(
+              {std::min(local[k], local[(k + 1) % 3]), std::max(local[k], local[(k + 1) % 3])});
+      }
+    }
+    out.toMesh(r.meshes[m]);
+    r.merged_vertex[m] = std::move(newGlobalOf);
+    r.curve_edges[m].assign(meshCurves.begin(), meshCurves.end());
+  }
+}
+
+}  // namespace
+
+std::size_t splitStoredAgain(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                             const SplitOptions& split, const OutputStageOptions& stage,
+                             StoredOutput& out) {
+  requireMergedOutput(r, "splitting the stored output again");
+  const std::size_t splitBefore = r.pairs_split_after_rounding;
+  std::size_t left = out.crossing;  // as the rounding before left them
+  std::size_t fewest = left;        // the fewest crossings a round has left
+  for (int round = 0; round < stage.split_rounds && left > 0 && r.merged.fn > 0; ++round) {
+    // The next round splits at least the pairs left: past the bound, the
+    // stage stops here with them.
+    if (out.pairs_split_again + left > stage.max_pairs_split_again) {
+      out.bounded = true;
+      break;
+    }
+    reportProgress(stage.progress, 97, "Splitting the stored result where it crosses");
+    const auto start = std::chrono::steady_clock::now();
+    Mesh& old = r.merged;
+    SplitOptions again;
+    again.between_meshes = false;
+    again.self = true;
+    again.separate_meshes = false;
+    again.snap_host_steps = split.snap_host_steps;
+    again.host = stage.scalar;
+    again.overlaps_once = split.overlaps_once;
+    again.progress = progressWithin(stage.progress, 97, 97);
+    SplitResult next = splitAlongIntersections({&old}, again);
+    if (next.intersecting_pairs == 0) {
+      left = 0;
+      break;
+    }
+    ++out.rounds_split_again;
+    out.pairs_split_again += next.intersecting_pairs;
+    // Rounds may leave a few more crossings than the round before and still
+    // end at none; where surfaces nearly coincide over a region they can
+    // also run away, each round's new slivers crossing more (99, 12, 16,
+    // 36, 169, 1,547, ... pairs): a round that leaves more than twice the
+    // fewest so far is not taken, and the rounds end. Re-rounding removes
+    // some three crossings in four: a round that rounded to nearest leaves
+    // more than eight times the fewest is not re-rounded either.
+    const std::size_t stillCrossing =
+        roundForHost(next, stage, &out, round > 0 ? 8 * fewest : kNoLimit);
+    if (round > 0 && stillCrossing > 2 * fewest) break;
+    fewest = std::min(fewest, stillCrossing);
+    // Provenance through the old output to the inputs.
+    FaceOriginHandle oldFace = faceOrigins(old), newFace = faceOrigins(next.merged);
+    VertexOriginHandle oldVertex = vertexOrigins(old), newVertex = vertexOrigins(next.merged);
+    std::vector<char> isNew(next.merged.vert.size(), 0);
+    for (std::size_t v = 0; v < next.merged.vert.size(); ++v) {
+      const VertexOrigin o = newVertex[v];
+      if (o.vertex >= 0) {
+        newVertex[v] = oldVertex[o.vertex];
+        continue;
+      }
+      isNew[v] = 1;
+      const FaceOrigin birth = oldFace[o.face];
+      VertexOrigin carried{birth.layer, -1, birth.face, Point3(1, 0, 0)};
+      if (birth.layer >= 0 && std::size_t(birth.layer) < inputs.size() && birth.face >= 0 &&
+          std::size_t(birth.face) < inputs[birth.layer]->face.size()) {
+        const Face& f = inputs[birth.layer]->face[birth.face];
+        carried.barycentric = barycentric(next.merged.vert[v].cP(), f.cP(0), f.cP(1), f.cP(2));
+      }
+      newVertex[v] = carried;
+    }
+    std::vector<char> newFaces(next.merged.face.size()), snapped;
+    const bool anySnapped = !r.merged_snapped_face.empty() || !next.merged_snapped_face.empty();
+    if (anySnapped) snapped.resize(next.merged.face.size());
+    for (std::size_t f = 0; f < next.merged.face.size(); ++f) {
+      const int before = newFace[f].face;
+      newFaces[f] = next.merged_new_face[f] || r.merged_new_face[before];
+      if (anySnapped)
+        snapped[f] = (!r.merged_snapped_face.empty() && r.merged_snapped_face[before]) ||
+                     (!next.merged_snapped_face.empty() && next.merged_snapped_face[f]);
+      newFace[f] = oldFace[before];
+    }
+    // The curves: the old ones where they went, and the new ones.
+    const std::vector<int>& moved = next.merged_vertex[0];  // old vertex -> new
+    // Around each vertex of a new face, its neighbours (over every face).
+    std::unordered_map<int, std::vector<int>> changed;
+    auto corner = [&](const Face& face, int i) {
+      return int(vcg::tri::Index(next.merged, face.cV(i)));
+    };
+    for (std::size_t f = 0; f < next.merged.face.size(); ++f)
+      if (next.merged_new_face[f])
+        for (int i = 0; i < 3; ++i) changed[corner(next.merged.face[f], i)];
+    for (const Face& face : next.merged.face)
+      for (int i = 0; i < 3; ++i) {
+        const int a = corner(face, i), b = corner(face, (i + 1) % 3);
+        if (const auto n = changed.find(a); n != changed.end()) n->second.push_back(b);
+        if (const auto n = changed.find(b); n != changed.end()) n->second.push_back(a);
+      }
+    std::vector<std::array<int, 2>> curves = next.merged_curve_edges;
+    for (const auto& e : r.merged_curve_edges)
+      carryCurveEdge(moved[e[0]], moved[e[1]], next.merged, stage.scalar, changed, isNew, curves);
+    // Only edges of the mesh (a face that collapsed takes its edges along).
+    curves.erase(std::remove_if(curves.begin(), curves.end(),
+                                [&](const std::array<int, 2>& e) {
+                                  const auto a = changed.find(e[0]);
+                                  return a != changed.end() &&
+                                         std::find(a->second.begin(), a->second.end(), e[1]) ==
+                                             a->second.end();
+                                }),
+                 curves.end());
+    sortUnique(curves, next.merged.vert.size());
+    for (std::vector<int>& global : r.merged_vertex)
+      for (int& g : global) g = moved[g];
+    r.merged_curve_edges = std::move(curves);
+    r.merged_new_face = std::move(newFaces);
+    r.merged_snapped_face = std::move(snapped);
+    r.faces_added += next.merged.face.size() - old.face.size();
+    r.new_vertices += next.new_vertices;
+    r.vertices_snapped += next.vertices_snapped;
+    r.edges_snapped += next.edges_snapped;
+    r.new_faces_below_1deg += next.new_faces_below_1deg;
+    r.smallest_new_angle_deg = std::min(r.smallest_new_angle_deg, next.smallest_new_angle_deg);
+    r.pairs_split_after_rounding += next.intersecting_pairs;
+    r.collapsed_faces_removed += next.collapsed_faces_removed;
+    r.merged = next.merged;
+    r.curve_edges_welded = r.merged_curve_edges.size();
+    countCurves(r.merged.vert.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
+    r.time_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    left = stillCrossing;
+  }
+  // (Where planar overlaps were kept once, the merged output no longer
+  // holds each input whole: the separate outputs stay as they were.)
+  if (r.pairs_split_after_rounding > splitBefore && !r.meshes.empty() &&
+      r.coincident_faces_removed == 0)
+    separateFromMerged(r);
+  return left;
+}
+
+namespace {
+
+// Defects of a stored result: crossings (as counted) and collapsed new faces.
+std::size_t defectsOf(const SplitResult& r, std::size_t crossing) {
+  return crossing + degenerateNewFaces(r);
+}
+
+// Steps 3 and 4 on `r` as rounded (crossing: what the rounding left).
+void splitAgainAndMend(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                       const SplitOptions& split, const OutputStageOptions& stage,
+                       StoredOutput& out) {
+  if (out.crossing > 0) out.crossing = splitStoredAgain(r, inputs, split, stage, out);
+  if (degenerateNewFaces(r) > 0) {
+    reportProgress(stage.progress, 98, "Mending flat faces");
+    out.collinear_faces_mended += mendCollinearNewFaces(r);
+  }
+}
+
+// The split of `inputs` with `split`, through steps 1, 3 and 4: a
+// candidate for steps 2 and 5.
+SplitResult splitAndStore(const std::vector<const Mesh*>& inputs, const SplitOptions& split,
+                          const OutputStageOptions& stage, StoredOutput& out) {
+  SplitResult again = splitAlongIntersections(inputs, split);
+  out.crossing = roundForHost(again, stage, &out);
+  splitAgainAndMend(again, inputs, split, stage, out);
+  return again;
+}
+
+// Keeps `candidate` (and what the stage did to make it) in place of `r`
+// when it leaves fewer defects.
+bool keepIfBetter(SplitResult& r, StoredOutput& out, SplitResult& candidate,
+                  const StoredOutput& made) {
+  if (defectsOf(candidate, made.crossing) >= defectsOf(r, out.crossing)) {
+    out.rounding_tests = made.rounding_tests;  // the work was done all the same
+    out.bounded |= made.bounded;
+    return false;
+  }
+  candidate.time_ms += r.time_ms;
+  r = std::move(candidate);
+  const StoredOutput before = out;
+  out = made;
+  out.snapped_for_host = true;
+  out.quality_snapped_for_host = before.quality_snapped_for_host || made.quality_snapped_for_host;
+  return true;
+}
+
+}  // namespace
+
+StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                          const SplitOptions& options, const OutputStageOptions& stage) {
+  requireMergedOutput(r, "storing for the host");
+  const auto start = std::chrono::steady_clock::now();
+  StoredOutput out;
+  out.scalar = stage.scalar;
+  reportProgress(
+      stage.progress, 95,
+      stage.scalar == Scalar::kFloat ? "Rounding to float" : "Checking the double result");
+  out.crossing = roundForHost(r, stage, &out);
+  SplitOptions used = options;
+  used.host = stage.scalar;
+  // Step 2: where curve points lie a few steps from each other or from an
+  // edge, no rounding keeps every face apart (or whole): split again with
+  // such points merged as quality snapping merges them.
+  if (stage.resplit_with_snapping && options.snap_host_steps <= 0 &&
+      defectsOf(r, out.crossing) > 0) {
+    reportProgress(stage.progress, 96, "Splitting again, merging points a step apart");
+    SplitOptions second = used;
+    second.snap_host_steps = kHostSnapSteps;
+    second.progress = progressWithin(stage.progress, 96, 96);
+    StoredOutput made;
+    made.scalar = stage.scalar;
+    made.rounding_tests = out.rounding_tests;
+    SplitResult candidate = splitAlongIntersections(inputs, second);
+    made.crossing = roundForHost(candidate, stage, &made);
+    if (keepIfBetter(r, out, candidate, made)) used = second;
+  }
+  // Steps 3 and 4: what is left crosses as stored; split again along those
+  // crossings on the stored values, rounded again; flat faces mended.
+  splitAgainAndMend(r, inputs, used, stage, out);
+  // Step 5: where surfaces nearly coincide over a region (a part and a copy
+  // a few steps away), curve points crowd within steps of each other
+  // everywhere and neither of the above keeps the stored result apart:
+  // quality snapping removes the slivers that hold them. Tried only when
+  // none was asked for; kept if it leaves fewer defects.
+  if (stage.resplit_with_snapping && options.snap_tolerance <= 0 &&
+      defectsOf(r, out.crossing) > 0) {
+    reportProgress(stage.progress, 98, "Splitting again with quality snapping");
+    SplitOptions snapping = used;
+    snapping.snap_tolerance = kQualitySnapTolerance;
+    snapping.snap_host_steps = kHostSnapSteps;
+    snapping.progress = progressWithin(stage.progress, 98, 98);
+    StoredOutput made;
+    made.scalar = stage.scalar;
+    made.quality_snapped_for_host = true;
+    made.rounding_tests = out.rounding_tests;
+    SplitResult candidate = splitAndStore(inputs, snapping, stage, made);
+    keepIfBetter(r, out, candidate, made);
+  }
+  out.degenerate_new_faces = degenerateNewFaces(r);
+  out.time_ms = msSince(start);
+  return out;
+}
+
+std::string StoredOutput::explanation() const {
+  if (crossing == 0 && degenerate_new_faces == 0) return {};
+  std::string why = std::to_string(crossing) + " pairs of faces cross and " +
+                    std::to_string(degenerate_new_faces) + " new faces are flat once stored in " +
+                    toString(scalar) + ": ";
+  if (bounded)
+    return why + "splitting the stored result again stopped at its work bound (" +
+           std::to_string(pairs_split_again) + " pairs split in " +
+           std::to_string(rounds_split_again) + " rounds)";
+  return why + "curve points lie a few " + toString(scalar) +
+         " steps apart where surfaces meet at a very small angle, and no rounding, snapping of "
+         "points within " +
+         std::to_string(kHostSnapSteps) + " steps or splitting again (" +
+         std::to_string(rounds_split_again) + " rounds) kept them apart" +
+         (scalar == Scalar::kFloat ? "; a double host (pymeshlab, MeshLab's double build, the "
+                                     "Python module) has room for them"
+                                   : "");
+}
+
+void addToReport(const StoredOutput& stored, JsonObject& report) {
+  report.set("host_scalar", toString(stored.scalar))
+      .set("crossings_left", stored.crossing)
+      .set("degenerate_new_faces", stored.degenerate_new_faces)
+      .set("vertices_rerounded", stored.vertices_rerounded)
+      .set("snapped_for_host", stored.snapped_for_host)
+      .set("quality_snapped_for_host", stored.quality_snapped_for_host)
+      .set("collinear_faces_mended", stored.collinear_faces_mended)
+      .set("rounds_split_again", std::size_t(stored.rounds_split_again))
+      .set("output_stage_bounded", stored.bounded)
+      .set("output_stage_ms", stored.time_ms);
+}
+
+}  // namespace meshmend
