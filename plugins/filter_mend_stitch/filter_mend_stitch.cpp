@@ -270,6 +270,10 @@ void logContract(FilterAdapter& plugin, const EditContract& c, MeshModel& layer)
 }  // namespace
 
 void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
+  // The defaults are the core's (the Python module reads the same).
+  const TrimOptions trim;
+  const StitchOptions stitch;
+  const CloseGapsOptions gaps;
   const QString report =
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
       "border_edges_before, border_edges_after, faces_added, vertices_merged, time_ms, ...).";
@@ -293,11 +297,12 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "the face with that index. Left of the loop: the side on the left when walking the "
         "loop in its given order, seen from where the normals point (an index list or picked "
         "vertices only: a selection has no direction)."));
-    parameters.addParam(RichInt("keep_face", -1, "Face to keep (index)",
+    parameters.addParam(RichInt("keep_face", trim.keep_face, "Face to keep (index)",
                                 "Index of a face on the side to keep, for 'Side to keep' = "
                                 "face 'keep_face'; ignored otherwise."));
     parameters.addParam(RichBool(
-        "remove_unreferenced_vertices", true, "Remove unreferenced vertices",
+        "remove_unreferenced_vertices", trim.remove_unreferenced_vertices,
+        "Remove unreferenced vertices",
         "Also removes the vertices that only removed faces used (vertex indices change). Off: "
         "every vertex stays, some unreferenced."));
     parameters.addParam(
@@ -342,20 +347,22 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
         "'0 1; 2 4'. Empty: 0 1; 2 3; 4 5; ... A path concatenated into another is referred "
         "to by either number."));
     parameters.addParam(RichFloat(
-        "max_aspect_ratio", 0, "Subdivide above aspect ratio (0 = never)",
+        "max_aspect_ratio", float(stitch.max_aspect_ratio),
+        "Subdivide above aspect ratio (0 = never)",
         QString("When a rung across the gap is longer than this many times the mean edge "
                 "length of the two paths, rows of new vertices are inserted across the strip; "
                 "0 adds no vertex. New vertices are stored in %1.")
             .arg(kHostPrecision)));
-    parameters.addParam(RichInt("max_rows", 64, "Max rows of new vertices",
+    parameters.addParam(RichInt("max_rows", stitch.max_rows, "Max rows of new vertices",
                                 "At most this many rows of new vertices across a wide strip."));
     parameters.addParam(RichBool(
-        "allow_orientation_conflict", false, "Allow opposite orientations",
+        "allow_orientation_conflict", stitch.allow_orientation_conflict,
+        "Allow opposite orientations",
         "Two sides whose faces are oppositely oriented cannot be joined consistently: they are "
         "refused unless this is on; then the new faces follow path A's side and the "
         "conflicting edges are counted."));
     parameters.addParam(
-        RichBool("check_intersections", true, "Check intersections",
+        RichBool("check_intersections", stitch.check_intersections, "Check intersections",
                  "Counts, exactly, the pairs of faces that a new face makes intersect "
                  "(new_intersecting_pairs in the log and report)."));
     parameters.addParam(
@@ -371,36 +378,38 @@ void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterLis
     parameters.addParam(keepPartialParameter());
   } else {
     parameters.addParam(RichFloat(
-        "merge_tolerance", 0, "Merge tolerance (fraction of the diagonal)",
+        "merge_tolerance", float(gaps.merge_tolerance),
+        "Merge tolerance (fraction of the diagonal)",
         "Border vertices closer than this fraction of the bounding box diagonal are merged "
         "where their border edges pair up; 0 merges only exactly equal coordinates (what "
         "CGAL's stitch_borders does)."));
     parameters.addParam(RichBool(
-        "orient_faces", true, "Orient faces consistently",
+        "orient_faces", gaps.orient_faces, "Orient faces consistently",
         "Before merging, flips faces so that faces meeting at an edge run it opposite ways "
         "(soups whose facets face against their neighbours then merge); a part that needs it is "
         "turned outward when closed, else keeps the orientation of most of its area."));
     parameters.addParam(RichFloat(
-        "max_gap", 0.01f, "Max gap (fraction of the diagonal)",
+        "max_gap", float(gaps.max_gap), "Max gap (fraction of the diagonal)",
         "Borders facing each other within this fraction of the bounding box diagonal are "
         "stitched with new faces (within one part, narrow slits also beyond it: see the local "
         "gap factor); 0 only merges."));
     parameters.addParam(RichFloat(
-        "local_gap_factor", 1.5f, "Local gap factor (x border edge length)",
+        "local_gap_factor", float(gaps.local_gap_factor), "Local gap factor (x border edge length)",
         "Within one part, a slit or crack no wider than this many times the mean length of the "
         "border edges on either side is closed too, even beyond the max gap; separate parts are "
         "stitched within the max gap only. 0: the max gap alone."));
     parameters.addParam(
-        RichInt("min_path_vertices", 2, "Min facing run (vertices)",
+        RichInt("min_path_vertices", gaps.min_path_vertices, "Min facing run (vertices)",
                 "Runs of fewer border vertices facing another border are left open."));
     parameters.addParam(
-        RichFloat("max_aspect_ratio", 0, "Subdivide above aspect ratio (0 = never)",
+        RichFloat("max_aspect_ratio", float(gaps.max_aspect_ratio),
+                  "Subdivide above aspect ratio (0 = never)",
                   QString("Stitched strips whose rungs are longer than this many times the mean "
                           "path edge length get rows of new vertices (stored in %1); 0 adds no "
                           "vertex.")
                       .arg(kHostPrecision)));
     parameters.addParam(
-        RichBool("check_intersections", true, "Check intersections",
+        RichBool("check_intersections", gaps.check_intersections, "Check intersections",
                  "Tests every stitch exactly against the mesh; one whose faces would intersect is "
                  "left out, with its reason in the log."));
     parameters.addParam(RichBool(
