@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "common/base/timing.h"
 #include "common/repair/clearance/clearance.h"
 #include "common/repair/edit_contract.h"
 #include "plugins/bridge/filter_support.h"
@@ -19,11 +20,6 @@ namespace {
 
 // The order of the "scope" choices in the dialog and in scripts.
 enum Scope { kWithinCurrent, kBetweenTwo, kBothOfTwo };
-
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 }  // namespace
 
@@ -340,8 +336,9 @@ void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& paramet
   Log("  %zu candidate pairs measured in %.0f ms", r.candidate_pairs, r.time_ms);
 }
 
-void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& parameters,
-                              vcg::CallBackPos* cb) {
+namespace {
+
+ClearanceOptions enforceOptions(const RichParameterList& parameters, vcg::CallBackPos* cb) {
   ClearanceOptions options;
   options.tau = parameters.getAbsPerc("tau");
   if (!(options.tau > 0) || !std::isfinite(options.tau))
@@ -357,55 +354,197 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   options.exclusion_rings = parameters.getInt("exclusion_rings");
   options.round_to_float = kHostStoresFloat;  // reach tau in what MeshLab will store
   options.progress = progressFrom(cb);
+  return options;
+}
 
+// The selected vertices of each layer as the core's locked lists; returns
+// how many.
+std::size_t lockSelected(Inputs& in, ClearanceOptions& options) {
+  std::size_t count = 0;
+  for (std::size_t l = 0; l < in.chosen.layers.size(); ++l) {
+    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    std::vector<char> locked(in.cores[l].vert.size(), 0);
+    for (std::size_t v = 0; v < locked.size(); ++v) {
+      locked[v] = in.chosen.layers[l]->cm.vert[vo[v].vertex].IsS();
+      count += locked[v];
+    }
+    options.locked.push_back(std::move(locked));
+  }
+  return count;
+}
+
+// The layers' frames. A layer placed by a matrix other than the identity is
+// not float in the common frame: the core's rounding (round_to_float)
+// shifts it by up to half a float step of its placed coordinates, and the
+// moved vertices round once more in the layer's own frame. The solve aims
+// beyond tau by more than both; the distances and displacements reported
+// are then measured on the exact input and on what the layers will store.
+struct Frames {
+  bool anyMatrix = false;
+  ClearanceMeasureOptions check;
+  ClearanceMeasure exactBefore;  // with a matrix: the input, exactly
+  // Per layer, per vertex in the common frame: exactly, and as the core
+  // takes it (rounded to float for a float host); a vertex the core did not
+  // move comes back as the latter.
+  std::vector<std::vector<Point3>> exact, rounded;
+};
+
+Frames framesOf(const Inputs& in, const ClearanceOptions& options) {
+  Frames f;
+  for (MeshModel* m : in.chosen.layers) f.anyMatrix |= !(m->cm.Tr == Matrix44m::Identity());
+  f.check.tau = options.tau;
+  f.check.scope = options.scope;
+  f.check.exclusion_rings = options.exclusion_rings;
+  std::vector<const Mesh*> cores;
+  for (const Mesh& m : in.cores) cores.push_back(&m);
+  if (f.anyMatrix) f.exactBefore = measureClearance(cores, f.check);
+  f.exact.resize(in.cores.size());
+  f.rounded.resize(in.cores.size());
+  for (std::size_t l = 0; l < in.cores.size(); ++l)
+    for (const Vertex& v : in.cores[l].vert) {
+      f.exact[l].push_back(v.cP());
+      f.rounded[l].push_back(kHostStoresFloat ? roundedToFloat(v.cP()) : v.cP());
+    }
+  return f;
+}
+
+// Per layer, the moved vertices (MeshLab's indices) in the layer's own
+// frame: back through the inverse matrix. The others keep their stored
+// coordinates bit for bit.
+using Moves = std::vector<std::vector<std::pair<int, HostPoint>>>;
+
+Moves movesInLayerFrames(Inputs& in, const Frames& frames) {
+  Moves moves(in.cores.size());
+  for (std::size_t l = 0; l < in.cores.size(); ++l) {
+    const CMeshO& cm = in.chosen.layers[l]->cm;
+    const bool identity = cm.Tr == Matrix44m::Identity();
+    const vcg::Matrix44d inverse = vcg::Inverse(vcg::Matrix44d::Construct(cm.Tr));
+    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
+      const Point3& p = in.cores[l].vert[v].cP();
+      if (p == frames.rounded[l][v]) continue;
+      moves[l].emplace_back(vo[v].vertex, HostPoint::Construct(identity ? p : Point3(inverse * p)));
+    }
+  }
+  return moves;
+}
+
+// The outcome as the layers will store it. Without matrices it is the
+// core's own (it checked its float result); with them, it is measured
+// again on the stored floats placed by the matrices.
+struct Stored {
+  double minBefore = 0, minAfter = 0;
+  std::size_t pairsBefore = 0, pairsAfter = 0;
+  double maxMove = 0, meanMoved = 0, meanAll = 0;
+  bool reached = false;
+};
+
+Stored storedOutcome(const ClearanceResult& r, const Frames& frames, const Moves& moves,
+                     Inputs& in) {
+  Stored s{r.min_distance_before,    r.min_distance_after,
+           r.violating_pairs_before, r.violating_pairs_after,
+           r.max_displacement,       r.mean_displacement_moved,
+           r.mean_displacement_all,  r.reached};
+  if (!frames.anyMatrix) return s;
+  const ClearanceMeasure& before = frames.exactBefore;
+  s.minBefore = before.found ? before.min_distance : s.minBefore;
+  s.pairsBefore = before.violating_pairs;
+  // The cores are not needed in the common frame any more (only their face
+  // provenance is): they take the positions as they will be stored.
+  std::size_t vertices = 0, moved = 0;
+  double sum = 0;
+  s.maxMove = 0;
+  for (std::size_t l = 0; l < in.cores.size(); ++l) {
+    const CMeshO& cm = in.chosen.layers[l]->cm;
+    const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
+    std::vector<int> slot(cm.vert.size(), -1);
+    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
+      slot[vo[v].vertex] = int(v);
+      in.cores[l].vert[v].P() = frames.exact[l][v];
+    }
+    for (const auto& [vertex, p] : moves[l]) {
+      const int v = slot[vertex];
+      in.cores[l].vert[v].P() = tr * Point3::Construct(p);
+      const double d = Point3(in.cores[l].vert[v].cP() - frames.exact[l][v]).Norm();
+      s.maxMove = std::max(s.maxMove, d);
+      sum += d;
+      moved += d > 0;
+    }
+    vertices += in.cores[l].vert.size();
+  }
+  s.meanMoved = moved ? sum / double(moved) : 0;
+  s.meanAll = vertices ? sum / double(vertices) : 0;
+  std::vector<const Mesh*> cores;
+  for (const Mesh& m : in.cores) cores.push_back(&m);
+  const ClearanceMeasure after = measureClearance(cores, frames.check);
+  s.minAfter = after.found ? after.min_distance : s.minAfter;
+  s.pairsAfter = after.violating_pairs;
+  s.reached = r.reached && s.pairsAfter == 0;
+  return s;
+}
+
+JsonObject enforceReport(const ClearanceResult& r, const Stored& s, const Frames& frames,
+                         const std::vector<std::string>& failures, const Inputs& in,
+                         std::size_t lockedCount, double ms) {
+  JsonObject report = toJson(r);
+  reportContract(report, failures);
+  report.set("unchanged", s.pairsBefore == 0);
+  if (s.reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
+  report.set("scope", toString(in.chosen.scope))
+      .set("layers", labels(in.chosen.layers))
+      .set("locked_vertices", lockedCount)
+      .set("short_pairs", pairsJson(r.short_pairs, in.cores))
+      .set("time_ms", ms);
+  if (!frames.anyMatrix) return report;
+  // What the layers hold, placed by their matrices; the solve's own values
+  // (on the input rounded to float in the common frame) are kept beside.
+  return report.set("min_distance_before", s.minBefore)
+      .set("violating_pairs_before", s.pairsBefore)
+      .set("min_distance_after", s.minAfter)
+      .set("violating_pairs_after", s.pairsAfter)
+      .set("max_displacement", s.maxMove)
+      .set("mean_displacement", s.meanMoved)
+      .set("mean_displacement_moved", s.meanMoved)
+      .set("mean_displacement_all", s.meanAll)
+      .set("solve", JsonObject()
+                        .set("min_distance_before", r.min_distance_before)
+                        .set("min_distance_after", r.min_distance_after)
+                        .set("violating_pairs_after", r.violating_pairs_after)
+                        .set("max_displacement", r.max_displacement));
+}
+
+// Why tau was not reached, and what to try.
+std::string whyNotReached(const ClearanceResult& r) {
+  if (r.reached)
+    return "rounding to the layers' own frames (their matrices) took some pairs back below tau: "
+           "apply the matrices first (Filters > Normals, Curvatures and Orientation > Matrix: "
+           "Freeze Current Matrix) and run again";
+  if (r.stop_reason == "locked")
+    return "every pair still short has only locked (selected) or capped vertices: deselect "
+           "some, raise the max displacement, or lower tau";
+  if (r.stop_reason == "iterations") return "the max iterations were used up: raise them";
+  if (r.stop_reason == "stalled")
+    return "no step that keeps the surfaces apart gets closer to tau (locked vertices, the "
+           "cap, or a part thinner than tau allows)";
+  return r.stop_reason;
+}
+
+}  // namespace
+
+void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& parameters,
+                              vcg::CallBackPos* cb) {
+  ClearanceOptions options = enforceOptions(parameters, cb);
   Inputs in;
   reportProgress(options.progress, 0, "MeshMend: reading the layers");
   readInputs(md, parameters, in);
   const std::vector<MeshModel*>& layers = in.chosen.layers;
   options.scope = in.chosen.scope;
   const bool lock = parameters.getBool("lock_selected");
-  std::size_t lockedCount = 0;
-  if (lock) {
-    for (std::size_t l = 0; l < layers.size(); ++l) {
-      VertexOriginHandle vo = vertexOrigins(in.cores[l]);
-      std::vector<char> locked(in.cores[l].vert.size(), 0);
-      for (std::size_t v = 0; v < locked.size(); ++v) {
-        locked[v] = layers[l]->cm.vert[vo[v].vertex].IsS();
-        lockedCount += locked[v];
-      }
-      options.locked.push_back(std::move(locked));
-    }
-  }
-
-  // A layer placed by a matrix other than the identity is not float in the
-  // common frame: the core's rounding (round_to_float) shifts it by up to half
-  // a float step of its placed coordinates, and the moved vertices round once
-  // more in the layer's own frame. The solve aims beyond tau by more than
-  // both; the distances and displacements reported are measured here on the
-  // exact input and on what the layers will store.
-  bool anyMatrix = false;
-  for (MeshModel* m : layers) anyMatrix |= !(m->cm.Tr == Matrix44m::Identity());
-  ClearanceMeasureOptions check;
-  check.tau = options.tau;
-  check.scope = options.scope;
-  check.exclusion_rings = options.exclusion_rings;
-  std::vector<const Mesh*> constCores;
-  for (const Mesh& m : in.cores) constCores.push_back(&m);
-  ClearanceMeasure exactBefore;
-  const auto measureStart = std::chrono::steady_clock::now();
-  if (anyMatrix) exactBefore = measureClearance(constCores, check);
-
-  // Where each vertex was in the common frame, exactly and as the core takes
-  // it (rounded to float for a float host): a vertex it did not move comes
-  // back as the latter.
-  std::vector<std::vector<Point3>> exact(layers.size()), rounded(layers.size());
-  for (std::size_t l = 0; l < layers.size(); ++l)
-    for (const Vertex& v : in.cores[l].vert) {
-      const Point3& p = v.cP();
-      exact[l].push_back(p);
-      rounded[l].push_back(kHostStoresFloat ? roundedToFloat(p) : p);
-    }
-  double ownMs = msSince(measureStart);
+  const std::size_t lockedCount = lock ? lockSelected(in, options) : 0;
+  auto start = std::chrono::steady_clock::now();
+  const Frames frames = framesOf(in, options);
+  double ownMs = msSince(start);
 
   std::vector<Mesh*> meshes;
   for (Mesh& m : in.cores) meshes.push_back(&m);
@@ -415,106 +554,25 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   } catch (const TopologyError& e) {
     throw TopologyError(std::string(e.what()) + " (" + layerList(layers) + ")");
   }
-
-  // MeshLab keeps each layer in its own frame, placed by its matrix: the
-  // moved vertices go back through the inverse matrix; the others keep their
-  // stored coordinates bit for bit.
-  const auto writeStart = std::chrono::steady_clock::now();
-  std::vector<std::vector<std::pair<int, HostPoint>>> moves(layers.size());
-  for (std::size_t l = 0; l < layers.size(); ++l) {
-    const CMeshO& cm = layers[l]->cm;
-    const bool identity = cm.Tr == Matrix44m::Identity();
-    const vcg::Matrix44d inverse = vcg::Inverse(vcg::Matrix44d::Construct(cm.Tr));
-    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
-    for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
-      const Point3& p = in.cores[l].vert[v].cP();
-      if (p == rounded[l][v]) continue;
-      moves[l].emplace_back(vo[v].vertex, HostPoint::Construct(identity ? p : Point3(inverse * p)));
-    }
-  }
-
-  // The outcome as stored. Without matrices it is the core's own (it checked
-  // its float result); with them, it is measured again on the stored floats.
-  double minBefore = r.min_distance_before, minAfter = r.min_distance_after;
-  std::size_t pairsBefore = r.violating_pairs_before, pairsAfter = r.violating_pairs_after;
-  double maxMove = r.max_displacement, meanMoved = r.mean_displacement_moved,
-         meanAll = r.mean_displacement_all;
-  if (anyMatrix) {
+  start = std::chrono::steady_clock::now();
+  const Moves moves = movesInLayerFrames(in, frames);
+  if (frames.anyMatrix)
     reportProgress(options.progress, 98, "MeshMend: checking the stored result");
-    minBefore = exactBefore.found ? exactBefore.min_distance : minBefore;
-    pairsBefore = exactBefore.violating_pairs;
-    // The cores are not needed in the common frame any more (only their face
-    // provenance is): they take the positions as they will be stored.
-    std::size_t vertices = 0, moved = 0;
-    double sum = 0;
-    maxMove = 0;
-    for (std::size_t l = 0; l < layers.size(); ++l) {
-      const CMeshO& cm = layers[l]->cm;
-      const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
-      std::vector<int> slot(cm.vert.size(), -1);
-      VertexOriginHandle vo = vertexOrigins(in.cores[l]);
-      for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
-        slot[vo[v].vertex] = int(v);
-        in.cores[l].vert[v].P() = exact[l][v];
-      }
-      for (const auto& [vertex, p] : moves[l]) {
-        const int v = slot[vertex];
-        in.cores[l].vert[v].P() = tr * Point3::Construct(p);
-        const double d = Point3(in.cores[l].vert[v].cP() - exact[l][v]).Norm();
-        maxMove = std::max(maxMove, d);
-        sum += d;
-        moved += d > 0;
-      }
-      vertices += in.cores[l].vert.size();
-    }
-    meanMoved = moved ? sum / double(moved) : 0;
-    meanAll = vertices ? sum / double(vertices) : 0;
-    const ClearanceMeasure after = measureClearance(constCores, check);
-    minAfter = after.found ? after.min_distance : minAfter;
-    pairsAfter = after.violating_pairs;
-  }
-  ownMs += msSince(writeStart);
+  const Stored s = storedOutcome(r, frames, moves, in);
+  ownMs += msSince(start);
 
-  // With matrices the verdict is the one on what the layers will hold.
-  const bool reached = anyMatrix ? r.reached && pairsAfter == 0 : r.reached;
   // The contract (clearance.h), on what the layers will hold.
   const std::vector<std::string> failures =
-      clearanceContractFailures(minBefore, minAfter, r.new_intersecting_pairs);
+      clearanceContractFailures(s.minBefore, s.minAfter, r.new_intersecting_pairs);
   requireContract(failures, "Enforce Minimum Clearance", parameters.getBool("keep_partial"),
                   "Try a smaller tau or a max displacement, or turn on 'Keep a partial result' "
                   "to see what was made");
-  JsonObject report = toJson(r);
-  reportContract(report, failures);
-  report.set("unchanged", pairsBefore == 0);
-  if (reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
-  report.set("scope", toString(options.scope))
-      .set("layers", labels(layers))
-      .set("locked_vertices", lockedCount)
-      .set("short_pairs", pairsJson(r.short_pairs, in.cores))
-      .set("time_ms", r.time_ms + ownMs);
-  if (anyMatrix) {
-    // What the layers hold, placed by their matrices; the solve's own values
-    // (on the input rounded to float in the common frame) are kept beside.
-    report.set("min_distance_before", minBefore)
-        .set("violating_pairs_before", pairsBefore)
-        .set("min_distance_after", minAfter)
-        .set("violating_pairs_after", pairsAfter)
-        .set("max_displacement", maxMove)
-        .set("mean_displacement", meanMoved)
-        .set("mean_displacement_moved", meanMoved)
-        .set("mean_displacement_all", meanAll)
-        .set("solve", JsonObject()
-                          .set("min_distance_before", r.min_distance_before)
-                          .set("min_distance_after", r.min_distance_after)
-                          .set("violating_pairs_after", r.violating_pairs_after)
-                          .set("max_displacement", r.max_displacement));
-  }
-  publishReport(parameters, report);
-
-  if (pairsBefore == 0) {
+  publishReport(parameters,
+                enforceReport(r, s, frames, failures, in, lockedCount, r.time_ms + ownMs));
+  if (s.pairsBefore == 0) {
     Log("MeshMend: no pair of faces is closer than tau = %.6g (the closest: %.6g): nothing to "
         "move; the layers are unchanged",
-        r.tau, minBefore);
+        r.tau, s.minBefore);
     reportProgress(options.progress, 100, "MeshMend: done");
     return;
   }
@@ -537,36 +595,19 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   if (layers.size() > 1)
     where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
   Log("MeshMend: clearance %s %s, tau = %.6g: %s", scopeText, where.c_str(), r.tau,
-      reached ? "reached" : "NOT reached");
-  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", minBefore, minAfter,
-      pairsBefore, pairsAfter);
+      s.reached ? "reached" : "NOT reached");
+  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", s.minBefore, s.minAfter,
+      s.pairsBefore, s.pairsAfter);
   Log("  %zu vertices moved (%zu locked): max displacement %.6g (no solution moves less than "
       "%.6g), mean %.6g; %d iterations, %.0f ms",
-      r.vertices_moved, lockedCount, maxMove, r.displacement_lower_bound, meanMoved, r.iterations,
-      r.time_ms + ownMs);
-  if (anyMatrix) Log("  layer matrices applied; moved vertices written back in each layer's frame");
+      r.vertices_moved, lockedCount, s.maxMove, r.displacement_lower_bound, s.meanMoved,
+      r.iterations, r.time_ms + ownMs);
+  if (frames.anyMatrix)
+    Log("  layer matrices applied; moved vertices written back in each layer's frame");
   if (lock && lockedCount == 0) Log("  note: no vertex is selected, so none was locked");
   if (r.vertices_capped) Log("  %zu vertices stopped at the max displacement", r.vertices_capped);
-  if (!reached) {
-    std::string why;
-    if (r.reached)
-      why =
-          "rounding to the layers' own frames (their matrices) took some pairs back below tau: "
-          "apply the matrices first (Filters > Normals, Curvatures and Orientation > Matrix: "
-          "Freeze Current Matrix) and run again";
-    else if (r.stop_reason == "locked")
-      why =
-          "every pair still short has only locked (selected) or capped vertices: deselect "
-          "some, raise the max displacement, or lower tau";
-    else if (r.stop_reason == "iterations")
-      why = "the max iterations were used up: raise them";
-    else if (r.stop_reason == "stalled")
-      why =
-          "no step that keeps the surfaces apart gets closer to tau (locked vertices, the "
-          "cap, or a part thinner than tau allows)";
-    else
-      why = r.stop_reason;
-    Log("  tau not reached: %s", why.c_str());
+  if (!s.reached) {
+    Log("  tau not reached: %s", whyNotReached(r).c_str());
     for (std::size_t i = 0; i < r.short_pairs.size(); ++i)
       Log("  short pair %zu: %s", i + 1, describe(r.short_pairs[i], in.cores, layers).c_str());
   }
