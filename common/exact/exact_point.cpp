@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "common/base/errors.h"
 #include "common/exact/interval.h"
 #include "common/exact/predicates.h"
 
@@ -61,6 +62,11 @@ Interval3 PlaneInterval::normal() const {
 }
 
 RationalPoint rationalOf(const Point3& p) {
+  // GMP has no infinity or NaN (mpq_set_d raises SIGFPE on them).
+  if (!isFinite(p))
+    throw InvalidInputError(
+        "an exact point met a non-finite coordinate (NaN or infinity), computed from "
+        "coordinates near the limits of double: scale the mesh towards the origin");
   return {{mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])}};
 }
 

@@ -1,5 +1,6 @@
 #include "common/exact/predicates.h"
 
+#include "common/base/errors.h"
 #include "common/exact/expansion.h"
 
 #include <algorithm>
@@ -18,9 +19,24 @@ constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 constexpr double kOrient3dBound = PlaneFilter::kOrient3dBound;
 // Below this magnitude products may underflow and the bounds no longer hold.
 constexpr double kUnderflowGuard = PlaneFilter::kUnderflowGuard;
+// orient3d's minors multiplied by a coordinate may have underflowed
+// (PlaneFilter::kUnderflowSlack). orient2d's two products are off by at
+// most 2^-1074 then, which the guard's 1e-250 keeps far below its bound.
+constexpr double kUnderflowSlack = PlaneFilter::kUnderflowSlack;
 
 int sign(const mpq_class& q) {
   return sgn(q);
+}
+
+// GMP has no infinity or NaN (mpq_set_d raises SIGFPE on them): a predicate
+// on such a coordinate, which no mesh the core takes has but a point
+// constructed near the double range may, refuses instead.
+void requireFinite(std::initializer_list<double> values) {
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw InvalidInputError(
+          "an exact test met a non-finite coordinate (NaN or infinity), computed from "
+          "coordinates near the limits of double: scale the mesh towards the origin");
 }
 
 }  // namespace
@@ -28,12 +44,14 @@ int sign(const mpq_class& q) {
 namespace exact {
 
 int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+  requireFinite({ax, ay, bx, by, cx, cy});
   const mpq_class acx = mpq_class(ax) - mpq_class(cx), bcx = mpq_class(bx) - mpq_class(cx);
   const mpq_class acy = mpq_class(ay) - mpq_class(cy), bcy = mpq_class(by) - mpq_class(cy);
   return sign(acx * bcy - acy * bcx);
 }
 
 int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  requireFinite({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2]});
   mpq_class m[3][3];
   for (int k = 0; k < 3; ++k) {
     m[0][k] = mpq_class(b[k]) - mpq_class(a[k]);
@@ -73,7 +91,8 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
   const double permanent = (std::fabs(cy * dz) + std::fabs(cz * dy)) * std::fabs(bx) +
                            (std::fabs(cx * dz) + std::fabs(cz * dx)) * std::fabs(by) +
                            (std::fabs(cx * dy) + std::fabs(cy * dx)) * std::fabs(bz);
-  const double bound = kOrient3dBound * permanent;
+  const double bound = kOrient3dBound * permanent +
+                       kUnderflowSlack * (std::fabs(bx) + std::fabs(by) + std::fabs(bz) + 1);
   if (std::isfinite(det) && permanent > kUnderflowGuard) {
     if (det > bound) return 1;
     if (-det > bound) return -1;

@@ -58,7 +58,8 @@ class PlaneFilter {
     const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
     const double permanent =
         std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
-    const double bound = kOrient3dBound * permanent;
+    const double bound = kOrient3dBound * permanent +
+                         kUnderflowSlack * (std::fabs(dx) + std::fabs(dy) + std::fabs(dz) + 1);
     if (std::isfinite(det) && permanent > kUnderflowGuard) {
       if (det > bound) return 1;
       if (-det > bound) return -1;
@@ -71,6 +72,13 @@ class PlaneFilter {
   static constexpr double kEpsilon = 0x1p-53;
   static constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
   static constexpr double kUnderflowGuard = 1e-250;
+  // Shewchuk's bound is relative: a product that underflows is off by up to
+  // 2^-1075 absolutely, and a 2x2 minor off by 2^-1074 is then multiplied by
+  // the third row's coordinate (up to 1e308). The bound adds this much per
+  // unit of that row's magnitude (16 times the worst case), so that tiny
+  // minors next to huge coordinates go to the exact evaluation instead of
+  // deciding wrongly; a large permanent alone does not exclude it.
+  static constexpr double kUnderflowSlack = 0x1p-1070;
 
  private:
   double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded

@@ -568,6 +568,7 @@ class Retriangulator {
   bool flipImproves(int u, int w, int p, int q, double before, double after) const {
     if (const int c = compareMeasures(before, after, {&V_[u], &V_[w], &V_[p], &V_[q]}))
       return c > 0;
+    countExactEvaluation();
     if (const int in = inCircle(V_[u].exact(), V_[w].exact(), V_[p].exact(), V_[q].exact()))
       return in > 0;
     int smallest = u;
@@ -658,7 +659,8 @@ class Retriangulator {
   mutable std::size_t exactEvaluations_ = 0;
   std::size_t maxExactEvaluations_ = 0;
 
-  // Counts one rational evaluation against the patch's work bound.
+  // Counts one rational evaluation (an orientation, an in-circle test)
+  // against the patch's work bound.
   void countExactEvaluation() const {
     if (++exactEvaluations_ > maxExactEvaluations_ && maxExactEvaluations_ > 0)
       throw WorkLimitError(

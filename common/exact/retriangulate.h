@@ -25,13 +25,14 @@ struct PatchInput {
   std::vector<std::uint8_t> on_edges;
   std::vector<std::array<int, 2>> segments;  // constraints: 0..2 corners, 3 + i points[i]
   bool improve = true;                       // max-min angle flips after the constraints
-  // Work bound: exact (rational) evaluations of orientations this patch
-  // may take, 0 = none. Points that the rounded values cannot tell apart
-  // (dozens of curves crossing within a few units in the last place, as
-  // every meridian of a spindle torus does near its axis) need rational
-  // arithmetic on long numbers for every decision; past the bound the
-  // patch stops with WorkLimitError. Real meshes (the corpus, CAD parts a
-  // millionth of their size apart) take under 500 per patch.
+  // Work bound: exact (rational) evaluations of orientations and of the
+  // flips' in-circle tests this patch may take, 0 = none. Points that the
+  // rounded values cannot tell apart (dozens of curves crossing within a
+  // few units in the last place, as every meridian of a spindle torus does
+  // near its axis) need rational arithmetic on long numbers for every
+  // decision; past the bound the patch stops with WorkLimitError. Real
+  // meshes (the corpus, CAD parts a millionth of their size apart) take
+  // under 500 per patch.
   std::size_t max_exact_evaluations = 20000;
 };
 
@@ -45,7 +46,7 @@ struct RetriangulatedPatch {
   std::vector<int> vertex_of_input;           // per input index (corners, points): its vertex
   std::vector<std::array<int, 3>> triangles;  // oriented like the input triangle
   std::vector<std::array<int, 2>> constrained_edges;  // the constraints, split at vertices on them
-  std::size_t exact_evaluations = 0;  // rational orientations the patch took (see the bound)
+  std::size_t exact_evaluations = 0;  // rational orientations and in-circle tests (the bound)
 };
 
 // Throws InvalidInputError when the triangle is degenerate, a point is not

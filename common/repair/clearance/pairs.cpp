@@ -210,7 +210,10 @@ std::vector<NearPair> pairsFromRadius(const Soup& soup, const std::vector<Point3
   double radius = start;
   while (true) {
     std::vector<NearPair> pairs = pairsWithin(soup, P, radius, candidates);
-    if (!pairs.empty() || radius > 2 * soup.diagonal || !anyPairInScope(soup)) {
+    // (A diagonal beyond double's range is infinite: the radius stops once
+    // it is too.)
+    if (!pairs.empty() || radius > 2 * soup.diagonal || std::isinf(radius) ||
+        !anyPairInScope(soup)) {
       *used = radius;
       return pairs;
     }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -315,6 +316,13 @@ class HoleFiller {
     FrontSettings settings;
     settings.merge = options_.merge_distance;
     const double uniformFaces = std::abs(signedArea(d.uv)) / (0.433 * meanSize * meanSize);
+    if (!std::isfinite(uniformFaces) || !(meanSize > 0) || !std::isfinite(meanSize)) {
+      c.problem =
+          "its size overflows double (coordinates near the limits of double): scale the mesh "
+          "towards the origin";
+      context_.times.triangulate += msSince(clock);
+      return;
+    }
     if (uniformFaces > double(options_.uniform_face_limit)) {
       settings.growth = options_.size_growth;
       settings.maxSize = options_.max_size_factor * meanSize;

@@ -10,6 +10,14 @@ namespace meshmend::holes {
 
 namespace {
 
+// A count estimated from measures, clamped before converting: near the
+// limits of double the measures overflow to infinity or NaN, which have no
+// integer (NaN counts as none; the front's checks refuse such a hole).
+std::size_t countOf(double estimate) {
+  constexpr double kMost = 1e15;
+  return estimate > 0 ? std::size_t(std::min(estimate, kMost)) : 0;
+}
+
 // The front of advanceFront (front.h): nodes in doubly linked loops, a
 // heap of nodes by interior angle, and grids of the front's vertices and
 // edges for the exact validity tests of each new triangle.
@@ -40,10 +48,10 @@ class AdvancingFront {
     // (geometric mean): few elements per cell near the border, few cells per
     // element inside.
     const double cell = std::sqrt(mean * std::min(settings.maxSize, 16 * mean));
-    const std::size_t expected = std::size_t(area / (0.43 * cell * cell)) + n;
+    const std::size_t expected = countOf(area / (0.43 * cell * cell)) + n;
     points_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
     edgeGrid_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
-    budget_ = 8 * (std::size_t(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000;
+    budget_ = 8 * (countOf(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000;
     for (const auto& [a, b] : existingEdges) edges_.insert(edgeKey(a, b));
     for (std::size_t i = 0; i < n; ++i)
       nodes_.push_back({int(i), int((i + n - 1) % n), int((i + 1) % n)});
