@@ -586,7 +586,7 @@ TEST(EnforceClearance, QuantisedScanFromTheCorpus) {
   // Spot (5,856 faces) quantised to 9 bits of its bounding box diagonal, as
   // a codec would: non-adjacent faces come within 0.0029; tau = 0.004.
   const std::filesystem::path path =
-      std::filesystem::path(__FILE__).parent_path() / "../../shared/data/scanned/spot.obj";
+      std::filesystem::path(__FILE__).parent_path() / "../../../../shared/data/scanned/spot.obj";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "corpus absent: " << path;
   const Mesh original = readMesh(path.string());
   const std::vector<Point3> p = positionsOf(original);
