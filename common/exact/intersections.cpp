@@ -213,163 +213,148 @@ std::size_t selfIntersectingPairs(const Mesh& mesh, Scalar scalar, bool sameVert
   return findIntersectionsInArrays({&arrays}, o).self_pairs[0];
 }
 
-FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
-                                                  const FindIntersectionsOptions& options) {
-  const auto start = Clock::now();
-  FindIntersectionsResult r;
-  const std::size_t n = meshes.size();
-  for (std::size_t m = 0; m < n; ++m) {
+namespace {
+
+// A pair found between meshes keeps the plane sides its test computed: the
+// contact classification needs the same ones.
+struct Found {
+  IntersectingPair pair;
+  std::int8_t side[2][3];  // as PlaneSides, for (pair.a, pair.b)
+  bool sidesKnown;
+};
+
+// Per-worker results, each on its own cache line (no false sharing).
+struct alignas(64) WorkerFindings {
+  std::vector<Found> pairs;
+  std::size_t candidates = 0;
+};
+
+void requireFacesAndFinite(const std::vector<const MeshArrays*>& meshes) {
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
     if (meshes[m]->triangles.empty())
       throw InvalidInputError("mesh " + std::to_string(m) + " has no faces");
     for (const Point3& p : meshes[m]->points)
       if (!isFinite(p))
         throw InvalidInputError("mesh " + std::to_string(m) + " has a non-finite coordinate");
   }
-  reportProgress(options.progress, 0, "Preparing boxes");
-  // Each mesh gets a tree (and every face's box and plane) only for its
-  // self-intersections; the search between meshes builds its own over the
-  // faces near the other mesh.
-  std::vector<Soup> soups;
-  soups.reserve(n);
-  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m]);
-  // Each mesh on its own, side by side (a large mesh's own stages take the
-  // threads a small one leaves).
-  parallelChunks(
-      n,
-      [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t m = begin; m < end; ++m) soups[m].prepare(options.self);
-      },
-      1);
-  // A pair found between meshes keeps the plane sides its test computed:
-  // the contact classification needs the same ones.
-  struct Found {
-    IntersectingPair pair;
-    std::int8_t side[2][3];  // as PlaneSides, for (pair.a, pair.b)
-    bool sidesKnown;
-  };
-  // Per-worker results, each on its own cache line (no false sharing).
-  struct alignas(64) WorkerFindings {
-    std::vector<Found> pairs;
-    std::size_t candidates = 0;
-  };
-  std::vector<WorkerFindings> found(workerCount());
+}
 
+// Each mesh's own pairs, from a tree of its faces' boxes; returns the
+// milliseconds spent building the trees.
+double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& options,
+                  std::vector<WorkerFindings>& found, FindIntersectionsResult& r) {
+  const std::size_t n = soups.size();
   const auto buildStart = Clock::now();
   std::vector<BoxTree> trees;
-  if (options.self) {
-    trees.reserve(n);
-    for (std::size_t m = 0; m < n; ++m)
-      trees.emplace_back(std::move(soups[m].boxes), options.layout == 1
-                                                        ? BoxTree::Layout::kMorton
-                                                        : BoxTree::Layout::kMedianSplit);
-  }
+  trees.reserve(n);
+  for (std::size_t m = 0; m < n; ++m)
+    trees.emplace_back(std::move(soups[m].boxes), options.layout == 1
+                                                      ? BoxTree::Layout::kMorton
+                                                      : BoxTree::Layout::kMedianSplit);
   r.build_ms = msSince(buildStart);
+  for (std::size_t m = 0; m < n; ++m) {
+    reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
+    const Soup& s = soups[m];
+    trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
+      if (s.degenerate[f] || s.degenerate[g]) return;
+      ++found[worker].candidates;
+      if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
+          selfIntersect(s, f, g))
+        found[worker].pairs.push_back(
+            {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
+    });
+  }
+  return r.build_ms;
+}
 
-  const auto searchStart = Clock::now();
-  if (options.self)
-    for (std::size_t m = 0; m < n; ++m) {
-      reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
-      const Soup& s = soups[m];
-      trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
-        if (s.degenerate[f] || s.degenerate[g]) return;
-        ++found[worker].candidates;
-        if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
-            selfIntersect(s, f, g))
-          found[worker].pairs.push_back(
-              {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
-      });
-    }
-  if (options.cross)
-    for (std::size_t m = 0; m < n; ++m)
-      for (std::size_t k = m + 1; k < n; ++k) {
-        reportProgress(options.progress, 50, "Intersections between meshes");
-        if (!overlap(soups[m].bounds, soups[k].bounds)) continue;
-        // One mesh after the other, each on every thread: side by side, the
-        // smaller one's thread idled while the larger one's did most of the work.
-        const Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
-                                    facesTouching(soups[k], soups[m].bounds)};
-        // A tree over the smaller set of candidates, queried by the other's.
-        const bool swap = near[0].faces.size() > near[1].faces.size();
-        const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];
-        const std::uint32_t small = std::uint32_t(swap ? k : m),
-                            large = std::uint32_t(swap ? m : k);
-        if (sc.faces.empty()) continue;
-        const Soup &s = soups[small], &l = soups[large];
-        const auto treeStart = Clock::now();
-        // Many faces of a large mesh lie inside the smaller one's bounds but
-        // far from its faces: a coarse grid of those turns them away before
-        // a tree descent (for a small mesh, its set-up would cost more).
-        std::unique_ptr<BoxGrid> nearSmall;
-        if (lc.faces.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(sc.boxes);
-        // The candidates near a curve are faces of similar sizes: a hashed
-        // grid finds their overlaps in less time than a tree (about as many
-        // instructions, but no median selections, whose comparisons are as
-        // good as random, to build it). A tree where the sizes differ too
-        // much for a grid.
-        std::optional<HashedBoxGrid> grid;
-        std::optional<BoxTree> tree;
-        std::vector<PlaneSide> planes(sc.faces.size());
-        {
-          // The planes on a second thread while this one builds.
-          TaskAlongside planesAside([&] {
-            for (std::size_t i = 0; i < sc.faces.size(); ++i) {
-              const TrianglePoints t = s.at(sc.faces[i]);
-              planes[i] = PlaneSide(t[0], t[1], t[2]);
-            }
-          });
-          if (options.layout == 0) grid.emplace(sc.boxes);
-          if (!grid || !grid->suits(lc.boxes)) {
-            grid.reset();
-            tree.emplace(sc.boxes, options.layout == 1 ? BoxTree::Layout::kMorton
-                                                       : BoxTree::Layout::kMedianSplit);
-          }
-          planesAside.wait();
-        }
-        r.build_ms += msSince(treeStart);
-        // A query face costs about a microsecond (a descent and its
-        // candidates' tests): a second thread from a few hundred each.
-        parallelChunks(
-            lc.faces.size(),
-            [&](std::size_t begin, std::size_t end, unsigned worker) {
-              for (std::size_t i = begin; i < end; ++i) {
-                if (nearSmall && !nearSmall->touches(lc.boxes[i])) continue;
-                const std::uint32_t g = lc.faces[i];
-                const TrianglePoints tg = l.at(g);
-                PlaneSide planeOfG;  // made when a face first reaches g's plane
-                bool planeOfGMade = false;
-                auto candidate = [&](std::uint32_t j, unsigned w) {
-                  ++found[w].candidates;
-                  // side[0]: f's corners against g's plane; side[1]: g's against f's.
-                  PlaneSides side;
-                  for (int c = 0; c < 3; ++c) side[1][c] = planes[j](tg[c]);
-                  if (side[1][0] != 0 && side[1][1] == side[1][0] && side[1][2] == side[1][0])
-                    return;
-                  if (!planeOfGMade) {
-                    planeOfG = PlaneSide(tg[0], tg[1], tg[2]);
-                    planeOfGMade = true;
-                  }
-                  const std::uint32_t f = sc.faces[j];
-                  const TrianglePoints tf = s.at(f);
-                  for (int c = 0; c < 3; ++c) side[0][c] = planeOfG(tf[c]);
-                  if (!trianglesIntersect(tf, tg, side)) return;
-                  Found x{{{small, f}, {large, g}}, {}, true};
-                  const bool flip = x.pair.b < x.pair.a;
-                  if (flip) std::swap(x.pair.a, x.pair.b);
-                  for (int t = 0; t < 2; ++t)
-                    for (int c = 0; c < 3; ++c)
-                      x.side[t][c] = std::int8_t(side[flip ? 1 - t : t][c]);
-                  found[w].pairs.push_back(x);
-                };
-                if (grid)
-                  grid->query(lc.boxes[i], [&](std::uint32_t j) { candidate(j, worker); });
-                else
-                  tree->query(lc.boxes[i], worker, candidate);
-              }
-            },
-            256);
+// The pairs between meshes m and k: a tree (or a hashed grid) over the
+// smaller set of the faces near the other mesh, queried by the other's.
+void searchBetween(std::vector<Soup>& soups, std::size_t m, std::size_t k,
+                   const FindIntersectionsOptions& options, std::vector<WorkerFindings>& found,
+                   FindIntersectionsResult& r) {
+  if (!overlap(soups[m].bounds, soups[k].bounds)) return;
+  // One mesh after the other, each on every thread: side by side, the
+  // smaller one's thread idled while the larger one's did most of the work.
+  const Candidates near[2] = {facesTouching(soups[m], soups[k].bounds),
+                              facesTouching(soups[k], soups[m].bounds)};
+  const bool swap = near[0].faces.size() > near[1].faces.size();
+  const Candidates &sc = near[swap ? 1 : 0], &lc = near[swap ? 0 : 1];
+  const std::uint32_t small = std::uint32_t(swap ? k : m), large = std::uint32_t(swap ? m : k);
+  if (sc.faces.empty()) return;
+  const Soup &s = soups[small], &l = soups[large];
+  const auto treeStart = Clock::now();
+  // Many faces of a large mesh lie inside the smaller one's bounds but far
+  // from its faces: a coarse grid of those turns them away before a tree
+  // descent (for a small mesh, its set-up would cost more).
+  std::unique_ptr<BoxGrid> nearSmall;
+  if (lc.faces.size() >= 65536) nearSmall = std::make_unique<BoxGrid>(sc.boxes);
+  // The candidates near a curve are faces of similar sizes: a hashed grid
+  // finds their overlaps in less time than a tree (about as many
+  // instructions, but no median selections, whose comparisons are as good
+  // as random, to build it). A tree where the sizes differ too much for a grid.
+  std::optional<HashedBoxGrid> grid;
+  std::optional<BoxTree> tree;
+  std::vector<PlaneSide> planes(sc.faces.size());
+  {
+    // The planes on a second thread while this one builds.
+    TaskAlongside planesAside([&] {
+      for (std::size_t i = 0; i < sc.faces.size(); ++i) {
+        const TrianglePoints t = s.at(sc.faces[i]);
+        planes[i] = PlaneSide(t[0], t[1], t[2]);
       }
-  r.search_ms = msSince(searchStart);
+    });
+    if (options.layout == 0) grid.emplace(sc.boxes);
+    if (!grid || !grid->suits(lc.boxes)) {
+      grid.reset();
+      tree.emplace(sc.boxes,
+                   options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
+    }
+    planesAside.wait();
+  }
+  r.build_ms += msSince(treeStart);
+  // A query face costs about a microsecond (a descent and its candidates'
+  // tests): a second thread from a few hundred each.
+  parallelChunks(
+      lc.faces.size(),
+      [&](std::size_t begin, std::size_t end, unsigned worker) {
+        for (std::size_t i = begin; i < end; ++i) {
+          if (nearSmall && !nearSmall->touches(lc.boxes[i])) continue;
+          const std::uint32_t g = lc.faces[i];
+          const TrianglePoints tg = l.at(g);
+          PlaneSide planeOfG;  // made when a face first reaches g's plane
+          bool planeOfGMade = false;
+          auto candidate = [&](std::uint32_t j, unsigned w) {
+            ++found[w].candidates;
+            // side[0]: f's corners against g's plane; side[1]: g's against f's.
+            PlaneSides side;
+            for (int c = 0; c < 3; ++c) side[1][c] = planes[j](tg[c]);
+            if (side[1][0] != 0 && side[1][1] == side[1][0] && side[1][2] == side[1][0]) return;
+            if (!planeOfGMade) {
+              planeOfG = PlaneSide(tg[0], tg[1], tg[2]);
+              planeOfGMade = true;
+            }
+            const std::uint32_t f = sc.faces[j];
+            const TrianglePoints tf = s.at(f);
+            for (int c = 0; c < 3; ++c) side[0][c] = planeOfG(tf[c]);
+            if (!trianglesIntersect(tf, tg, side)) return;
+            Found x{{{small, f}, {large, g}}, {}, true};
+            const bool flip = x.pair.b < x.pair.a;
+            if (flip) std::swap(x.pair.a, x.pair.b);
+            for (int t = 0; t < 2; ++t)
+              for (int c = 0; c < 3; ++c) x.side[t][c] = std::int8_t(side[flip ? 1 - t : t][c]);
+            found[w].pairs.push_back(x);
+          };
+          if (grid)
+            grid->query(lc.boxes[i], [&](std::uint32_t j) { candidate(j, worker); });
+          else
+            tree->query(lc.boxes[i], worker, candidate);
+        }
+      },
+      256);
+}
 
+// The workers' pairs in one sorted list, into the result.
+std::vector<Found> gatherPairs(std::vector<WorkerFindings>& found, FindIntersectionsResult& r) {
   std::vector<Found> all;
   for (std::size_t w = 0; w < found.size(); ++w) {
     all.insert(all.end(), found[w].pairs.begin(), found[w].pairs.end());
@@ -380,7 +365,14 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   });
   r.pairs.reserve(all.size());
   for (const Found& x : all) r.pairs.push_back(x.pair);
+  return all;
+}
 
+// Pairs and distinct faces per mesh, within and between meshes. Distinct
+// faces are counted as they are first met (counting the bits afterwards
+// walked every face of every mesh).
+void countFaces(const std::vector<Soup>& soups, FindIntersectionsResult& r) {
+  const std::size_t n = soups.size();
   r.self_pairs.assign(n, 0);
   r.self_faces.assign(n, 0);
   r.cross_faces.assign(n, 0);
@@ -394,8 +386,6 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
     r.degenerate_faces.push_back(
         std::size_t(std::count(soups[m].degenerate.begin(), soups[m].degenerate.end(), true)));
   }
-  // Distinct faces are counted as they are first met (counting the bits
-  // afterwards walked every face of every mesh).
   for (const IntersectingPair& p : r.pairs) {
     const bool self = p.a.mesh == p.b.mesh;
     auto& flags = self ? inSelf : inCross;
@@ -412,31 +402,72 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
       r.face_involved[f.mesh][f.face] = true;
     }
   }
+}
 
+// Each pair's contact, with the plane sides its test computed where known.
+// A pair takes some ten thousand instructions (a few microseconds): a
+// second thread, which takes tens of microseconds to start, pays for itself
+// from a few dozen pairs each on.
+void classifyContacts(const std::vector<Found>& all, const std::vector<Soup>& soups,
+                      FindIntersectionsResult& r) {
+  r.contacts.resize(all.size());
+  parallelChunks(
+      all.size(),
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const Found& x = all[i];
+          const TrianglePoints a = soups[x.pair.a.mesh].at(x.pair.a.face);
+          const TrianglePoints b = soups[x.pair.b.mesh].at(x.pair.b.face);
+          if (!x.sidesKnown) {
+            r.contacts[i] = classifyContact(a, b);
+            continue;
+          }
+          PlaneSides side;
+          for (int t = 0; t < 2; ++t)
+            for (int c = 0; c < 3; ++c) side[t][c] = x.side[t][c];
+          r.contacts[i] = classifyContact(a, b, side);
+        }
+      },
+      48);
+}
+
+}  // namespace
+
+FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshArrays*>& meshes,
+                                                  const FindIntersectionsOptions& options) {
+  const auto start = Clock::now();
+  FindIntersectionsResult r;
+  const std::size_t n = meshes.size();
+  requireFacesAndFinite(meshes);
+  reportProgress(options.progress, 0, "Preparing boxes");
+  // Each mesh gets a tree (and every face's box and plane) only for its
+  // self-intersections; the search between meshes builds its own over the
+  // faces near the other mesh. Each mesh on its own, side by side (a large
+  // mesh's own stages take the threads a small one leaves).
+  std::vector<Soup> soups;
+  soups.reserve(n);
+  for (std::size_t m = 0; m < n; ++m) soups.emplace_back(*meshes[m]);
+  parallelChunks(
+      n,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t m = begin; m < end; ++m) soups[m].prepare(options.self);
+      },
+      1);
+  std::vector<WorkerFindings> found(workerCount());
+  const auto searchStart = Clock::now();
+  const double selfBuild = options.self ? searchSelf(soups, options, found, r) : 0;
+  if (options.cross)
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = m + 1; k < n; ++k) {
+        reportProgress(options.progress, 50, "Intersections between meshes");
+        searchBetween(soups, m, k, options, found, r);
+      }
+  r.search_ms = msSince(searchStart) - selfBuild;
+  const std::vector<Found> all = gatherPairs(found, r);
+  countFaces(soups, r);
   if (options.contacts) {
     reportProgress(options.progress, 80, "Intersection segments");
-    r.contacts.resize(all.size());
-    // A pair takes some ten thousand instructions (a few microseconds): a
-    // second thread, which takes tens of microseconds to start, pays for
-    // itself from a few dozen pairs each on.
-    parallelChunks(
-        all.size(),
-        [&](std::size_t begin, std::size_t end, unsigned) {
-          for (std::size_t i = begin; i < end; ++i) {
-            const Found& x = all[i];
-            const TrianglePoints a = soups[x.pair.a.mesh].at(x.pair.a.face);
-            const TrianglePoints b = soups[x.pair.b.mesh].at(x.pair.b.face);
-            if (!x.sidesKnown) {
-              r.contacts[i] = classifyContact(a, b);
-              continue;
-            }
-            PlaneSides side;
-            for (int t = 0; t < 2; ++t)
-              for (int c = 0; c < 3; ++c) side[t][c] = x.side[t][c];
-            r.contacts[i] = classifyContact(a, b, side);
-          }
-        },
-        48);
+    classifyContacts(all, soups, r);
   }
   reportProgress(options.progress, 100, "Done");
   r.time_ms = msSince(start);

@@ -269,158 +269,169 @@ void logContract(FilterAdapter& plugin, const EditContract& c, MeshModel& layer)
 
 }  // namespace
 
+namespace {
+
+void addTrimParameters(RichParameterList& parameters) {
+  const TrimOptions trim;  // the core's defaults
+  parameters.addParam(RichString(
+      "loop_vertices", "", "Loop (vertex indices)",
+      "The loop as vertex indices in order, separated by spaces, e.g. '12 45 46 ...' "
+      "(consecutive vertices share an edge; the last joins the first). Empty: the picked "
+      "vertices below, else the selected vertices."));
+  parameters.addParam(RichString(
+      "picked_vertices", "", "Picked vertices (indices)",
+      "A few vertex indices in order around the loop, joined by shortest edge paths "
+      "(used when the loop above is empty). Empty: the selected vertices form the loop."));
+  parameters.addParam(RichEnum(
+      "keep_side", kKeepSelectedFace,
+      QStringList() << "The side of the selected face"
+                    << "The side of face 'keep_face'"
+                    << "Left of the loop (its direction)",
+      "Side to keep",
+      "Selected face: exactly one face must be selected, on the side to keep. keep_face: "
+      "the face with that index. Left of the loop: the side on the left when walking the "
+      "loop in its given order, seen from where the normals point (an index list or picked "
+      "vertices only: a selection has no direction)."));
+  parameters.addParam(RichInt("keep_face", trim.keep_face, "Face to keep (index)",
+                              "Index of a face on the side to keep, for 'Side to keep' = "
+                              "face 'keep_face'; ignored otherwise."));
+  parameters.addParam(RichBool(
+      "remove_unreferenced_vertices", trim.remove_unreferenced_vertices,
+      "Remove unreferenced vertices",
+      "Also removes the vertices that only removed faces used (vertex indices change). Off: "
+      "every vertex stays, some unreferenced."));
+  parameters.addParam(
+      RichBool("removed_to_layer", false, "Keep removed faces in a new layer",
+               "Also puts the removed faces into a new layer named 'trimmed away', so nothing is "
+               "lost."));
+}
+
+void addStitchParameters(MeshDocument& md, RichParameterList& parameters) {
+  const StitchOptions stitch;  // the core's defaults
+  MeshModel* current = md.mm();
+  MeshModel* other = layerOtherThanCurrent(md);
+  parameters.addParam(RichEnum(
+      "paths_from", kTwoPathsOneLayer,
+      QStringList() << "Two paths on the current layer"
+                    << "One path on each of two layers"
+                    << "Several paths in sequence (junctions)",
+      "Paths",
+      "Two paths on the current layer: path_a and path_b, or the two runs of selected border "
+      "vertices. One path on each of two layers: path_a on the first layer, path_b on the "
+      "second (or one run of selected border vertices on each). Several paths in sequence: "
+      "'paths' (or every run of selected border vertices) stitched pairwise as "
+      "'stitch_pairs' says, leftover paths concatenated at junctions."));
+  parameters.addParam(layerParameter("first_layer", current, md, "First layer",
+                                     "First layer of the 'one path on each of two layers' mode."));
+  parameters.addParam(layerParameter("second_layer", other, md, "Second layer",
+                                     "Second layer of the 'one path on each of two layers' mode."));
+  parameters.addParam(
+      RichString("path_a", "", "Path A (vertex indices)",
+                 "Border vertex indices in order along the border, separated by spaces; repeat the "
+                 "first at the end for a closed loop. Empty: from the selected border vertices."));
+  parameters.addParam(RichString(
+      "path_b", "", "Path B (vertex indices)",
+      "The other path, like path A (on the second layer in the two-layer mode, with that "
+      "layer's indices). Empty: from the selected border vertices."));
+  parameters.addParam(RichString(
+      "paths", "", "Paths for the sequence (vertex indices)",
+      "For the sequence mode: paths separated by ';', e.g. '0 1 2; 9 8 7; 20 21'. Empty: "
+      "every run of selected border vertices, numbered as the log lists them."));
+  parameters.addParam(RichString(
+      "stitch_pairs", "", "Pairs to stitch, in order",
+      "For the sequence mode: pairs of path numbers (from 0) separated by ';', e.g. "
+      "'0 1; 2 4'. Empty: 0 1; 2 3; 4 5; ... A path concatenated into another is referred "
+      "to by either number."));
+  parameters.addParam(RichFloat(
+      "max_aspect_ratio", float(stitch.max_aspect_ratio),
+      "Subdivide above aspect ratio (0 = never)",
+      QString("When a rung across the gap is longer than this many times the mean edge "
+              "length of the two paths, rows of new vertices are inserted across the strip; "
+              "0 adds no vertex. New vertices are stored in %1.")
+          .arg(kHostPrecision)));
+  parameters.addParam(RichInt("max_rows", stitch.max_rows, "Max rows of new vertices",
+                              "At most this many rows of new vertices across a wide strip."));
+  parameters.addParam(RichBool(
+      "allow_orientation_conflict", stitch.allow_orientation_conflict,
+      "Allow opposite orientations",
+      "Two sides whose faces are oppositely oriented cannot be joined consistently: they are "
+      "refused unless this is on; then the new faces follow path A's side and the "
+      "conflicting edges are counted."));
+  parameters.addParam(
+      RichBool("check_intersections", stitch.check_intersections, "Check intersections",
+               "Counts, exactly, the pairs of faces that a new face makes intersect "
+               "(new_intersecting_pairs in the log and report)."));
+  parameters.addParam(
+      RichEnum("output", kNewLayer,
+               QStringList() << "New layer 'stitched' (inputs kept, hidden)"
+                             << "Into the first layer (the second is deleted)",
+               "Two-layer output",
+               "For the two-layer mode. New layer: both layers joined by the strip go to a new, "
+               "current layer; the inputs are hidden, unchanged. Into the first layer: the first "
+               "layer receives the result and the second layer is removed from the document."));
+  parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
+                               "Selects the stitched faces afterwards (and nothing else)."));
+  parameters.addParam(keepPartialParameter());
+}
+
+void addCloseGapsParameters(RichParameterList& parameters) {
+  const CloseGapsOptions gaps;  // the core's defaults
+  parameters.addParam(RichFloat(
+      "merge_tolerance", float(gaps.merge_tolerance), "Merge tolerance (fraction of the diagonal)",
+      "Border vertices closer than this fraction of the bounding box diagonal are merged "
+      "where their border edges pair up; 0 merges only exactly equal coordinates (what "
+      "CGAL's stitch_borders does)."));
+  parameters.addParam(RichBool(
+      "orient_faces", gaps.orient_faces, "Orient faces consistently",
+      "Before merging, flips faces so that faces meeting at an edge run it opposite ways "
+      "(soups whose facets face against their neighbours then merge); a part that needs it is "
+      "turned outward when closed, else keeps the orientation of most of its area."));
+  parameters.addParam(RichFloat(
+      "max_gap", float(gaps.max_gap), "Max gap (fraction of the diagonal)",
+      "Borders facing each other within this fraction of the bounding box diagonal are "
+      "stitched with new faces (within one part, narrow slits also beyond it: see the local "
+      "gap factor); 0 only merges."));
+  parameters.addParam(RichFloat(
+      "local_gap_factor", float(gaps.local_gap_factor), "Local gap factor (x border edge length)",
+      "Within one part, a slit or crack no wider than this many times the mean length of the "
+      "border edges on either side is closed too, even beyond the max gap; separate parts are "
+      "stitched within the max gap only. 0: the max gap alone."));
+  parameters.addParam(
+      RichInt("min_path_vertices", gaps.min_path_vertices, "Min facing run (vertices)",
+              "Runs of fewer border vertices facing another border are left open."));
+  parameters.addParam(RichFloat(
+      "max_aspect_ratio", float(gaps.max_aspect_ratio), "Subdivide above aspect ratio (0 = never)",
+      QString("Stitched strips whose rungs are longer than this many times the mean "
+              "path edge length get rows of new vertices (stored in %1); 0 adds no "
+              "vertex.")
+          .arg(kHostPrecision)));
+  parameters.addParam(
+      RichBool("check_intersections", gaps.check_intersections, "Check intersections",
+               "Tests every stitch exactly against the mesh; one whose faces would intersect is "
+               "left out, with its reason in the log."));
+  parameters.addParam(
+      RichBool("all_visible_layers", false, "All visible layers",
+               "Merges every visible layer into a new layer 'gaps closed' (layer matrices applied) "
+               "and closes the gaps there, also between layers; the inputs are hidden, unchanged. "
+               "Off: the current layer, in place."));
+  parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
+                               "Selects the stitched faces afterwards (and nothing else)."));
+  parameters.addParam(keepPartialParameter());
+}
+
+}  // namespace
+
 void StitchPlugin::initParameters(QAction* a, MeshDocument& md, RichParameterList& parameters) {
   // The defaults are the core's (the Python module reads the same).
-  const TrimOptions trim;
-  const StitchOptions stitch;
-  const CloseGapsOptions gaps;
+  if (ID(a) == TRIM_ALONG_LOOP)
+    addTrimParameters(parameters);
+  else if (ID(a) == STITCH_BOUNDARIES)
+    addStitchParameters(md, parameters);
+  else
+    addCloseGapsParameters(parameters);
   const QString report =
       "When not empty, the outcome is also written to this path as one JSON object (keys: "
       "border_edges_before, border_edges_after, faces_added, vertices_merged, time_ms, ...).";
-  if (ID(a) == TRIM_ALONG_LOOP) {
-    parameters.addParam(RichString(
-        "loop_vertices", "", "Loop (vertex indices)",
-        "The loop as vertex indices in order, separated by spaces, e.g. '12 45 46 ...' "
-        "(consecutive vertices share an edge; the last joins the first). Empty: the picked "
-        "vertices below, else the selected vertices."));
-    parameters.addParam(RichString(
-        "picked_vertices", "", "Picked vertices (indices)",
-        "A few vertex indices in order around the loop, joined by shortest edge paths "
-        "(used when the loop above is empty). Empty: the selected vertices form the loop."));
-    parameters.addParam(RichEnum(
-        "keep_side", kKeepSelectedFace,
-        QStringList() << "The side of the selected face"
-                      << "The side of face 'keep_face'"
-                      << "Left of the loop (its direction)",
-        "Side to keep",
-        "Selected face: exactly one face must be selected, on the side to keep. keep_face: "
-        "the face with that index. Left of the loop: the side on the left when walking the "
-        "loop in its given order, seen from where the normals point (an index list or picked "
-        "vertices only: a selection has no direction)."));
-    parameters.addParam(RichInt("keep_face", trim.keep_face, "Face to keep (index)",
-                                "Index of a face on the side to keep, for 'Side to keep' = "
-                                "face 'keep_face'; ignored otherwise."));
-    parameters.addParam(RichBool(
-        "remove_unreferenced_vertices", trim.remove_unreferenced_vertices,
-        "Remove unreferenced vertices",
-        "Also removes the vertices that only removed faces used (vertex indices change). Off: "
-        "every vertex stays, some unreferenced."));
-    parameters.addParam(
-        RichBool("removed_to_layer", false, "Keep removed faces in a new layer",
-                 "Also puts the removed faces into a new layer named 'trimmed away', so nothing is "
-                 "lost."));
-  } else if (ID(a) == STITCH_BOUNDARIES) {
-    MeshModel* current = md.mm();
-    MeshModel* other = layerOtherThanCurrent(md);
-    parameters.addParam(RichEnum(
-        "paths_from", kTwoPathsOneLayer,
-        QStringList() << "Two paths on the current layer"
-                      << "One path on each of two layers"
-                      << "Several paths in sequence (junctions)",
-        "Paths",
-        "Two paths on the current layer: path_a and path_b, or the two runs of selected border "
-        "vertices. One path on each of two layers: path_a on the first layer, path_b on the "
-        "second (or one run of selected border vertices on each). Several paths in sequence: "
-        "'paths' (or every run of selected border vertices) stitched pairwise as "
-        "'stitch_pairs' says, leftover paths concatenated at junctions."));
-    parameters.addParam(
-        layerParameter("first_layer", current, md, "First layer",
-                       "First layer of the 'one path on each of two layers' mode."));
-    parameters.addParam(
-        layerParameter("second_layer", other, md, "Second layer",
-                       "Second layer of the 'one path on each of two layers' mode."));
-    parameters.addParam(RichString(
-        "path_a", "", "Path A (vertex indices)",
-        "Border vertex indices in order along the border, separated by spaces; repeat the "
-        "first at the end for a closed loop. Empty: from the selected border vertices."));
-    parameters.addParam(RichString(
-        "path_b", "", "Path B (vertex indices)",
-        "The other path, like path A (on the second layer in the two-layer mode, with that "
-        "layer's indices). Empty: from the selected border vertices."));
-    parameters.addParam(RichString(
-        "paths", "", "Paths for the sequence (vertex indices)",
-        "For the sequence mode: paths separated by ';', e.g. '0 1 2; 9 8 7; 20 21'. Empty: "
-        "every run of selected border vertices, numbered as the log lists them."));
-    parameters.addParam(RichString(
-        "stitch_pairs", "", "Pairs to stitch, in order",
-        "For the sequence mode: pairs of path numbers (from 0) separated by ';', e.g. "
-        "'0 1; 2 4'. Empty: 0 1; 2 3; 4 5; ... A path concatenated into another is referred "
-        "to by either number."));
-    parameters.addParam(RichFloat(
-        "max_aspect_ratio", float(stitch.max_aspect_ratio),
-        "Subdivide above aspect ratio (0 = never)",
-        QString("When a rung across the gap is longer than this many times the mean edge "
-                "length of the two paths, rows of new vertices are inserted across the strip; "
-                "0 adds no vertex. New vertices are stored in %1.")
-            .arg(kHostPrecision)));
-    parameters.addParam(RichInt("max_rows", stitch.max_rows, "Max rows of new vertices",
-                                "At most this many rows of new vertices across a wide strip."));
-    parameters.addParam(RichBool(
-        "allow_orientation_conflict", stitch.allow_orientation_conflict,
-        "Allow opposite orientations",
-        "Two sides whose faces are oppositely oriented cannot be joined consistently: they are "
-        "refused unless this is on; then the new faces follow path A's side and the "
-        "conflicting edges are counted."));
-    parameters.addParam(
-        RichBool("check_intersections", stitch.check_intersections, "Check intersections",
-                 "Counts, exactly, the pairs of faces that a new face makes intersect "
-                 "(new_intersecting_pairs in the log and report)."));
-    parameters.addParam(
-        RichEnum("output", kNewLayer,
-                 QStringList() << "New layer 'stitched' (inputs kept, hidden)"
-                               << "Into the first layer (the second is deleted)",
-                 "Two-layer output",
-                 "For the two-layer mode. New layer: both layers joined by the strip go to a new, "
-                 "current layer; the inputs are hidden, unchanged. Into the first layer: the first "
-                 "layer receives the result and the second layer is removed from the document."));
-    parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
-                                 "Selects the stitched faces afterwards (and nothing else)."));
-    parameters.addParam(keepPartialParameter());
-  } else {
-    parameters.addParam(RichFloat(
-        "merge_tolerance", float(gaps.merge_tolerance),
-        "Merge tolerance (fraction of the diagonal)",
-        "Border vertices closer than this fraction of the bounding box diagonal are merged "
-        "where their border edges pair up; 0 merges only exactly equal coordinates (what "
-        "CGAL's stitch_borders does)."));
-    parameters.addParam(RichBool(
-        "orient_faces", gaps.orient_faces, "Orient faces consistently",
-        "Before merging, flips faces so that faces meeting at an edge run it opposite ways "
-        "(soups whose facets face against their neighbours then merge); a part that needs it is "
-        "turned outward when closed, else keeps the orientation of most of its area."));
-    parameters.addParam(RichFloat(
-        "max_gap", float(gaps.max_gap), "Max gap (fraction of the diagonal)",
-        "Borders facing each other within this fraction of the bounding box diagonal are "
-        "stitched with new faces (within one part, narrow slits also beyond it: see the local "
-        "gap factor); 0 only merges."));
-    parameters.addParam(RichFloat(
-        "local_gap_factor", float(gaps.local_gap_factor), "Local gap factor (x border edge length)",
-        "Within one part, a slit or crack no wider than this many times the mean length of the "
-        "border edges on either side is closed too, even beyond the max gap; separate parts are "
-        "stitched within the max gap only. 0: the max gap alone."));
-    parameters.addParam(
-        RichInt("min_path_vertices", gaps.min_path_vertices, "Min facing run (vertices)",
-                "Runs of fewer border vertices facing another border are left open."));
-    parameters.addParam(
-        RichFloat("max_aspect_ratio", float(gaps.max_aspect_ratio),
-                  "Subdivide above aspect ratio (0 = never)",
-                  QString("Stitched strips whose rungs are longer than this many times the mean "
-                          "path edge length get rows of new vertices (stored in %1); 0 adds no "
-                          "vertex.")
-                      .arg(kHostPrecision)));
-    parameters.addParam(
-        RichBool("check_intersections", gaps.check_intersections, "Check intersections",
-                 "Tests every stitch exactly against the mesh; one whose faces would intersect is "
-                 "left out, with its reason in the log."));
-    parameters.addParam(RichBool(
-        "all_visible_layers", false, "All visible layers",
-        "Merges every visible layer into a new layer 'gaps closed' (layer matrices applied) "
-        "and closes the gaps there, also between layers; the inputs are hidden, unchanged. "
-        "Off: the current layer, in place."));
-    parameters.addParam(RichBool("select_new_faces", false, "Select the new faces",
-                                 "Selects the stitched faces afterwards (and nothing else)."));
-    parameters.addParam(keepPartialParameter());
-  }
   parameters.addParam(RichString("report_file", "", "Report file (JSON)", report));
 }
 
@@ -555,11 +566,9 @@ void StitchPlugin::trim(MeshDocument& md, const RichParameterList& parameters,
 
 // ------------------------------------------------------------------ stitch
 
-void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
-                          vcg::CallBackPos* cb) {
-  const int mode = parameters.getEnum("paths_from");
-  if (mode < 0 || mode > kSequence)
-    throw InvalidInputError("unknown path source " + std::to_string(mode) + ": use 0 to 2");
+namespace {
+
+StitchOptions stitchOptionsFrom(const RichParameterList& parameters, vcg::CallBackPos* cb) {
   StitchOptions options;
   options.max_aspect_ratio = parameters.getFloat("max_aspect_ratio");
   options.round_to_float = kHostStoresFloat;  // store what this MeshLab stores
@@ -569,84 +578,141 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
   options.allow_orientation_conflict = parameters.getBool("allow_orientation_conflict");
   options.check_intersections = parameters.getBool("check_intersections");
   options.progress = progressFrom(cb);
+  return options;
+}
+
+// The layers a stitch reads and the core mesh it edits (a Mesh cannot
+// move: built in place).
+struct StitchInput {
+  std::vector<MeshModel*> layers;
+  std::unique_ptr<Mesh> core;
+};
+
+// One path on each of two layers: both layers in one mesh, in one frame
+// (the layer matrices applied), path b after a's vertices.
+StitchInput readTwoLayers(MeshDocument& md, const RichParameterList& parameters,
+                          StitchOptions& options) {
+  MeshModel* first = layerFrom(parameters, md, "first_layer");
+  MeshModel* second = layerFrom(parameters, md, "second_layer");
+  if (!first || !second) throw InvalidInputError("choose the two layers to stitch");
+  if (first == second)
+    throw InvalidInputError("the same layer (" + layerName(*first) +
+                            ") was chosen twice: choose two layers, or the mode 'Two paths "
+                            "on the current layer'");
+  reportProgress(options.progress, 0, "MeshMend: reading the layers");
+  Mesh a, b;
+  toCore(first->cm, a, {0, true});
+  toCore(second->cm, b, {1, true});
+  requireFacesAndFiniteCoordinates(a, layerName(*first));
+  requireFacesAndFiniteCoordinates(b, layerName(*second));
   const std::string listA = toStd(parameters.getString("path_a"));
   const std::string listB = toStd(parameters.getString("path_b"));
+  const IndexMap mapA = indexMapOf(a, first->cm), mapB = indexMapOf(b, second->cm);
+  options.a =
+      listA.empty()
+          ? selectedBorderPaths(a, first->cm, *first, 1).front()
+          : pathFromList(toCoreVertices(parseIndices(listA, "path_a"), mapA, *first, "path_a"));
+  options.b =
+      listB.empty()
+          ? selectedBorderPaths(b, second->cm, *second, 1).front()
+          : pathFromList(toCoreVertices(parseIndices(listB, "path_b"), mapB, *second, "path_b"));
+  for (int& v : options.b.vertices) v += int(a.vert.size());
+  StitchInput in;
+  in.layers = {first, second};
+  in.core.reset(new Mesh(appended(a, b)));
+  return in;
+}
 
-  std::vector<MeshModel*> layers;
-  std::unique_ptr<Mesh> core;  // a Mesh cannot move: built in place
-  if (mode == kOnePathPerLayer) {
-    MeshModel* first = layerFrom(parameters, md, "first_layer");
-    MeshModel* second = layerFrom(parameters, md, "second_layer");
-    if (!first || !second) throw InvalidInputError("choose the two layers to stitch");
-    if (first == second)
-      throw InvalidInputError("the same layer (" + layerName(*first) +
-                              ") was chosen twice: choose two layers, or the mode 'Two paths "
-                              "on the current layer'");
-    layers = {first, second};
-    reportProgress(options.progress, 0, "MeshMend: reading the layers");
-    Mesh a, b;
-    toCore(first->cm, a, {0, true});  // one frame: the layer matrices applied
-    toCore(second->cm, b, {1, true});
-    requireFacesAndFiniteCoordinates(a, layerName(*first));
-    requireFacesAndFiniteCoordinates(b, layerName(*second));
-    const IndexMap mapA = indexMapOf(a, first->cm), mapB = indexMapOf(b, second->cm);
-    options.a =
-        listA.empty()
-            ? selectedBorderPaths(a, first->cm, *first, 1).front()
-            : pathFromList(toCoreVertices(parseIndices(listA, "path_a"), mapA, *first, "path_a"));
-    // Path b in the joined mesh: after a's vertices.
-    options.b =
-        listB.empty()
-            ? selectedBorderPaths(b, second->cm, *second, 1).front()
-            : pathFromList(toCoreVertices(parseIndices(listB, "path_b"), mapB, *second, "path_b"));
-    for (int& v : options.b.vertices) v += int(a.vert.size());
-    core.reset(new Mesh(appended(a, b)));
-  } else {
-    MeshModel* model = md.mm();
-    if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
-    layers = {model};
-    reportProgress(options.progress, 0, "MeshMend: reading the layer");
-    core = std::make_unique<Mesh>();
-    toCore(model->cm, *core);
-    requireFacesAndFiniteCoordinates(*core, layerName(*model));
+StitchInput readCurrentLayer(MeshDocument& md, const StitchOptions& options) {
+  MeshModel* model = md.mm();
+  if (!model) throw InvalidInputError("there is no current layer: open a mesh first");
+  reportProgress(options.progress, 0, "MeshMend: reading the layer");
+  StitchInput in;
+  in.layers = {model};
+  in.core = std::make_unique<Mesh>();
+  toCore(model->cm, *in.core);
+  requireFacesAndFiniteCoordinates(*in.core, layerName(*model));
+  return in;
+}
+
+// Two paths on the current layer: path_a and path_b, or the two runs of
+// selected border vertices.
+void pathsOnOneLayer(const RichParameterList& parameters, Mesh& core, MeshModel& current,
+                     StitchOptions& options) {
+  const std::string listA = toStd(parameters.getString("path_a"));
+  const std::string listB = toStd(parameters.getString("path_b"));
+  if (listA.empty() != listB.empty())
+    throw InvalidInputError(
+        "give both path_a and path_b, or neither (then the selected border vertices form the "
+        "two paths)");
+  if (listA.empty()) {
+    const std::vector<BorderPath> paths = selectedBorderPaths(core, current.cm, current, 2);
+    options.a = paths[0];
+    options.b = paths[1];
+    return;
   }
+  const IndexMap map = indexMapOf(core, current.cm);
+  options.a = pathFromList(toCoreVertices(parseIndices(listA, "path_a"), map, current, "path_a"));
+  options.b = pathFromList(toCoreVertices(parseIndices(listB, "path_b"), map, current, "path_b"));
+}
+
+// Several paths in sequence: 'paths' (or every run of selected border
+// vertices) stitched pairwise as 'stitch_pairs' says.
+StitchSequenceOptions sequenceOptionsFrom(const RichParameterList& parameters, Mesh& core,
+                                          MeshModel& current, const StitchOptions& options) {
+  StitchSequenceOptions so;
+  so.stitch = options;
+  const std::string listed = toStd(parameters.getString("paths"));
+  if (listed.empty()) {
+    so.paths = selectedBorderPaths(core, current.cm, current, 0);
+  } else {
+    const IndexMap map = indexMapOf(core, current.cm);
+    for (const std::vector<int>& list : parseLists(listed, "paths"))
+      so.paths.push_back(pathFromList(toCoreVertices(list, map, current, "paths")));
+  }
+  const std::string pairsText = toStd(parameters.getString("stitch_pairs"));
+  if (pairsText.empty()) {
+    for (std::size_t k = 0; k + 1 < so.paths.size(); k += 2)
+      so.pairs.push_back({int(k), int(k + 1)});
+  } else {
+    for (const std::vector<int>& pair : parseLists(pairsText, "stitch_pairs")) {
+      if (pair.size() != 2)
+        throw InvalidInputError("stitch_pairs: each pair is two path numbers ('0 1; 2 4')");
+      for (int p : pair)
+        if (std::size_t(p) >= so.paths.size())
+          throw InvalidInputError("stitch_pairs names path " + std::to_string(p) + ", but " +
+                                  std::to_string(so.paths.size()) + " paths are given");
+      so.pairs.push_back({pair[0], pair[1]});
+    }
+  }
+  if (so.pairs.empty())
+    throw InvalidInputError("the sequence needs at least two paths (" +
+                            std::to_string(so.paths.size()) + " given)");
+  return so;
+}
+
+}  // namespace
+
+void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
+                          vcg::CallBackPos* cb) {
+  const int mode = parameters.getEnum("paths_from");
+  if (mode < 0 || mode > kSequence)
+    throw InvalidInputError("unknown path source " + std::to_string(mode) + ": use 0 to 2");
+  StitchOptions options = stitchOptionsFrom(parameters, cb);
+  StitchInput in = mode == kOnePathPerLayer ? readTwoLayers(md, parameters, options)
+                                            : readCurrentLayer(md, options);
+  const std::vector<MeshModel*>& layers = in.layers;
+  Mesh& core = *in.core;
   MeshModel& current = *layers.front();
-  const Mesh before = *core;
+  const Mesh before = core;
 
   JsonObject report;
   std::vector<int> newFaces;
   if (mode == kSequence) {
-    const IndexMap map = indexMapOf(*core, current.cm);
-    StitchSequenceOptions so;
-    so.stitch = options;
-    const std::string listed = toStd(parameters.getString("paths"));
-    if (listed.empty()) {
-      so.paths = selectedBorderPaths(*core, current.cm, current, 0);
-    } else {
-      for (const std::vector<int>& list : parseLists(listed, "paths"))
-        so.paths.push_back(pathFromList(toCoreVertices(list, map, current, "paths")));
-    }
+    const StitchSequenceOptions so = sequenceOptionsFrom(parameters, core, current, options);
     for (std::size_t k = 0; k < so.paths.size(); ++k)
       Log("  path %zu: %s", k, describePath(so.paths[k]).c_str());
-    const std::string pairsText = toStd(parameters.getString("stitch_pairs"));
-    if (pairsText.empty()) {
-      for (std::size_t k = 0; k + 1 < so.paths.size(); k += 2)
-        so.pairs.push_back({int(k), int(k + 1)});
-    } else {
-      for (const std::vector<int>& pair : parseLists(pairsText, "stitch_pairs")) {
-        if (pair.size() != 2)
-          throw InvalidInputError("stitch_pairs: each pair is two path numbers ('0 1; 2 4')");
-        for (int p : pair)
-          if (std::size_t(p) >= so.paths.size())
-            throw InvalidInputError("stitch_pairs names path " + std::to_string(p) + ", but " +
-                                    std::to_string(so.paths.size()) + " paths are given");
-        so.pairs.push_back({pair[0], pair[1]});
-      }
-    }
-    if (so.pairs.empty())
-      throw InvalidInputError("the sequence needs at least two paths (" +
-                              std::to_string(so.paths.size()) + " given)");
-    const StitchSequenceResult r = stitchPathsSequence(*core, so);
+    const StitchSequenceResult r = stitchPathsSequence(core, so);
     report = toJson(r);
     for (const StitchResult& s : r.steps)
       newFaces.insert(newFaces.end(), s.new_faces.begin(), s.new_faces.end());
@@ -658,24 +724,8 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
       for (const auto& c : r.concatenated[k])
         Log("  after stitch %zu: paths %d and %d concatenated at the junction", k, c[0], c[1]);
   } else {
-    if (mode == kTwoPathsOneLayer) {
-      const IndexMap map = indexMapOf(*core, current.cm);
-      if (listA.empty() != listB.empty())
-        throw InvalidInputError(
-            "give both path_a and path_b, or neither (then the selected border vertices form "
-            "the two paths)");
-      if (listA.empty()) {
-        const std::vector<BorderPath> paths = selectedBorderPaths(*core, current.cm, current, 2);
-        options.a = paths[0];
-        options.b = paths[1];
-      } else {
-        options.a =
-            pathFromList(toCoreVertices(parseIndices(listA, "path_a"), map, current, "path_a"));
-        options.b =
-            pathFromList(toCoreVertices(parseIndices(listB, "path_b"), map, current, "path_b"));
-      }
-    }
-    const StitchResult r = stitchPaths(*core, options);
+    if (mode == kTwoPathsOneLayer) pathsOnOneLayer(parameters, core, current, options);
+    const StitchResult r = stitchPaths(core, options);
     report = toJson(r);
     newFaces = r.new_faces;
     Log("MeshMend: stitched %s (%zu and %zu path vertices%s): %zu faces and %zu vertices added, "
@@ -692,7 +742,7 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
           kHostPrecision);
   }
   const EditContract contract = requireEditContract(
-      before, *core, "Stitch Boundaries",
+      before, core, "Stitch Boundaries",
       editContractOptions(options, parameters.getBool("keep_partial")),
       "Try paths that face each other, without subdivision (aspect ratio 0), or turn on 'Keep "
       "a partial result' to see what was made");
@@ -709,23 +759,21 @@ void StitchPlugin::stitch(MeshDocument& md, const RichParameterList& parameters,
   std::vector<LayerAttributes> attributes;
   for (MeshModel* m : layers) attributes.push_back(snapshot(*m));
   MeshModel* target = &current;
-  if (layers.size() == 2) {
-    if (output == kIntoFirstLayer) {
-      writeMesh(*core, attributes, current);
-      current.cm.Tr.SetIdentity();  // the geometry is in the common frame now
-      deleteLayer(md, layers[1]);
-      md.setCurrent(&current);
-      Log("  the result is in %s; the second layer was merged into it and removed",
-          layerName(current).c_str());
-    } else {
-      target = md.addNewMesh("", "stitched", true);
-      writeMesh(*core, attributes, *target);
-      target->cm.Tr.SetIdentity();
-      for (MeshModel* m : layers) setLayerVisible(*m, false);
-      Log("  the result is the new layer 'stitched'; the inputs are hidden, unchanged");
-    }
+  if (layers.size() == 2 && output == kIntoFirstLayer) {
+    writeMesh(core, attributes, current);
+    current.cm.Tr.SetIdentity();  // the geometry is in the common frame now
+    deleteLayer(md, layers[1]);
+    md.setCurrent(&current);
+    Log("  the result is in %s; the second layer was merged into it and removed",
+        layerName(current).c_str());
+  } else if (layers.size() == 2) {
+    target = md.addNewMesh("", "stitched", true);
+    writeMesh(core, attributes, *target);
+    target->cm.Tr.SetIdentity();
+    for (MeshModel* m : layers) setLayerVisible(*m, false);
+    Log("  the result is the new layer 'stitched'; the inputs are hidden, unchanged");
   } else {
-    writeMesh(*core, attributes, current);
+    writeMesh(core, attributes, current);
   }
   if (parameters.getBool("select_new_faces")) selectOnly(target->cm, newFaces);
   logContract(*this, contract, *target);

@@ -175,6 +175,94 @@ class Neighbourhoods {
   std::vector<std::vector<int>> faces_;
 };
 
+// Why a hole is left open (empty: it is to be filled): its border, its
+// size against the limits, the selection.
+std::string reasonToSkip(const BorderLoop& loop, const HoleReport& report,
+                         const HoleFillOptions& options, double diagonal,
+                         const std::vector<int>& selected) {
+  const bool bySelection =
+      !options.selected_vertices.empty() || !options.selected_vertex_indices.empty();
+  auto isSelected = [&](int v) { return std::binary_search(selected.begin(), selected.end(), v); };
+  if (!loop.closed)
+    return "its border is not a closed loop: at vertex " + std::to_string(loop.broken_at) +
+           " the faces are non-manifold or inconsistently oriented (repair them first)";
+  if (loop.vertices.size() < 3)
+    return "a border of two edges (a slit between two faces): weld or stitch it instead";
+  if (options.max_boundary_edges > 0 && report.boundary_edges > options.max_boundary_edges)
+    return "larger than the limit: " + std::to_string(report.boundary_edges) + " > " +
+           std::to_string(options.max_boundary_edges) + " boundary edges";
+  if (options.max_diameter > 0 && report.diameter > options.max_diameter * diagonal)
+    return "wider than the limit: diameter " + std::to_string(report.diameter / diagonal) + " > " +
+           std::to_string(options.max_diameter) + " of the bounding box diagonal";
+  if (bySelection && std::none_of(loop.vertices.begin(), loop.vertices.end(), isSelected))
+    return "not selected (no selected vertex on its border)";
+  return "";
+}
+
+// A report per hole found; returns the holes to fill, with the region
+// around each whose faces its patch is checked against.
+std::vector<std::size_t> chooseHoles(const Mesh& mesh, const Surface& s, const BorderLoops& found,
+                                     const HoleFillOptions& options, HoleFillResult& result,
+                                     std::vector<Bounds>& regions) {
+  // The bounding box and the selection only when a limit needs them.
+  const double diagonal = options.max_diameter > 0 ? diagonalOf(mesh) : 0;
+  std::vector<int> selected = options.selected_vertex_indices;
+  for (std::size_t v = 0; v < options.selected_vertices.size(); ++v)
+    if (options.selected_vertices[v]) selected.push_back(int(v));
+  std::sort(selected.begin(), selected.end());
+  std::vector<std::size_t> toFill;
+  for (const BorderLoop& loop : found.loops) {
+    HoleReport report;
+    report.boundary = loop.vertices;
+    report.boundary_edges = loop.closed ? loop.vertices.size() : loop.vertices.size() - 1;
+    report.diameter = loopDiameter(mesh, loop.vertices);
+    report.reason = reasonToSkip(loop, report, options, diagonal, selected);
+    if (report.reason.empty()) {
+      toFill.push_back(result.holes.size());
+      Bounds box;
+      double length = 0;
+      for (std::size_t i = 0; i < loop.vertices.size(); ++i) {
+        const Point3& p = s.point(loop.vertices[i]);
+        box.add(p);
+        length += (s.point(loop.vertices[(i + 1) % loop.vertices.size()]) - p).Norm();
+      }
+      regions.push_back(
+          box.grown(0.25 * report.diameter + 2 * length / double(loop.vertices.size())));
+    }
+    result.holes.push_back(std::move(report));
+  }
+  return toFill;
+}
+
+// The output stage (output_stage.h) on the stored values: the pairs with a
+// new or split face counted exactly (new_intersecting_pairs, the patches'
+// checks confirmed), new vertices re-rounded where rounding made such a
+// pair cross (only where the checks were off), and every intersecting pair
+// of the result by the checker's rule (remaining_intersecting_pairs).
+void verifyStored(Surface& s, const HoleFillOptions& options, Scalar scalar,
+                  HoleFillResult& result) {
+  const auto verifyStart = Clock::now();
+  std::vector<Point3> points(s.vertexCount());
+  std::vector<Triangle> triangles(s.faceCount());
+  for (std::size_t v = 0; v < points.size(); ++v) points[v] = s.point(int(v));
+  for (std::size_t f = 0; f < triangles.size(); ++f) triangles[f] = s.corners(int(f));
+  std::vector<char> movable(points.size(), 0), changed(triangles.size(), 0);
+  for (std::size_t v = s.inputVertices(); v < points.size(); ++v) movable[v] = 1;
+  for (std::size_t f = s.inputFaces(); f < triangles.size(); ++f) changed[f] = 1;
+  for (int f : s.changedInputFaces()) changed[std::size_t(f)] = 1;
+  OutputStageOptions stage;
+  stage.scalar = scalar;
+  stage.progress = progressWithin(options.progress, 92, 96);
+  result.stored = storeNewPoints(points, triangles, movable, changed, stage);
+  for (std::size_t v = s.inputVertices(); v < points.size(); ++v) s.setNewPoint(int(v), points[v]);
+  result.new_intersecting_pairs = result.stored.crossing;
+  result.remaining_intersecting_pairs =
+      storedIntersectingPairs(MeshArrays{points, triangles}, scalar);
+  result.remaining_counted = true;
+  result.verified = true;
+  result.stage_ms.verify = msSince(verifyStart);
+}
+
 }  // namespace
 
 HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
@@ -206,52 +294,8 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     for (std::size_t i = 0; i < loop.faces.size(); ++i)
       s.setBorderFace(loop.vertices[i], loop.vertices[(i + 1) % loop.vertices.size()],
                       loop.faces[i]);
-
-  // Which holes to fill (the bounding box and the selection only when a limit needs them).
-  const double diagonal = options.max_diameter > 0 ? diagonalOf(mesh) : 0;
-  const bool bySelection =
-      !options.selected_vertices.empty() || !options.selected_vertex_indices.empty();
-  std::vector<int> selected = options.selected_vertex_indices;
-  for (std::size_t v = 0; v < options.selected_vertices.size(); ++v)
-    if (options.selected_vertices[v]) selected.push_back(int(v));
-  std::sort(selected.begin(), selected.end());
-  auto isSelected = [&](int v) { return std::binary_search(selected.begin(), selected.end(), v); };
-  std::vector<std::size_t> toFill;
   std::vector<Bounds> regions;
-  for (const BorderLoop& loop : found.loops) {
-    HoleReport report;
-    report.boundary = loop.vertices;
-    report.boundary_edges = loop.closed ? loop.vertices.size() : loop.vertices.size() - 1;
-    report.diameter = loopDiameter(mesh, loop.vertices);
-    if (!loop.closed)
-      report.reason = "its border is not a closed loop: at vertex " +
-                      std::to_string(loop.broken_at) +
-                      " the faces are non-manifold or inconsistently oriented (repair them first)";
-    else if (loop.vertices.size() < 3)
-      report.reason = "a border of two edges (a slit between two faces): weld or stitch it instead";
-    else if (options.max_boundary_edges > 0 && report.boundary_edges > options.max_boundary_edges)
-      report.reason = "larger than the limit: " + std::to_string(report.boundary_edges) + " > " +
-                      std::to_string(options.max_boundary_edges) + " boundary edges";
-    else if (options.max_diameter > 0 && report.diameter > options.max_diameter * diagonal)
-      report.reason = "wider than the limit: diameter " +
-                      std::to_string(report.diameter / diagonal) + " > " +
-                      std::to_string(options.max_diameter) + " of the bounding box diagonal";
-    else if (bySelection && std::none_of(loop.vertices.begin(), loop.vertices.end(), isSelected))
-      report.reason = "not selected (no selected vertex on its border)";
-    if (report.reason.empty()) {
-      toFill.push_back(result.holes.size());
-      Bounds box;
-      double length = 0;
-      for (std::size_t i = 0; i < loop.vertices.size(); ++i) {
-        const Point3& p = s.point(loop.vertices[i]);
-        box.add(p);
-        length += (s.point(loop.vertices[(i + 1) % loop.vertices.size()]) - p).Norm();
-      }
-      regions.push_back(
-          box.grown(0.25 * report.diameter + 2 * length / double(loop.vertices.size())));
-    }
-    result.holes.push_back(std::move(report));
-  }
+  const std::vector<std::size_t> toFill = chooseHoles(mesh, s, found, options, result, regions);
   if (toFill.empty()) {
     for (const HoleReport& r : result.holes) result.holes_skipped += !r.filled;
     reportProgress(options.progress, 100, "Done");
@@ -286,7 +330,6 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
     }
     report.time_ms = msSince(holeStart);
   }
-
   for (const HoleReport& r : result.holes) {
     if (r.filled) {
       ++result.holes_filled;
@@ -302,36 +345,9 @@ HoleFillResult fillHoles(Mesh& mesh, const HoleFillOptions& options) {
   // float for a float host): no pair with a new or split face crosses.
   result.verified = options.check_intersections;
   if (options.verify) {
-    // The output stage (output_stage.h) on the stored values: the pairs
-    // with a new or split face counted exactly (new_intersecting_pairs, the
-    // patches' checks confirmed), new vertices re-rounded where rounding
-    // made such a pair cross (only where the checks were off), and every
-    // intersecting pair of the result by the checker's rule
-    // (remaining_intersecting_pairs).
     reportProgress(options.progress, 92, "Checking the stored result");
-    const auto verifyStart = Clock::now();
-    std::vector<Point3> points(s.vertexCount());
-    std::vector<Triangle> triangles(s.faceCount());
-    for (std::size_t v = 0; v < points.size(); ++v) points[v] = s.point(int(v));
-    for (std::size_t f = 0; f < triangles.size(); ++f) triangles[f] = s.corners(int(f));
-    std::vector<char> movable(points.size(), 0), changed(triangles.size(), 0);
-    for (std::size_t v = s.inputVertices(); v < points.size(); ++v) movable[v] = 1;
-    for (std::size_t f = s.inputFaces(); f < triangles.size(); ++f) changed[f] = 1;
-    for (int f : s.changedInputFaces()) changed[std::size_t(f)] = 1;
-    OutputStageOptions stage;
-    stage.scalar = scalar;
-    stage.progress = progressWithin(options.progress, 92, 96);
-    result.stored = storeNewPoints(points, triangles, movable, changed, stage);
-    for (std::size_t v = s.inputVertices(); v < points.size(); ++v)
-      s.setNewPoint(int(v), points[v]);
-    result.new_intersecting_pairs = result.stored.crossing;
-    result.remaining_intersecting_pairs =
-        storedIntersectingPairs(MeshArrays{points, triangles}, scalar);
-    result.remaining_counted = true;
-    result.verified = true;
-    result.stage_ms.verify = msSince(verifyStart);
+    verifyStored(s, options, scalar, result);
   }
-
   reportProgress(options.progress, 97, "Writing");
   const auto writeStart = Clock::now();
   s.writeInto(mesh, result);

@@ -287,61 +287,72 @@ std::unordered_map<int, FaceTwins> twinsOf(const std::vector<Point3>& P,
   return result;
 }
 
-}  // namespace
+// What the stages of classifyPatches share: the mesh as arrays, each face's
+// part, the parts' winding number trees.
+struct Classification {
+  const FaceLabels& labels;
+  Patches& patches;
+  std::vector<Triangle> T;
+  std::vector<Point3> P;
+  std::vector<EdgeUse> uses;
+  std::vector<WindingTree> trees;  // per part
 
-void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patches) {
-  const std::vector<Triangle> T = trianglesOf(mesh);
-  const std::vector<Point3> P = positionsOf(mesh);
-  if (patches.patch_of_face.size() != T.size())
-    throw InvalidInputError("the patches were painted on another mesh");
-  auto partOf = [&](std::size_t f) { return labels.part.empty() ? 0 : labels.part[f]; };
-  std::vector<std::vector<int>> facesOfPart(patches.parts);
-  for (std::size_t f = 0; f < T.size(); ++f) facesOfPart[partOf(f)].push_back(int(f));
+  int partOf(std::size_t f) const { return labels.part.empty() ? 0 : labels.part[f]; }
+  Point3 centroid(int f) const { return (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0; }
+};
 
-  // A part is closed when none of its edges has a single face of the part.
+// A part is closed when none of its edges has a single face of the part.
+void findClosedParts(Classification& c) {
+  Patches& patches = c.patches;
   patches.part_closed.assign(patches.parts, true);
-  const std::vector<EdgeUse> uses = edgeUses(T);
+  const std::vector<EdgeUse>& uses = c.uses;
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
     std::vector<int> count(patches.parts, 0);
-    for (std::size_t k = i; k < j; ++k) ++count[partOf(uses[k].face)];
+    for (std::size_t k = i; k < j; ++k) ++count[c.partOf(uses[k].face)];
     for (int p = 0; p < patches.parts; ++p)
       if (count[p] == 1) patches.part_closed[p] = false;
     i = j;
   }
+}
 
-  std::vector<WindingTree> trees;
-  for (int p = 0; p < patches.parts; ++p) trees.emplace_back(P, T, facesOfPart[p]);
-
-  // Sample faces: the few largest of each patch, away from its edges where
-  // the winding number of a nearby surface changes fastest.
+// Sample faces: the few largest of each patch, away from its edges where
+// the winding number of a nearby surface changes fastest.
+std::vector<std::vector<int>> sampleFaces(const Classification& c) {
   constexpr std::size_t kSamples = 3;
+  const Patches& patches = c.patches;
   std::vector<std::vector<int>> samples(patches.patches.size());
-  {
-    std::vector<std::vector<std::pair<double, int>>> largest(patches.patches.size());
-    for (std::size_t f = 0; f < T.size(); ++f) {
-      auto& l = largest[patches.patch_of_face[f]];
-      const double area = normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm();
-      if (!(area > 0)) continue;
-      l.push_back({area, int(f)});
-      if (l.size() > 4 * kSamples) {
-        std::nth_element(l.begin(), l.begin() + kSamples, l.end(), std::greater<>());
-        l.resize(kSamples);
-      }
-    }
-    for (std::size_t id = 0; id < largest.size(); ++id) {
-      auto& l = largest[id];
-      std::sort(l.begin(), l.end(), std::greater<>());
-      for (std::size_t k = 0; k < l.size() && k < kSamples; ++k) samples[id].push_back(l[k].second);
-      if (samples[id].empty()) samples[id].push_back(patches.patches[id].first_face);
+  std::vector<std::vector<std::pair<double, int>>> largest(patches.patches.size());
+  for (std::size_t f = 0; f < c.T.size(); ++f) {
+    auto& l = largest[patches.patch_of_face[f]];
+    const double area = normalOf(c.P[c.T[f][0]], c.P[c.T[f][1]], c.P[c.T[f][2]]).Norm();
+    if (!(area > 0)) continue;
+    l.push_back({area, int(f)});
+    if (l.size() > 4 * kSamples) {
+      std::nth_element(l.begin(), l.begin() + kSamples, l.end(), std::greater<>());
+      l.resize(kSamples);
     }
   }
-  // Where parts overlap in a plane, each keeps its copy of the overlap: a
-  // sample face's twin in another part (the same corners) is that part's
-  // surface at the sample, whose own solid angle there is left out like
-  // the sample's, and whose orientation tells on which side that part lies.
-  const std::unordered_map<int, FaceTwins> twins = twinsOf(P, T, samples, partOf, patches.parts);
+  for (std::size_t id = 0; id < largest.size(); ++id) {
+    auto& l = largest[id];
+    std::sort(l.begin(), l.end(), std::greater<>());
+    for (std::size_t k = 0; k < l.size() && k < kSamples; ++k) samples[id].push_back(l[k].second);
+    if (samples[id].empty()) samples[id].push_back(patches.patches[id].first_face);
+  }
+  return samples;
+}
+
+// Each patch's winding number in every part: the median over its samples
+// (one odd sample is outvoted). Where parts overlap in a plane, each keeps
+// its copy of the overlap: a sample face's twin in another part (the same
+// corners) is that part's surface at the sample, whose own solid angle
+// there is left out like the sample's, and whose orientation tells on which
+// side that part lies (the samples' majority).
+void windingsAtSamples(Classification& c, const std::vector<std::vector<int>>& samples) {
+  Patches& patches = c.patches;
+  const std::unordered_map<int, FaceTwins> twins = twinsOf(
+      c.P, c.T, samples, [&](std::size_t f) { return c.partOf(f); }, patches.parts);
   parallelChunks(
       patches.patches.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
@@ -352,32 +363,33 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
           patch.coincident[patch.part] = 1;
           for (int p = 0; p < patches.parts; ++p) {
             std::vector<double> values;
-            int facing[3] = {0, 0,
-                             0};  // samples with a twin facing the other way, none, the same way
+            int facing[3] = {0, 0, 0};  // samples with a twin facing the other way, none, the same
             for (int f : samples[id]) {
-              const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
               const auto it = twins.find(f);
               const FaceTwins::Twin twin = it == twins.end() ? FaceTwins::Twin{} : it->second.in(p);
-              values.push_back(trees[p].at(c, twin.face >= 0 ? twin.face : f));
+              values.push_back(c.trees[p].at(c.centroid(f), twin.face >= 0 ? twin.face : f));
               if (p != patch.part) ++facing[twin.facing + 1];
             }
             std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-            patch.winding[p] = values[values.size() / 2];  // the median: one odd sample is outvoted
+            patch.winding[p] = values[values.size() / 2];
             if (p != patch.part)
-              patch.coincident[p] = std::int8_t(std::max_element(facing, facing + 3) - facing -
-                                                1);  // the samples' majority
+              patch.coincident[p] = std::int8_t(std::max_element(facing, facing + 3) - facing - 1);
           }
           patch.setSideWindings();
         }
       },
       4);
-  // A closed part whose faces point inward has winding number -1 inside:
-  // taken turned, its winding numbers and the sides its surface faces
-  // change sign.
+}
+
+// A closed part whose faces point inward has winding number -1 inside:
+// taken turned, its winding numbers and the sides its surface faces change
+// sign.
+void turnInsideOutParts(Classification& c) {
+  Patches& patches = c.patches;
   patches.part_inside_out.assign(patches.parts, false);
   std::vector<double> volume(patches.parts, 0);
-  for (std::size_t f = 0; f < T.size(); ++f)
-    volume[partOf(f)] += P[T[f][0]].dot(P[T[f][1]] ^ P[T[f][2]]);
+  for (std::size_t f = 0; f < c.T.size(); ++f)
+    volume[c.partOf(f)] += c.P[c.T[f][0]].dot(c.P[c.T[f][1]] ^ c.P[c.T[f][2]]);
   for (int p = 0; p < patches.parts; ++p) {
     if (!patches.part_closed[p] || !(volume[p] < 0)) continue;
     patches.part_inside_out[p] = true;
@@ -387,58 +399,67 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
       patch.setSideWindings();
     }
   }
+}
 
-  // A patch can lie on both sides of another part where that part is open:
-  // a curve that ends at the other part's border does not separate the
-  // patch (a closed mesh passing through a scan's hole). Faces spread over
-  // each patch reveal it; such a patch is split by classifying every face,
-  // along the level set where the other part's winding number crosses ½.
-  // Per part: inside it in front of the patch and behind it (on a part's
-  // surface, one side only), and whether the patch is on the union's surface.
-  auto statusOf = [&](const std::vector<double>& winding, const Patch& patch) {
-    Patch at = patch;
-    at.winding = winding;
-    at.setSideWindings();
-    std::vector<std::uint8_t> status(patches.parts + 1, 0);
-    for (int p = 0; p < patches.parts; ++p)
-      status[p] = std::uint8_t((at.windingInFront(p) > 0.5) | (at.windingBehind(p) > 0.5) << 1);
-    status[patches.parts] = at.onUnionSurface();
-    return status;
-  };
-  // A closed part's winding number is the same all over a patch that does
-  // not cross it: only the open parts' change from face to face.
-  if (std::all_of(patches.part_closed.begin(), patches.part_closed.end(), [](bool c) { return c; }))
-    return;
-  std::vector<std::vector<int>> facesOfPatch(patches.patches.size());
-  for (std::size_t f = 0; f < T.size(); ++f)
-    facesOfPatch[patches.patch_of_face[f]].push_back(int(f));
-  // On an open part's surface (a planar overlap), each face's own twin is
-  // left out, as for the samples.
-  std::vector<std::vector<int>> onOtherParts(1);
-  for (std::size_t id = 0; id < patches.patches.size(); ++id) {
-    const Patch& patch = patches.patches[id];
-    for (int p = 0; p < patches.parts; ++p)
-      if (p != patch.part && patch.coincident[p] != 0 && !patches.part_closed[p]) {
-        onOtherParts[0].insert(onOtherParts[0].end(), facesOfPatch[id].begin(),
-                               facesOfPatch[id].end());
-        break;
-      }
+// Per part: inside it in front of the patch and behind it (on a part's
+// surface, one side only), and whether the patch is on the union's surface.
+std::vector<std::uint8_t> statusOf(const std::vector<double>& winding, const Patch& patch,
+                                   int parts) {
+  Patch at = patch;
+  at.winding = winding;
+  at.setSideWindings();
+  std::vector<std::uint8_t> status(parts + 1, 0);
+  for (int p = 0; p < parts; ++p)
+    status[p] = std::uint8_t((at.windingInFront(p) > 0.5) | (at.windingBehind(p) > 0.5) << 1);
+  status[parts] = at.onUnionSurface();
+  return status;
+}
+
+// A face's winding numbers: its patch's for the closed parts, its own for
+// the open ones (on an open part's surface, a planar overlap, the face's
+// own twin left out, as for the samples).
+class FaceWindings {
+ public:
+  FaceWindings(const Classification& c, const std::vector<std::vector<int>>& facesOfPatch) : c_(c) {
+    const Patches& patches = c.patches;
+    std::vector<std::vector<int>> onOtherParts(1);
+    for (std::size_t id = 0; id < patches.patches.size(); ++id) {
+      const Patch& patch = patches.patches[id];
+      for (int p = 0; p < patches.parts; ++p)
+        if (p != patch.part && patch.coincident[p] != 0 && !patches.part_closed[p]) {
+          onOtherParts[0].insert(onOtherParts[0].end(), facesOfPatch[id].begin(),
+                                 facesOfPatch[id].end());
+          break;
+        }
+    }
+    if (!onOtherParts[0].empty())
+      twins_ = twinsOf(
+          c.P, c.T, onOtherParts, [&](std::size_t f) { return c.partOf(f); }, patches.parts);
   }
-  const std::unordered_map<int, FaceTwins> faceTwins =
-      onOtherParts[0].empty() ? std::unordered_map<int, FaceTwins>()
-                              : twinsOf(P, T, onOtherParts, partOf, patches.parts);
-  auto windingAt = [&](int f) {
+
+  std::vector<double> at(int f) const {
+    const Patches& patches = c_.patches;
     std::vector<double> w = patches.patches[patches.patch_of_face[f]].winding;
-    const Point3 c = (P[T[f][0]] + P[T[f][1]] + P[T[f][2]]) / 3.0;
-    const auto twins = faceTwins.find(f);
+    const auto twins = twins_.find(f);
     for (int p = 0; p < patches.parts; ++p) {
       if (patches.part_closed[p]) continue;
-      const int twin = twins == faceTwins.end() ? -1 : twins->second.in(p).face;
-      w[p] = trees[p].at(c, twin >= 0 ? twin : f);
+      const int twin = twins == twins_.end() ? -1 : twins->second.in(p).face;
+      w[p] = c_.trees[p].at(c_.centroid(f), twin >= 0 ? twin : f);
     }
     return w;
-  };
+  }
+
+ private:
+  const Classification& c_;
+  std::unordered_map<int, FaceTwins> twins_;
+};
+
+// Patches whose faces do not all share their status: probed at a few faces
+// spread over each.
+std::vector<char> mixedPatches(const Classification& c, const FaceWindings& windings,
+                               const std::vector<std::vector<int>>& facesOfPatch) {
   constexpr std::size_t kProbes = 32;
+  const Patches& patches = c.patches;
   std::vector<char> mixed(patches.patches.size(), 0);
   parallelChunks(
       patches.patches.size(),
@@ -446,31 +467,40 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
         for (std::size_t id = begin; id < end; ++id) {
           const std::vector<int>& faces = facesOfPatch[id];
           const Patch& patch = patches.patches[id];
-          const std::vector<std::uint8_t> status = statusOf(patch.winding, patch);
+          const std::vector<std::uint8_t> status = statusOf(patch.winding, patch, patches.parts);
           const std::size_t step = std::max<std::size_t>(1, faces.size() / kProbes);
           for (std::size_t k = step / 2; k < faces.size() && !mixed[id]; k += step)
-            mixed[id] = statusOf(windingAt(faces[k]), patch) != status;
+            mixed[id] = statusOf(windings.at(faces[k]), patch, patches.parts) != status;
         }
       },
       1);
-  std::vector<int> refine;  // faces of mixed patches
-  for (std::size_t id = 0; id < mixed.size(); ++id)
-    if (mixed[id]) refine.insert(refine.end(), facesOfPatch[id].begin(), facesOfPatch[id].end());
-  if (refine.empty()) return;
-  std::vector<std::vector<double>> faceWinding(T.size());
-  std::vector<std::vector<std::uint8_t>> faceStatus(T.size());
+  return mixed;
+}
+
+// The faces of the mixed patches classified one by one and joined into
+// pieces of one status; each piece becomes a patch (the piece with the
+// patch's first face keeps its id), with the mean winding numbers of its
+// faces.
+void splitMixed(Classification& c, const FaceWindings& windings, const std::vector<char>& mixed,
+                const std::vector<int>& refine) {
+  Patches& patches = c.patches;
+  const std::size_t nf = c.T.size();
+  std::vector<std::vector<double>> faceWinding(nf);
+  std::vector<std::vector<std::uint8_t>> faceStatus(nf);
   parallelChunks(
       refine.size(),
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t i = begin; i < end; ++i) {
           const int f = refine[i];
-          faceWinding[f] = windingAt(f);
-          faceStatus[f] = statusOf(faceWinding[f], patches.patches[patches.patch_of_face[f]]);
+          faceWinding[f] = windings.at(f);
+          faceStatus[f] =
+              statusOf(faceWinding[f], patches.patches[patches.patch_of_face[f]], patches.parts);
         }
       },
       256);
-  std::vector<int> parent(T.size());
+  std::vector<int> parent(nf);
   std::iota(parent.begin(), parent.end(), 0);
+  const std::vector<EdgeUse>& uses = c.uses;
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
@@ -484,13 +514,10 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
     }
     i = j;
   }
-  // Each piece becomes a patch (the piece with the patch's first face keeps
-  // its id), with the mean winding numbers of its faces.
   std::unordered_map<int, int> idOfRoot;
   for (int f : refine) {
     const int root = find(parent, f);
     auto [it, added] = idOfRoot.emplace(root, -1);
-    Patch* patch = nullptr;
     if (added) {
       const int old = patches.patch_of_face[f];
       if (patches.patches[old].first_face == root) {
@@ -500,23 +527,62 @@ void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patche
         patches.patches.push_back(patches.patches[old]);
         patches.patches.back().first_face = root;
       }
-      patch = &patches.patches[it->second];
-      patch->faces = 0;
-      patch->area = 0;
-      patch->winding.assign(patches.parts, 0);
+      Patch& fresh = patches.patches[it->second];
+      fresh.faces = 0;
+      fresh.area = 0;
+      fresh.winding.assign(patches.parts, 0);
     }
-    patch = &patches.patches[it->second];
+    Patch& patch = patches.patches[it->second];
     patches.patch_of_face[f] = it->second;
-    ++patch->faces;
-    patch->area += normalOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]).Norm() / 2;
-    for (int p = 0; p < patches.parts; ++p) patch->winding[p] += faceWinding[f][p];
+    ++patch.faces;
+    patch.area += normalOf(c.P[c.T[f][0]], c.P[c.T[f][1]], c.P[c.T[f][2]]).Norm() / 2;
+    for (int p = 0; p < patches.parts; ++p) patch.winding[p] += faceWinding[f][p];
   }
   for (const auto& [root, id] : idOfRoot) {
     Patch& patch = patches.patches[id];
     for (double& w : patch.winding) w /= double(patch.faces);
     patch.setSideWindings();
   }
+}
+
+// A patch can lie on both sides of another part where that part is open:
+// a curve that ends at the other part's border does not separate the patch
+// (a closed mesh passing through a scan's hole). Faces spread over each
+// patch reveal it; such a patch is split by classifying every face, along
+// the level set where the other part's winding number crosses ½. A closed
+// part's winding number is the same all over a patch that does not cross
+// it: only the open parts' change from face to face.
+void splitAtOpenParts(Classification& c) {
+  Patches& patches = c.patches;
+  if (std::all_of(patches.part_closed.begin(), patches.part_closed.end(), [](bool x) { return x; }))
+    return;
+  std::vector<std::vector<int>> facesOfPatch(patches.patches.size());
+  for (std::size_t f = 0; f < c.T.size(); ++f)
+    facesOfPatch[patches.patch_of_face[f]].push_back(int(f));
+  const FaceWindings windings(c, facesOfPatch);
+  const std::vector<char> mixed = mixedPatches(c, windings, facesOfPatch);
+  std::vector<int> refine;  // faces of mixed patches
+  for (std::size_t id = 0; id < mixed.size(); ++id)
+    if (mixed[id]) refine.insert(refine.end(), facesOfPatch[id].begin(), facesOfPatch[id].end());
+  if (refine.empty()) return;
+  splitMixed(c, windings, mixed, refine);
   patches.patches_split_at_open_parts = std::count(mixed.begin(), mixed.end(), 1);
+}
+
+}  // namespace
+
+void classifyPatches(const Mesh& mesh, const FaceLabels& labels, Patches& patches) {
+  Classification c{labels, patches, trianglesOf(mesh), positionsOf(mesh), {}, {}};
+  if (patches.patch_of_face.size() != c.T.size())
+    throw InvalidInputError("the patches were painted on another mesh");
+  c.uses = edgeUses(c.T);
+  findClosedParts(c);
+  std::vector<std::vector<int>> facesOfPart(patches.parts);
+  for (std::size_t f = 0; f < c.T.size(); ++f) facesOfPart[c.partOf(f)].push_back(int(f));
+  for (int p = 0; p < patches.parts; ++p) c.trees.emplace_back(c.P, c.T, facesOfPart[p]);
+  windingsAtSamples(c, sampleFaces(c));
+  turnInsideOutParts(c);
+  splitAtOpenParts(c);
 }
 
 const char* toString(BooleanOperation op) {

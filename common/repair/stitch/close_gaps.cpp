@@ -244,6 +244,75 @@ void orientConsistently(const std::vector<Point3>& P, std::vector<Triangle>& T,
     }
 }
 
+// Around an edge where more than two border edges coincide (from class lo
+// to class hi): each use's face apex at an angle; a face running lo -> hi
+// faces towards larger angles, so its inside is its predecessor, which must
+// run hi -> lo. `uses` are the border edges there.
+void requestsAround(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                    const std::vector<int>& classOf, const std::vector<BorderEdge>& border, int lo,
+                    const std::vector<int>& uses, std::vector<std::array<int, 2>>& requests) {
+  const BorderEdge& first = border[uses[0]];
+  const Point3 origin = P[classOf[first.from] == lo ? first.from : first.to];
+  Point3 axis = P[classOf[first.from] == lo ? first.to : first.from] - origin;
+  axis.Normalize();
+  Point3 u = std::abs(axis[0]) < 0.9 ? Point3(1, 0, 0) ^ axis : Point3(0, 1, 0) ^ axis;
+  u.Normalize();
+  const Point3 w = axis ^ u;
+  struct Around {
+    double angle;
+    int edge;
+    bool forward;
+  };
+  std::vector<Around> around;
+  for (int edge : uses) {
+    const BorderEdge& e = border[edge];
+    const Triangle& t = T[e.face];
+    const int apex = t[0] != e.from && t[0] != e.to   ? t[0]
+                     : t[1] != e.from && t[1] != e.to ? t[1]
+                                                      : t[2];
+    const Point3 d = P[apex] - origin;
+    around.push_back({std::atan2(d * w, d * u), edge, classOf[e.from] == lo});
+  }
+  std::sort(around.begin(), around.end(),
+            [](const Around& x, const Around& y) { return x.angle < y.angle; });
+  for (std::size_t k = 0; k < around.size(); ++k) {
+    const Around& behind = around[(k + around.size() - 1) % around.size()];
+    if (around[k].forward && !behind.forward) requests.push_back({around[k].edge, behind.edge});
+  }
+}
+
+// The merges to try: pairs of border edges between the same two classes
+// running opposite ways, or one edge to collapse (second -1).
+std::vector<std::array<int, 2>> mergeRequests(const std::vector<Point3>& P,
+                                              const std::vector<Triangle>& T,
+                                              const std::vector<int>& classOf,
+                                              const std::vector<BorderEdge>& border) {
+  std::vector<std::array<int, 2>> requests;
+  for (std::size_t e = 0; e < border.size(); ++e)
+    if (classOf[border[e].from] == classOf[border[e].to]) requests.push_back({int(e), -1});
+  std::vector<std::pair<std::uint64_t, int>> byKey;
+  for (std::size_t e = 0; e < border.size(); ++e) {
+    const int a = classOf[border[e].from], b = classOf[border[e].to];
+    if (a != b) byKey.push_back({undirectedKey(a, b), int(e)});
+  }
+  std::sort(byKey.begin(), byKey.end());
+  for (std::size_t i = 0; i < byKey.size();) {
+    std::size_t j = i + 1;
+    while (j < byKey.size() && byKey[j].first == byKey[i].first) ++j;
+    if (j - i == 2) {
+      const BorderEdge &x = border[byKey[i].second], &y = border[byKey[i + 1].second];
+      if (classOf[x.from] == classOf[y.to])
+        requests.push_back({byKey[i].second, byKey[i + 1].second});
+    } else if (j - i > 2) {
+      std::vector<int> uses;
+      for (std::size_t k = i; k < j; ++k) uses.push_back(byKey[k].second);
+      requestsAround(P, T, classOf, border, int(byKey[i].first >> 32), uses, requests);
+    }
+    i = j;
+  }
+  return requests;
+}
+
 // Step 1: border edges that coincide (within the tolerance) and run
 // opposite ways become one edge, and border edges whose ends coincide
 // collapse (their face, of zero area within the tolerance, goes). Where
@@ -261,63 +330,7 @@ void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>&
   std::iota(target.begin(), target.end(), 0);
   removedFace.assign(T.size(), 0);
   const std::vector<BorderEdge> border = borderEdgesDirected(T);
-  // Requested merges: pairs of border edges, or one edge to collapse (e2 < 0).
-  std::vector<std::array<int, 2>> requests;
-  for (std::size_t e = 0; e < border.size(); ++e)
-    if (classOf[border[e].from] == classOf[border[e].to]) requests.push_back({int(e), -1});
-  {
-    std::vector<std::pair<std::uint64_t, int>> byKey;
-    for (std::size_t e = 0; e < border.size(); ++e) {
-      const int a = classOf[border[e].from], b = classOf[border[e].to];
-      if (a != b) byKey.push_back({undirectedKey(a, b), int(e)});
-    }
-    std::sort(byKey.begin(), byKey.end());
-    for (std::size_t i = 0; i < byKey.size();) {
-      std::size_t j = i + 1;
-      while (j < byKey.size() && byKey[j].first == byKey[i].first) ++j;
-      const std::size_t count = j - i;
-      if (count == 2) {
-        const BorderEdge &x = border[byKey[i].second], &y = border[byKey[i + 1].second];
-        if (classOf[x.from] == classOf[y.to])
-          requests.push_back({byKey[i].second, byKey[i + 1].second});
-      } else if (count > 2) {
-        // Around the edge from class lo to class hi: each use's face apex at
-        // an angle; a face running lo -> hi faces towards larger angles,
-        // so its inside is its predecessor, which must run hi -> lo.
-        const int lo = int(byKey[i].first >> 32);
-        const BorderEdge& first = border[byKey[i].second];
-        const Point3 origin = P[classOf[first.from] == lo ? first.from : first.to];
-        Point3 axis = P[classOf[first.from] == lo ? first.to : first.from] - origin;
-        axis.Normalize();
-        Point3 u = std::abs(axis[0]) < 0.9 ? Point3(1, 0, 0) ^ axis : Point3(0, 1, 0) ^ axis;
-        u.Normalize();
-        const Point3 w = axis ^ u;
-        struct Around {
-          double angle;
-          int edge;
-          bool forward;
-        };
-        std::vector<Around> around;
-        for (std::size_t k = i; k < j; ++k) {
-          const BorderEdge& e = border[byKey[k].second];
-          const Triangle& t = T[e.face];
-          const int apex = t[0] != e.from && t[0] != e.to   ? t[0]
-                           : t[1] != e.from && t[1] != e.to ? t[1]
-                                                            : t[2];
-          const Point3 d = P[apex] - origin;
-          around.push_back({std::atan2(d * w, d * u), byKey[k].second, classOf[e.from] == lo});
-        }
-        std::sort(around.begin(), around.end(),
-                  [](const Around& x, const Around& y) { return x.angle < y.angle; });
-        for (std::size_t k = 0; k < around.size(); ++k) {
-          const Around& behind = around[(k + around.size() - 1) % around.size()];
-          if (around[k].forward && !behind.forward)
-            requests.push_back({around[k].edge, behind.edge});
-        }
-      }
-      i = j;
-    }
-  }
+  const std::vector<std::array<int, 2>> requests = mergeRequests(P, T, classOf, border);
   if (requests.empty()) return;
 
   // Faces per vertex (a merged vertex's go to the vertex it joins).
@@ -445,38 +458,60 @@ void mergeCoincidentBorders(const std::vector<Point3>& P, std::vector<Triangle>&
 // the mean length of the border edges at either vertex, whichever is
 // smaller (at most four times the typical local bound: a few long border
 // edges do not widen the search everywhere).
-std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::vector<Triangle>& T,
-                                     double bound, double localFactor, int minPathVertices) {
-  const BorderLoops found = findBorderLoops(P, T);
-  const std::vector<BorderLoop>& loops = found.loops;
+// The border loops with what the search for facing runs needs per vertex:
+// its loop and place there, the arc length along each loop, the direction
+// across the border (away from its faces, in their planes) and the mean
+// length of its border edges.
+struct BorderGeometry {
+  BorderLoops found;
+  std::vector<int> loopOf, positionOf;
+  std::vector<int> ids;                  // border vertices, each once
+  std::vector<std::vector<double>> arc;  // per loop: arc length from its start
+  std::vector<Point3> outward;
+  std::vector<double> borderLength;
+  std::vector<int> borderEdges;
+
+  const std::vector<BorderLoop>& loops() const { return found.loops; }
+  double alongLoop(int l, int i, int j) const {
+    const double d = std::abs(arc[l][i] - arc[l][j]);
+    return found.loops[l].closed ? std::min(d, arc[l].back() - d) : d;
+  }
+  double localBound(int v, double factor) const {
+    return borderEdges[v] > 0 ? factor * borderLength[v] / borderEdges[v] : 0.0;
+  }
+};
+
+BorderGeometry borderGeometry(const std::vector<Point3>& P, const std::vector<Triangle>& T) {
+  BorderGeometry b;
+  b.found = findBorderLoops(P, T);
+  const std::vector<BorderLoop>& loops = b.found.loops;
   const std::size_t n = P.size();
-  std::vector<int> loopOf(n, -1), positionOf(n, -1);
-  std::vector<int> ids;
-  std::vector<std::vector<double>> arc(loops.size());  // arc length from the loop's start
+  b.loopOf.assign(n, -1);
+  b.positionOf.assign(n, -1);
+  b.arc.resize(loops.size());
   for (std::size_t l = 0; l < loops.size(); ++l) {
     const std::vector<int>& loop = loops[l].vertices;
-    arc[l].assign(loop.size() + 1, 0);
+    b.arc[l].assign(loop.size() + 1, 0);
     for (std::size_t k = 0; k < loop.size(); ++k) {
-      if (loopOf[loop[k]] < 0) {
-        loopOf[loop[k]] = int(l);
-        positionOf[loop[k]] = int(k);
-        ids.push_back(loop[k]);
+      if (b.loopOf[loop[k]] < 0) {
+        b.loopOf[loop[k]] = int(l);
+        b.positionOf[loop[k]] = int(k);
+        b.ids.push_back(loop[k]);
       }
       const int next = loop[(k + 1) % loop.size()];
       const bool wraps = k + 1 == loop.size();
-      arc[l][k + 1] = arc[l][k] + (wraps && !loops[l].closed ? 0.0 : (P[next] - P[loop[k]]).Norm());
+      b.arc[l][k + 1] =
+          b.arc[l][k] + (wraps && !loops[l].closed ? 0.0 : (P[next] - P[loop[k]]).Norm());
     }
   }
-  // Across each border edge, away from its face, in the face's plane; and
-  // the lengths of the border edges at each vertex.
-  std::vector<Point3> outward(n, Point3(0, 0, 0));
-  std::vector<double> borderLength(n, 0);
-  std::vector<int> borderEdges(n, 0);
+  b.outward.assign(n, Point3(0, 0, 0));
+  b.borderLength.assign(n, 0);
+  b.borderEdges.assign(n, 0);
   for (const BorderEdge& e : borderEdgesDirected(T)) {
     const double edgeLength = (P[e.to] - P[e.from]).Norm();
     for (const int v : {e.from, e.to}) {
-      borderLength[v] += edgeLength;
-      ++borderEdges[v];
+      b.borderLength[v] += edgeLength;
+      ++b.borderEdges[v];
     }
     const Triangle& t = T[e.face];
     const Point3 normal = (P[t[1]] - P[t[0]]) ^ (P[t[2]] - P[t[0]]);
@@ -484,17 +519,18 @@ std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::ve
     const double length = across.Norm();
     if (length > 0) {
       across /= length;
-      outward[e.from] += across;
-      outward[e.to] += across;
+      b.outward[e.from] += across;
+      b.outward[e.to] += across;
     }
   }
-  auto alongLoop = [&](int l, int i, int j) {
-    const double d = std::abs(arc[l][i] - arc[l][j]);
-    return loops[l].closed ? std::min(d, arc[l].back() - d) : d;
-  };
-  auto localBound = [&](int v) {
-    return borderEdges[v] > 0 ? localFactor * borderLength[v] / borderEdges[v] : 0.0;
-  };
+  return b;
+}
+
+// Each border vertex's partner (-1: none): its nearest border vertex within
+// the bound in front of it, on another loop or far along its own.
+std::vector<int> partnersOf(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                            const BorderGeometry& b, double bound, double localFactor) {
+  const std::size_t n = P.size();
   // Parts: vertices joined through faces.
   std::vector<int> part(n);
   std::iota(part.begin(), part.end(), 0);
@@ -506,127 +542,146 @@ std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::ve
     for (int k = 1; k < 3; ++k) part[partOf(t[k])] = partOf(t[0]);
   // The grid's cell: the bound, or the typical (median) local bound if larger.
   double cell = bound;
-  if (localFactor > 0 && !ids.empty()) {
+  if (localFactor > 0 && !b.ids.empty()) {
     std::vector<double> locals;
-    for (int v : ids) locals.push_back(localBound(v));
+    for (int v : b.ids) locals.push_back(b.localBound(v, localFactor));
     std::nth_element(locals.begin(), locals.begin() + locals.size() / 2, locals.end());
     cell = std::max(cell, locals[locals.size() / 2]);
   }
-  if (!(cell > 0)) return {};
-  const NearPoints near(P, ids, cell);
   std::vector<int> partnerOf(n, -1);
-  for (int v : ids) {
+  if (!(cell > 0)) return partnerOf;
+  const NearPoints near(P, b.ids, cell);
+  for (int v : b.ids) {
     double best = INFINITY;
-    const int l = loopOf[v];
-    const double radius = std::min(std::max(bound, localBound(v)), 4 * cell);
+    const int l = b.loopOf[v];
+    const double localV = b.localBound(v, localFactor);
+    const double radius = std::min(std::max(bound, localV), 4 * cell);
     near.near(P[v], radius, [&](int w) {
       if (w == v) return;
       const Point3 d = P[w] - P[v];
       const double distance = d.Norm();
       if (distance > bound &&
-          (partOf(v) != partOf(w) || distance > std::min(localBound(v), localBound(w))))
+          (partOf(v) != partOf(w) || distance > std::min(localV, b.localBound(w, localFactor))))
         return;
-      if (loopOf[w] == l) {
-        const double along = alongLoop(l, positionOf[v], positionOf[w]);
+      if (b.loopOf[w] == l) {
+        const double along = b.alongLoop(l, b.positionOf[v], b.positionOf[w]);
         if (along <= 0 || along < 2 * distance) return;
       }
-      const double facing = d * outward[v];
-      if (facing < -0.2 * distance * outward[v].Norm()) return;
+      const double facing = d * b.outward[v];
+      if (facing < -0.2 * distance * b.outward[v].Norm()) return;
       if (distance < best) best = distance, partnerOf[v] = w;
     });
   }
-  // Runs of loop l whose partners are on loop `other`, in the loop's order.
-  auto runsOf = [&](int l, int other) {
-    std::vector<std::vector<int>> runs;
-    const std::vector<int>& loop = loops[l].vertices;
-    const std::size_t m = loop.size();
-    auto facing = [&](std::size_t k) {
-      const int w = partnerOf[loop[k % m]];
-      return w >= 0 && loopOf[w] == other;
-    };
-    std::size_t first = 0;
-    if (loops[l].closed) {
-      while (first < m && facing(first)) ++first;
-      if (first == m) return std::vector<std::vector<int>>{loop};  // the whole loop
-    }
-    const std::size_t end = loops[l].closed ? first + m : m;
-    for (std::size_t k = first; k < end; ++k) {
-      if (!facing(k)) continue;
-      std::vector<int> run;
-      while (k < end && facing(k)) run.push_back(loop[k++ % m]);
-      runs.push_back(run);
-    }
-    return runs;
+  return partnerOf;
+}
+
+// Runs of loop l whose partners are on loop `other`, in the loop's order.
+std::vector<std::vector<int>> runsFacing(const BorderGeometry& b, const std::vector<int>& partnerOf,
+                                         int l, int other) {
+  std::vector<std::vector<int>> runs;
+  const BorderLoop& loop = b.loops()[l];
+  const std::size_t m = loop.vertices.size();
+  auto facing = [&](std::size_t k) {
+    const int w = partnerOf[loop.vertices[k % m]];
+    return w >= 0 && b.loopOf[w] == other;
   };
-  std::vector<std::array<int, 2>> loopPairs;
-  {
-    std::set<std::array<int, 2>> seen;
-    for (int v : ids)
-      if (const int w = partnerOf[v]; w >= 0) {
-        const std::array<int, 2> key{std::min(loopOf[v], loopOf[w]),
-                                     std::max(loopOf[v], loopOf[w])};
-        if (seen.insert(key).second) loopPairs.push_back(key);
-      }
+  std::size_t first = 0;
+  if (loop.closed) {
+    while (first < m && facing(first)) ++first;
+    if (first == m) return {loop.vertices};  // the whole loop
   }
-  std::vector<GapReport> gaps;
-  for (const auto& [l1, l2] : loopPairs) {
-    const auto runs1 = runsOf(l1, l2);
-    const auto runs2 = l1 == l2 ? runs1 : runsOf(l2, l1);
-    const bool whole1 = runs1.size() == 1 && runs1[0].size() == loops[l1].vertices.size();
-    const bool whole2 = runs2.size() == 1 && runs2[0].size() == loops[l2].vertices.size();
-    std::unordered_map<int, int> runOf2;
-    for (std::size_t k = 0; k < runs2.size(); ++k)
-      for (int v : runs2[k]) runOf2[v] = int(k);
-    std::vector<char> taken(runs2.size(), 0);
-    for (std::size_t k1 = 0; k1 < runs1.size(); ++k1) {
-      if (l1 == l2 && taken[k1]) continue;
-      const std::vector<int>& run = runs1[k1];
-      std::vector<int> votes(runs2.size(), 0);
-      for (int v : run) {
-        const auto it = runOf2.find(partnerOf[v]);
-        if (it != runOf2.end()) ++votes[it->second];
-      }
-      if (l1 == l2) votes[k1] = 0;  // a run does not face itself
-      if (votes.empty()) continue;
-      const int k2 = int(std::max_element(votes.begin(), votes.end()) - votes.begin());
-      if (votes[k2] == 0 || taken[k2]) continue;
-      taken[k2] = 1;
-      if (l1 == l2) taken[k1] = 1;
-      GapReport g;
-      g.closed = l1 != l2 && whole1 && whole2;
-      g.path_a = run;
-      g.path_b = runs2[k2];
-      for (int v : g.path_a)
-        if (partnerOf[v] >= 0) g.gap = std::max(g.gap, (P[partnerOf[v]] - P[v]).Norm());
-      if (l1 != l2 && (whole1 || whole2) && !g.closed)
-        g.reason = "a whole border loop faces only part of another loop";
-      auto onLoop = [&](int v) { return loopOf[v] == l1; };
-      if (l1 == l2 && loops[l1].closed && onLoop(g.path_a.front()) && onLoop(g.path_a.back()) &&
-          onLoop(g.path_b.front()) && onLoop(g.path_b.back())) {
-        // a runs forward along the loop beside b running backward: a's
-        // start meets b's end, a's end meets b's start.
-        const std::vector<int>& loop = loops[l1].vertices;
-        const int m = int(loop.size());
-        auto at = [&](int k) { return loop[((k % m) + m) % m]; };
-        std::unordered_set<int> used(g.path_a.begin(), g.path_a.end());
-        used.insert(g.path_b.begin(), g.path_b.end());
-        const int p = at(positionOf[g.path_a.front()] - 1), q = at(positionOf[g.path_b.back()] + 1);
-        if (!used.count(p) && !used.count(q) && (p == q || at(positionOf[q] + 1) == p)) {
-          g.path_a.insert(g.path_a.begin(), p);
-          g.path_b.push_back(q);
-          used.insert(p);
-          used.insert(q);
-        }
-        const int s = at(positionOf[g.path_a.back()] + 1), t = at(positionOf[g.path_b.front()] - 1);
-        if (!used.count(s) && !used.count(t) && (s == t || at(positionOf[s] + 1) == t)) {
-          g.path_a.push_back(s);
-          g.path_b.insert(g.path_b.begin(), t);
-        }
-      }
-      if (int(std::min(g.path_a.size(), g.path_b.size())) < minPathVertices) continue;
-      gaps.push_back(g);
+  const std::size_t end = loop.closed ? first + m : m;
+  for (std::size_t k = first; k < end; ++k) {
+    if (!facing(k)) continue;
+    std::vector<int> run;
+    while (k < end && facing(k)) run.push_back(loop.vertices[k++ % m]);
+    runs.push_back(run);
+  }
+  return runs;
+}
+
+// On one closed loop, a runs forward beside b running backward: a's start
+// meets b's end, a's end meets b's start. Where they end one vertex or one
+// border edge short of a crack's tip, both are extended to it.
+void extendToCrackTips(const BorderGeometry& b, int l, GapReport& g) {
+  const std::vector<int>& loop = b.loops()[l].vertices;
+  const int m = int(loop.size());
+  auto at = [&](int k) { return loop[((k % m) + m) % m]; };
+  std::unordered_set<int> used(g.path_a.begin(), g.path_a.end());
+  used.insert(g.path_b.begin(), g.path_b.end());
+  const int p = at(b.positionOf[g.path_a.front()] - 1), q = at(b.positionOf[g.path_b.back()] + 1);
+  if (!used.count(p) && !used.count(q) && (p == q || at(b.positionOf[q] + 1) == p)) {
+    g.path_a.insert(g.path_a.begin(), p);
+    g.path_b.push_back(q);
+    used.insert(p);
+    used.insert(q);
+  }
+  const int s = at(b.positionOf[g.path_a.back()] + 1), t = at(b.positionOf[g.path_b.front()] - 1);
+  if (!used.count(s) && !used.count(t) && (s == t || at(b.positionOf[s] + 1) == t)) {
+    g.path_a.push_back(s);
+    g.path_b.insert(g.path_b.begin(), t);
+  }
+}
+
+// The gaps between loops l1 and l2 (the same loop for a crack): each run
+// of l1 faces the run of l2 holding most of its partners.
+void gapsBetween(const std::vector<Point3>& P, const BorderGeometry& b,
+                 const std::vector<int>& partnerOf, int l1, int l2, int minPathVertices,
+                 std::vector<GapReport>& gaps) {
+  const auto runs1 = runsFacing(b, partnerOf, l1, l2);
+  const auto runs2 = l1 == l2 ? runs1 : runsFacing(b, partnerOf, l2, l1);
+  const bool whole1 = runs1.size() == 1 && runs1[0].size() == b.loops()[l1].vertices.size();
+  const bool whole2 = runs2.size() == 1 && runs2[0].size() == b.loops()[l2].vertices.size();
+  std::unordered_map<int, int> runOf2;
+  for (std::size_t k = 0; k < runs2.size(); ++k)
+    for (int v : runs2[k]) runOf2[v] = int(k);
+  std::vector<char> taken(runs2.size(), 0);
+  for (std::size_t k1 = 0; k1 < runs1.size(); ++k1) {
+    if (l1 == l2 && taken[k1]) continue;
+    const std::vector<int>& run = runs1[k1];
+    std::vector<int> votes(runs2.size(), 0);
+    for (int v : run) {
+      const auto it = runOf2.find(partnerOf[v]);
+      if (it != runOf2.end()) ++votes[it->second];
     }
+    if (l1 == l2) votes[k1] = 0;  // a run does not face itself
+    if (votes.empty()) continue;
+    const int k2 = int(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    if (votes[k2] == 0 || taken[k2]) continue;
+    taken[k2] = 1;
+    if (l1 == l2) taken[k1] = 1;
+    GapReport g;
+    g.closed = l1 != l2 && whole1 && whole2;
+    g.path_a = run;
+    g.path_b = runs2[k2];
+    for (int v : g.path_a)
+      if (partnerOf[v] >= 0) g.gap = std::max(g.gap, (P[partnerOf[v]] - P[v]).Norm());
+    if (l1 != l2 && (whole1 || whole2) && !g.closed)
+      g.reason = "a whole border loop faces only part of another loop";
+    auto onLoop = [&](int v) { return b.loopOf[v] == l1; };
+    if (l1 == l2 && b.loops()[l1].closed && onLoop(g.path_a.front()) && onLoop(g.path_a.back()) &&
+        onLoop(g.path_b.front()) && onLoop(g.path_b.back()))
+      extendToCrackTips(b, l1, g);
+    if (int(std::min(g.path_a.size(), g.path_b.size())) < minPathVertices) continue;
+    gaps.push_back(g);
   }
+}
+
+std::vector<GapReport> facingBorders(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                                     double bound, double localFactor, int minPathVertices) {
+  const BorderGeometry b = borderGeometry(P, T);
+  const std::vector<int> partnerOf = partnersOf(P, T, b, bound, localFactor);
+  std::vector<std::array<int, 2>> loopPairs;
+  std::set<std::array<int, 2>> seen;
+  for (int v : b.ids)
+    if (const int w = partnerOf[v]; w >= 0) {
+      const std::array<int, 2> key{std::min(b.loopOf[v], b.loopOf[w]),
+                                   std::max(b.loopOf[v], b.loopOf[w])};
+      if (seen.insert(key).second) loopPairs.push_back(key);
+    }
+  std::vector<GapReport> gaps;
+  for (const auto& [l1, l2] : loopPairs)
+    gapsBetween(P, b, partnerOf, l1, l2, minPathVertices, gaps);
   return gaps;
 }
 

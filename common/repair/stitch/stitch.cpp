@@ -211,41 +211,28 @@ void rotate(std::vector<T>& v, std::size_t first) {
   std::rotate(v.begin(), v.begin() + first, v.end());
 }
 
-}  // namespace
-
-namespace stitch_detail {
-
-// topologyRead is called once the mesh's faces are no longer read (from
-// then on the plan reads the path vertices' coordinates and what it
-// gathered).
-StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
-                      const std::function<void()>& topologyRead) {
-  StitchPlan plan;
-  PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
-  constexpr char kOnA = 1, kOnB = 2;
-  std::vector<char> on(mesh.vert.size(), 0);
-  checkDistinct(mesh, A, on, kOnA, "a");
-  checkDistinct(mesh, B, on, kOnB, "b");
-  std::vector<int> all = A.v;
-  all.insert(all.end(), B.v.begin(), B.v.end());
-  const LocalEdges edges(mesh, all, true);
-  // Most path vertices are on a border edge of their path; the others are
-  // checked against all their edges.
-  {
-    std::vector<int> unsure;
-    for (int v : all)
+// Every path vertex must be on a border edge. Most are on a border edge of
+// their path; the others are checked against all their edges.
+void requireOnBorders(const Mesh& mesh, const PreparedPath& A, const PreparedPath& B,
+                      const LocalEdges& edges) {
+  std::vector<int> unsure;
+  for (const PreparedPath* p : {&A, &B})
+    for (int v : p->v)
       if (!edges.onBorder(v)) unsure.push_back(v);
-    if (!unsure.empty()) {
-      const LocalEdges full(mesh, unsure);
-      for (const auto* p : {&A, &B})
-        for (int v : p->v)
-          if (!edges.onBorder(v) && !full.onBorder(v))
-            throw InvalidInputError(describeVertex(mesh, v) + " of path " + (p == &A ? "a" : "b") +
-                                    " is not on a border edge: stitch paths must follow borders");
-    }
-  }
-  if (topologyRead) topologyRead();
-  // Auto shape: a path whose ends share a border edge goes all around.
+  if (unsure.empty()) return;
+  const LocalEdges full(mesh, unsure);
+  for (const PreparedPath* p : {&A, &B})
+    for (int v : p->v)
+      if (!edges.onBorder(v) && !full.onBorder(v))
+        throw InvalidInputError(describeVertex(mesh, v) + " of path " + (p == &A ? "a" : "b") +
+                                " is not on a border edge: stitch paths must follow borders");
+}
+
+// Both paths open or both closed (an Auto path whose ends share a border
+// edge goes all around); shared vertices only at the ends of open paths
+// (a crack closing at a point); each path oriented along its border.
+void settleShapes(const Mesh& mesh, const StitchOptions& o, PreparedPath& A, PreparedPath& B,
+                  const LocalEdges& edges, const std::vector<char>& on, char onA) {
   for (auto [p, path] : {std::make_pair(&A, &o.a), std::make_pair(&B, &o.b)})
     if (path->shape == BorderPath::Shape::Auto && !p->closed && p->v.size() >= 3 &&
         edges.uses(p->v.front(), p->v.back()) == 1)
@@ -254,40 +241,43 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
     throw InvalidInputError(
         "one path is a closed loop and the other is open: stitch a loop to a loop, or give two "
         "open paths");
-  plan.closed = A.closed;
-  // Shared vertices: only the ends of open paths (a crack closing at a point).
-  {
-    for (std::size_t k = 0; k < B.v.size(); ++k)
-      if (on[B.v[k]] & kOnA) {
-        const bool endOfB = k == 0 || k + 1 == B.v.size();
-        const bool endOfA = B.v[k] == A.v.front() || B.v[k] == A.v.back();
-        if (A.closed || !endOfA || !endOfB)
-          throw InvalidInputError(describeVertex(mesh, B.v[k]) +
-                                  " is on both paths (only open paths may share an end)");
-      }
-  }
+  for (std::size_t k = 0; k < B.v.size(); ++k)
+    if (on[B.v[k]] & onA) {
+      const bool endOfB = k == 0 || k + 1 == B.v.size();
+      const bool endOfA = B.v[k] == A.v.front() || B.v[k] == A.v.back();
+      if (A.closed || !endOfA || !endOfB)
+        throw InvalidInputError(describeVertex(mesh, B.v[k]) +
+                                " is on both paths (only open paths may share an end)");
+    }
   orientPath(A, edges);
   orientPath(B, edges);
+}
 
-  // Closed loops start at their nearest pair of vertices (nearest to a
-  // sample of a's vertices: linear, and good enough to start the zipper).
-  if (A.closed) {
-    const std::size_t samples = std::min<std::size_t>(A.v.size(), 32);
-    double best = INFINITY;
-    std::size_t bi = 0, bj = 0;
-    for (std::size_t s = 0; s < samples; ++s) {
-      const std::size_t i = s * A.v.size() / samples;
-      const Point3& p = mesh.vert[A.v[i]].cP();
-      for (std::size_t j = 0; j < B.v.size(); ++j) {
-        const double d = (mesh.vert[B.v[j]].cP() - p).SquaredNorm();
-        if (d < best) best = d, bi = i, bj = j;
-      }
+// Closed loops start at their nearest pair of vertices (nearest to a
+// sample of a's vertices: linear, and good enough to start the zipper).
+void startAtNearestPair(const Mesh& mesh, PreparedPath& A, PreparedPath& B) {
+  const std::size_t samples = std::min<std::size_t>(A.v.size(), 32);
+  double best = INFINITY;
+  std::size_t bi = 0, bj = 0;
+  for (std::size_t s = 0; s < samples; ++s) {
+    const std::size_t i = s * A.v.size() / samples;
+    const Point3& p = mesh.vert[A.v[i]].cP();
+    for (std::size_t j = 0; j < B.v.size(); ++j) {
+      const double d = (mesh.vert[B.v[j]].cP() - p).SquaredNorm();
+      if (d < best) best = d, bi = i, bj = j;
     }
-    rotate(A.v, bi);
-    rotate(B.v, bj);
   }
-  // Which way b runs beside a: by geometry, and by orientation (a side
-  // that runs along its border must meet one that runs against it).
+  rotate(A.v, bi);
+  rotate(B.v, bj);
+}
+
+// Which way b runs beside a: by geometry, and by orientation (a side that
+// runs along its border must meet one that runs against it). Reverses b
+// when it runs the other way; returns whether the new faces run forward
+// (against a[i] -> a[i+1] and along b[j+1] -> b[j]: right when a runs
+// against its border and b along its own).
+bool chooseDirection(const Mesh& mesh, const StitchOptions& o, PreparedPath& A, PreparedPath& B,
+                     StitchPlan& plan) {
   const PathLine lineA(mesh, A.v, A.closed), lineB(mesh, B.v, B.closed);
   const double costSame = correspondenceCost(lineA, lineB, false);
   const double costReversed = correspondenceCost(lineA, lineB, true);
@@ -315,58 +305,51 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
     std::reverse(B.v.begin() + (B.closed ? 1 : 0), B.v.end());
     B.sign = -B.sign;
   }
-  // forward faces run a against a[i] -> a[i+1] and b along b[j+1] -> b[j]:
-  // right when a runs against its border and b along its own.
-  const bool forward = A.sign != 0 ? A.sign < 0 : B.sign != 0 ? B.sign > 0 : true;
   plan.conflicts += A.against + B.against;
+  return A.sign != 0 ? A.sign < 0 : B.sign != 0 ? B.sign > 0 : true;
+}
 
-  std::vector<int> a = A.v, b = B.v;
-  if (A.closed) {
-    a.push_back(a.front());
-    b.push_back(b.front());
-  } else {
-    if (b.front() == a.front()) b.erase(b.begin());
-    if (!b.empty() && b.back() == a.back()) b.pop_back();
-    if (b.empty()) throw InvalidInputError("path b has no vertex that path a does not share");
-  }
-
-  // Every edge of a path gets one new face: it must be a border edge run
-  // the other way, or no edge yet. Noted per edge: the third corner of the
-  // face on it (-1: no face), for the zipper's fold test.
-  auto checkPathEdges = [&](const std::vector<int>& p, bool newFaceRunsForward, const char* name) {
-    std::vector<int> opposite(p.size() > 1 ? p.size() - 1 : 0, -1);
-    for (std::size_t k = 0; k + 1 < p.size(); ++k) {
-      const LocalEdges::Neighbour e = edges.find(p[k], p[k + 1]);
-      const int used = e.out + e.in;
-      if (used == 0) {
-        ++plan.borderDelta;
-      } else if (used == 1) {
-        opposite[k] = e.opposite;
-        const bool existingForward = e.out == 1;
-        if (existingForward == newFaceRunsForward && !o.allow_orientation_conflict)
-          throw TopologyError("the border along path " + std::string(name) +
-                              " changes direction between " + describeVertex(mesh, p[k]) + " and " +
-                              describeVertex(mesh, p[k + 1]) +
-                              ": the faces there are inconsistently oriented");
-        --plan.borderDelta;
-      } else {
-        throw TopologyError("the edge from " + describeVertex(mesh, p[k]) + " to " +
-                            describeVertex(mesh, p[k + 1]) + " on path " + name +
-                            " already has two faces: the path leaves the border there");
-      }
+// Every edge of a path gets one new face: it must be a border edge run the
+// other way, or no edge yet. Returns per edge the third corner of the face
+// on it (-1: no face), for the zipper's fold test.
+std::vector<int> checkPathEdges(const Mesh& mesh, const LocalEdges& edges, const StitchOptions& o,
+                                const std::vector<int>& p, bool newFaceRunsForward,
+                                const char* name, StitchPlan& plan) {
+  std::vector<int> opposite(p.size() > 1 ? p.size() - 1 : 0, -1);
+  for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+    const LocalEdges::Neighbour e = edges.find(p[k], p[k + 1]);
+    const int used = e.out + e.in;
+    if (used == 0) {
+      ++plan.borderDelta;
+    } else if (used == 1) {
+      opposite[k] = e.opposite;
+      const bool existingForward = e.out == 1;
+      if (existingForward == newFaceRunsForward && !o.allow_orientation_conflict)
+        throw TopologyError("the border along path " + std::string(name) +
+                            " changes direction between " + describeVertex(mesh, p[k]) + " and " +
+                            describeVertex(mesh, p[k + 1]) +
+                            ": the faces there are inconsistently oriented");
+      --plan.borderDelta;
+    } else {
+      throw TopologyError("the edge from " + describeVertex(mesh, p[k]) + " to " +
+                          describeVertex(mesh, p[k + 1]) + " on path " + name +
+                          " already has two faces: the path leaves the border there");
     }
-    return opposite;
-  };
-  const std::vector<int> oppositeA = checkPathEdges(a, forward, "a");
-  const std::vector<int> oppositeB = checkPathEdges(b, !forward, "b");
+  }
+  return opposite;
+}
 
-  const int n = int(mesh.vert.size());
+// The zipper between the rows a and b of existing vertices: a new face may
+// not fold over the face already on a path edge, so a vertex must lie
+// beyond edge k of path a (onB: of path b), on the other side of it than
+// the face there, measured in that face's plane (any point is beyond an
+// edge with no face). The zipper asks about one edge of each path until it
+// moves past it: the edge's frame is kept for the next question.
+std::vector<char> zipExisting(const Mesh& mesh, const std::vector<int>& a,
+                              const std::vector<int>& b, const std::vector<int>& oppositeA,
+                              const std::vector<int>& oppositeB, bool forward, StitchPlan& plan,
+                              double& maxSquaredAspect) {
   auto existingPoint = [&](int v) -> Point3 { return mesh.vert[v].cP(); };
-  // Beyond edge k of path a (onB: of path b): on the other side of it than
-  // the face already on it, measured in that face's plane (any point is
-  // beyond an edge with no face).
-  // The zipper asks about one edge of each path until it moves past it: the
-  // edge's frame is kept for the next question.
   struct EdgeFrame {
     std::size_t k = SIZE_MAX;
     Point3 P, d, normal;
@@ -384,122 +367,163 @@ StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
     }
     return ((f.d ^ (existingPoint(x) - f.P)) * f.normal) < 0;
   };
-  double maxSquaredAspect = 0;
-  std::vector<char> steps =
-      zipper(a, b, existingPoint, beyond, forward, plan.faces, maxSquaredAspect);
+  return zipper(a, b, existingPoint, beyond, forward, plan.faces, maxSquaredAspect);
+}
 
-  // Rungs: an end rung may close an existing border edge; an inner rung
-  // gets two new faces, so it must not exist yet.
-  {
-    std::size_t i = 0, j = 0;
-    for (std::size_t s = 0; s <= steps.size(); ++s) {
-      const bool end = !A.closed && (s == 0 || s == steps.size());
-      const LocalEdges::Neighbour e =
-          a[i] != b[j] ? edges.find(a[i], b[j]) : LocalEdges::Neighbour{b[j], -1, 0, 0};
-      const int used = e.out + e.in;
-      if (end) {
-        // The first face runs b[0] -> a[0] (forward), the last a -> b.
-        const bool newRunsAToB = (s == 0) != forward;
-        if (used == 0) {
-          ++plan.borderDelta;
-        } else if (used == 1 && (e.out == 1) != newRunsAToB) {
-          --plan.borderDelta;
-        } else {
-          throw TopologyError("the stitch would add a face to the edge from " +
-                              describeVertex(mesh, a[i]) + " to " + describeVertex(mesh, b[j]) +
-                              ", which " +
-                              (used == 1 ? "runs the same way" : "already has two faces"));
-        }
-      } else if (used > 0) {
-        throw TopologyError("the stitch would add two faces to the existing edge from " +
+// Rungs: an end rung may close an existing border edge; an inner rung gets
+// two new faces, so it must not exist yet.
+void checkRungs(const Mesh& mesh, const LocalEdges& edges, bool closed, const std::vector<int>& a,
+                const std::vector<int>& b, const std::vector<char>& steps, bool forward,
+                StitchPlan& plan) {
+  std::size_t i = 0, j = 0;
+  for (std::size_t s = 0; s <= steps.size(); ++s) {
+    const bool end = !closed && (s == 0 || s == steps.size());
+    const LocalEdges::Neighbour e =
+        a[i] != b[j] ? edges.find(a[i], b[j]) : LocalEdges::Neighbour{b[j], -1, 0, 0};
+    const int used = e.out + e.in;
+    if (end) {
+      // The first face runs b[0] -> a[0] (forward), the last a -> b.
+      const bool newRunsAToB = (s == 0) != forward;
+      if (used == 0) {
+        ++plan.borderDelta;
+      } else if (used == 1 && (e.out == 1) != newRunsAToB) {
+        --plan.borderDelta;
+      } else {
+        throw TopologyError("the stitch would add a face to the edge from " +
                             describeVertex(mesh, a[i]) + " to " + describeVertex(mesh, b[j]) +
-                            ": the paths touch there; stitch shorter paths");
+                            ", which " +
+                            (used == 1 ? "runs the same way" : "already has two faces"));
       }
-      if (s < steps.size()) (steps[s] ? i : j)++;
+    } else if (used > 0) {
+      throw TopologyError("the stitch would add two faces to the existing edge from " +
+                          describeVertex(mesh, a[i]) + " to " + describeVertex(mesh, b[j]) +
+                          ": the paths touch there; stitch shorter paths");
     }
+    if (s < steps.size()) (steps[s] ? i : j)++;
   }
+}
+
+// Subdivision: rows of new vertices across a wide strip, one row count for
+// the whole strip: enough for the widest rung, but never so many that rows
+// crowd closer than h / max_aspect_ratio where the gap is narrowest (that
+// would trade long slivers for flat ones).
+void subdivide(const Mesh& mesh, const LocalEdges& edges, const StitchOptions& o, bool closed,
+               const std::vector<int>& a, const std::vector<int>& b, const std::vector<char>& steps,
+               bool forward, StitchPlan& plan, double& maxSquaredAspect) {
+  const int n = int(mesh.vert.size());
+  auto existingPoint = [&](int v) -> Point3 { return mesh.vert[v].cP(); };
+  auto meanEdge = [&](const std::vector<int>& p) {
+    double sum = 0;
+    for (std::size_t k = 0; k + 1 < p.size(); ++k)
+      sum += (existingPoint(p[k + 1]) - existingPoint(p[k])).Norm();
+    return p.size() > 1 ? sum / double(p.size() - 1) : 0.0;
+  };
+  const double ha = meanEdge(a), hb = meanEdge(b.size() > 1 ? b : a);
+  const double h = 0.5 * (ha + hb);
+  std::vector<std::array<int, 2>> rungs{{a[0], b[0]}};
+  std::size_t i = 0, j = 0;
+  for (char s : steps) {
+    (s ? i : j)++;
+    rungs.push_back({a[i], b[j]});
+  }
+  double longest = 0, shortest = INFINITY;
+  for (const auto& r : rungs) {
+    const double l = (existingPoint(r[0]) - existingPoint(r[1])).Norm();
+    longest = std::max(longest, l);
+    shortest = std::min(shortest, l);
+  }
+  int strips = 1;
+  if (h > 0) {
+    strips = int(std::ceil(longest / (o.max_aspect_ratio * h)));
+    strips = std::min(strips, int(std::floor(shortest * o.max_aspect_ratio / h)));
+    strips = std::max(1, std::min(strips, o.max_rows + 1));
+  }
+  if (strips <= 1) return;
+  plan.faces.clear();
+  maxSquaredAspect = 0;
+  std::vector<std::vector<int>> rows{a};
+  for (int k = 1; k < strips; ++k) {
+    const double t = double(k) / strips;
+    std::vector<Point3> curve;
+    for (const auto& r : rungs)
+      curve.push_back(existingPoint(r[0]) * (1 - t) + existingPoint(r[1]) * t);
+    const Polyline line(curve);
+    const double spacing = (1 - t) * ha + t * hb;
+    const int segments = std::max(1, int(std::lround(line.length() / std::max(spacing, 1e-300))));
+    std::vector<int> row;
+    for (int s = 0; s <= segments; ++s) {
+      if (closed && s == segments) {
+        row.push_back(row.front());
+        break;
+      }
+      row.push_back(n + int(plan.newPoints.size()));
+      plan.newPoints.push_back(line.at(line.length() * s / segments));
+    }
+    rows.push_back(row);
+  }
+  rows.push_back(b);
+  auto anyPoint = [&](int v) -> Point3 {
+    return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
+  };
+  // One of the two rows of every strip is new vertices: the fold test,
+  // made between an existing edge and an existing vertex, never applies.
+  auto anyIsValid = [](bool, std::size_t, int) { return true; };
+  for (std::size_t k = 0; k + 1 < rows.size(); ++k)
+    zipper(rows[k], rows[k + 1], anyPoint, anyIsValid, forward, plan.faces, maxSquaredAspect);
+  // End rungs are now chains of strips edges (new border edges).
+  if (closed) return;
+  if (edges.uses(a.front(), b.front()) == 1 || edges.uses(a.back(), b.back()) == 1)
+    throw TopologyError(
+        "a wide stitch cannot be subdivided where its end rung is an existing edge");
+  plan.borderDelta += 2 * (strips - 1);
+}
+
+}  // namespace
+
+namespace stitch_detail {
+
+// topologyRead is called once the mesh's faces are no longer read (from
+// then on the plan reads the path vertices' coordinates and what it
+// gathered).
+StitchPlan planStitch(const Mesh& mesh, const StitchOptions& o,
+                      const std::function<void()>& topologyRead) {
+  StitchPlan plan;
+  PreparedPath A = preparePath(mesh, o.a, "a"), B = preparePath(mesh, o.b, "b");
+  constexpr char kOnA = 1, kOnB = 2;
+  std::vector<char> on(mesh.vert.size(), 0);
+  checkDistinct(mesh, A, on, kOnA, "a");
+  checkDistinct(mesh, B, on, kOnB, "b");
+  std::vector<int> all = A.v;
+  all.insert(all.end(), B.v.begin(), B.v.end());
+  const LocalEdges edges(mesh, all, true);
+  requireOnBorders(mesh, A, B, edges);
+  if (topologyRead) topologyRead();
+  settleShapes(mesh, o, A, B, edges, on, kOnA);
+  plan.closed = A.closed;
+  if (A.closed) startAtNearestPair(mesh, A, B);
+  const bool forward = chooseDirection(mesh, o, A, B, plan);
+
+  std::vector<int> a = A.v, b = B.v;
+  if (A.closed) {
+    a.push_back(a.front());
+    b.push_back(b.front());
+  } else {
+    if (b.front() == a.front()) b.erase(b.begin());
+    if (!b.empty() && b.back() == a.back()) b.pop_back();
+    if (b.empty()) throw InvalidInputError("path b has no vertex that path a does not share");
+  }
+  const std::vector<int> oppositeA = checkPathEdges(mesh, edges, o, a, forward, "a", plan);
+  const std::vector<int> oppositeB = checkPathEdges(mesh, edges, o, b, !forward, "b", plan);
+  double maxSquaredAspect = 0;
+  const std::vector<char> steps =
+      zipExisting(mesh, a, b, oppositeA, oppositeB, forward, plan, maxSquaredAspect);
+  checkRungs(mesh, edges, A.closed, a, b, steps, forward, plan);
   if (!A.closed) {
     plan.firstRung = {a.front(), b.front()};
     plan.lastRung = {a.back(), b.back()};
   }
-
-  // Subdivision: rows of new vertices across a wide strip.
-  if (o.max_aspect_ratio > 0) {
-    auto meanEdge = [&](const std::vector<int>& p) {
-      double sum = 0;
-      for (std::size_t k = 0; k + 1 < p.size(); ++k)
-        sum += (existingPoint(p[k + 1]) - existingPoint(p[k])).Norm();
-      return p.size() > 1 ? sum / double(p.size() - 1) : 0.0;
-    };
-    const double ha = meanEdge(a), hb = meanEdge(b.size() > 1 ? b : a);
-    const double h = 0.5 * (ha + hb);
-    std::vector<std::array<int, 2>> rungs{{a[0], b[0]}};
-    {
-      std::size_t i = 0, j = 0;
-      for (char s : steps) {
-        (s ? i : j)++;
-        rungs.push_back({a[i], b[j]});
-      }
-    }
-    double longest = 0, shortest = INFINITY;
-    for (const auto& r : rungs) {
-      const double l = (existingPoint(r[0]) - existingPoint(r[1])).Norm();
-      longest = std::max(longest, l);
-      shortest = std::min(shortest, l);
-    }
-    // One row count for the whole strip: enough for the widest rung, but
-    // never so many that rows crowd closer than h / max_aspect_ratio where
-    // the gap is narrowest (that would trade long slivers for flat ones).
-    int strips = 1;
-    if (h > 0) {
-      strips = int(std::ceil(longest / (o.max_aspect_ratio * h)));
-      strips = std::min(strips, int(std::floor(shortest * o.max_aspect_ratio / h)));
-      strips = std::max(1, std::min(strips, o.max_rows + 1));
-    }
-    if (strips > 1) {
-      plan.faces.clear();
-      maxSquaredAspect = 0;
-      std::vector<std::vector<int>> rows{a};
-      for (int k = 1; k < strips; ++k) {
-        const double t = double(k) / strips;
-        std::vector<Point3> curve;
-        for (const auto& r : rungs)
-          curve.push_back(existingPoint(r[0]) * (1 - t) + existingPoint(r[1]) * t);
-        const Polyline line(curve);
-        const double spacing = (1 - t) * ha + t * hb;
-        const int segments =
-            std::max(1, int(std::lround(line.length() / std::max(spacing, 1e-300))));
-        std::vector<int> row;
-        for (int s = 0; s <= segments; ++s) {
-          if (A.closed && s == segments) {
-            row.push_back(row.front());
-            break;
-          }
-          row.push_back(n + int(plan.newPoints.size()));
-          plan.newPoints.push_back(line.at(line.length() * s / segments));
-        }
-        rows.push_back(row);
-      }
-      rows.push_back(b);
-      auto anyPoint = [&](int v) -> Point3 {
-        return v < n ? mesh.vert[v].cP() : plan.newPoints[v - n];
-      };
-      // One of the two rows of every strip is new vertices: the fold test,
-      // made between an existing edge and an existing vertex, never applies.
-      auto anyIsValid = [](bool, std::size_t, int) { return true; };
-      for (std::size_t k = 0; k + 1 < rows.size(); ++k)
-        zipper(rows[k], rows[k + 1], anyPoint, anyIsValid, forward, plan.faces, maxSquaredAspect);
-      // End rungs are now chains of strips edges (new border edges).
-      if (!A.closed) {
-        const bool closesFirst = edges.uses(a.front(), b.front()) == 1;
-        const bool closesLast = edges.uses(a.back(), b.back()) == 1;
-        if (closesFirst || closesLast)
-          throw TopologyError(
-              "a wide stitch cannot be subdivided where its end rung is an existing edge");
-        plan.borderDelta += 2 * (strips - 1);
-      }
-    }
-  }
+  if (o.max_aspect_ratio > 0)
+    subdivide(mesh, edges, o, A.closed, a, b, steps, forward, plan, maxSquaredAspect);
   plan.maxAspect = std::sqrt(maxSquaredAspect);
   return plan;
 }

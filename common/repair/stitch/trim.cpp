@@ -194,6 +194,205 @@ std::vector<int> loopFromPicks(const Mesh& mesh, const Adjacency& adj,
   return loop;
 }
 
+// The loop to trim along, from the options: a list of vertices, a
+// selection (which gives no direction: `directed` false) or picked vertices.
+std::vector<int> loopOf(const Mesh& mesh, const Adjacency& adj, const TrimOptions& options,
+                        bool& directed) {
+  directed = true;
+  if (!options.selected_vertices.empty() && options.loop.empty()) {
+    directed = false;
+    return loopFromSelection(mesh, adj, options.selected_vertices);
+  }
+  if (options.loop.empty() && !options.picked_vertices.empty())
+    return loopFromPicks(mesh, adj, options.picked_vertices);
+  if (options.loop.empty())
+    throw InvalidInputError("no trim loop given: select a closed loop of vertices, or give it");
+  std::vector<int> loop = options.loop;
+  if (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
+  for (int v : loop) requireVertex(mesh, v, "the loop");
+  if (loop.size() < 3) throw InvalidInputError("the loop needs at least three vertices");
+  std::vector<char> seen(mesh.vert.size(), 0);
+  for (int v : loop) {
+    if (seen[v])
+      throw InvalidInputError("the loop passes " + describeVertex(mesh, v) +
+                              " twice: a trim loop must be simple");
+    seen[v] = 1;
+  }
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const int a = loop[k], b = loop[(k + 1) % loop.size()];
+    if (!adj.joined(a, b))
+      throw InvalidInputError("the loop is broken between " + describeVertex(mesh, a) + " and " +
+                              describeVertex(mesh, b) + ": they share no edge");
+  }
+  return loop;
+}
+
+// A face on a loop edge: whether it runs the edge in the loop's direction.
+struct LoopUse {
+  int face;
+  bool along;
+  int a, b;  // the loop edge, in the loop's direction
+};
+
+// The faces joined across every edge that is not on the loop (union-find),
+// and the faces on loop edges.
+struct LoopComponents {
+  std::vector<int> parent;
+  std::vector<LoopUse> uses;
+  int root(int f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  }
+};
+
+LoopComponents componentsAcross(const std::vector<Triangle>& T, const std::vector<EdgeUse>& uses,
+                                const std::vector<int>& loop) {
+  std::unordered_map<std::uint64_t, std::pair<int, int>> loopEdges;  // undirected -> directed
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const int a = loop[k], b = loop[(k + 1) % loop.size()];
+    loopEdges[undirectedKey(a, b)] = {a, b};
+  }
+  LoopComponents c;
+  c.parent.resize(T.size());
+  std::iota(c.parent.begin(), c.parent.end(), 0);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
+    const auto it = loopEdges.find(undirectedKey(uses[i].u, uses[i].v));
+    if (it == loopEdges.end()) {
+      for (std::size_t k = i + 1; k < j; ++k) c.parent[c.root(uses[k].face)] = c.root(uses[i].face);
+    } else {
+      for (std::size_t k = i; k < j; ++k)
+        c.uses.push_back({uses[k].face, T[uses[k].face][uses[k].corner] == it->second.first,
+                          it->second.first, it->second.second});
+    }
+    i = j;
+  }
+  return c;
+}
+
+TopologyError notSeparating(const Mesh& mesh, int a, int b) {
+  return TopologyError(
+      "the loop does not separate the mesh: the faces on both sides of its edge from " +
+      describeVertex(mesh, a) + " to " + describeVertex(mesh, b) +
+      " are connected without crossing the loop (e.g. a loop around a handle or across a strip)");
+}
+
+// The same component on both sides of one loop edge: nothing separates.
+void requireSeparating(const Mesh& mesh, LoopComponents& c) {
+  std::unordered_map<std::uint64_t, std::pair<int, int>> sides;  // edge -> (along, against) root
+  for (const LoopUse& u : c.uses) {
+    auto& s = sides.try_emplace(undirectedKey(u.a, u.b), -1, -1).first->second;
+    (u.along ? s.first : s.second) = c.root(u.face);
+    if (s.first >= 0 && s.first == s.second) throw notSeparating(mesh, u.a, u.b);
+  }
+}
+
+// Per component root: 1 keep, 2 remove (0 unknown). By the loop's
+// direction: the faces running a loop edge its way are kept.
+std::vector<char> sidesByDirection(const Mesh& mesh, LoopComponents& c, std::size_t faces) {
+  std::vector<char> side(faces, 0);
+  for (const LoopUse& u : c.uses) {
+    const int r = c.root(u.face);
+    const char want = u.along ? 1 : 2;
+    if (side[r] != 0 && side[r] != want)
+      throw TopologyError(
+          "the side to keep cannot be decided by the loop's direction near " +
+          describeVertex(mesh, u.a) +
+          ": the faces along the loop are inconsistently oriented, or the loop does not "
+          "separate the mesh; select a face on the side to keep");
+    side[r] = want;
+  }
+  return side;
+}
+
+// The same from a face on the side to keep: the components two-coloured,
+// the sides differing across every loop edge.
+std::vector<char> sidesFromKeptFace(const Mesh& mesh, LoopComponents& c, std::size_t faces,
+                                    int keepFace) {
+  std::vector<char> side(faces, 0);
+  std::unordered_map<int, std::vector<int>> across;  // root -> roots across a loop edge
+  std::unordered_map<std::uint64_t, std::vector<std::pair<int, bool>>> byEdge;
+  for (const LoopUse& u : c.uses)
+    byEdge[undirectedKey(u.a, u.b)].push_back({c.root(u.face), u.along});
+  for (const auto& [key, list] : byEdge)
+    for (const auto& x : list)
+      for (const auto& y : list)
+        if (x.second != y.second) across[x.first].push_back(y.first);
+  const int keepRoot = c.root(keepFace);
+  if (!across.count(keepRoot) && std::none_of(c.uses.begin(), c.uses.end(),
+                                              [&](auto& u) { return c.root(u.face) == keepRoot; }))
+    throw InvalidInputError("face " + std::to_string(keepFace) +
+                            " is not next to the loop on either side (it lies on a part of the "
+                            "mesh the loop does not touch)");
+  side[keepRoot] = 1;
+  std::vector<int> stack{keepRoot};
+  while (!stack.empty()) {
+    const int r = stack.back();
+    stack.pop_back();
+    for (int other : across[r]) {
+      const char want = side[r] == 1 ? 2 : 1;
+      if (side[other] == 0) {
+        side[other] = want;
+        stack.push_back(other);
+      } else if (side[other] != want) {
+        for (const LoopUse& u : c.uses)
+          if (c.root(u.face) == other) throw notSeparating(mesh, u.a, u.b);
+      }
+    }
+  }
+  // Components on the loop that no loop edge ties to the kept side (a loop
+  // edge on a border has one face): the loop's direction relative to the
+  // kept side decides.
+  int keepAlong = 0;
+  for (const LoopUse& u : c.uses)
+    if (side[c.root(u.face)] != 0) keepAlong += (side[c.root(u.face)] == 1) == u.along ? 1 : -1;
+  for (const LoopUse& u : c.uses) {
+    const int r = c.root(u.face);
+    if (side[r] == 0) side[r] = (u.along == (keepAlong >= 0)) ? 1 : 2;
+  }
+  return side;
+}
+
+// The faces of `remove`d or kept side as a mesh, with provenance; `index`
+// maps the mesh's vertices to the part's (-1: not in it).
+struct Part {
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  std::vector<VertexOrigin> vertexOrigin;
+  std::vector<FaceOrigin> faceOrigin;
+};
+
+Part partOf(Mesh& mesh, const std::vector<char>& removeFace, bool removed, bool removeUnreferenced,
+            std::vector<int>& index) {
+  const std::vector<Point3> P = positionsOf(mesh);
+  const std::vector<Triangle> T = trianglesOf(mesh);
+  VertexOriginHandle vo = vertexOrigins(mesh);
+  FaceOriginHandle fo = faceOrigins(mesh);
+  const std::size_t n = P.size();
+  std::vector<char> used(n, 0), usedAtAll(n, 0);
+  for (std::size_t f = 0; f < T.size(); ++f)
+    for (int v : T[f]) {
+      usedAtAll[v] = 1;
+      if (bool(removeFace[f]) == removed) used[v] = 1;
+    }
+  Part part;
+  index.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v) {
+    const bool keep = removed ? used[v] : (used[v] || !usedAtAll[v] || !removeUnreferenced);
+    if (!keep) continue;
+    index[v] = int(part.points.size());
+    part.points.push_back(P[v]);
+    part.vertexOrigin.push_back(vo[v]);
+  }
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (bool(removeFace[f]) == removed) {
+      part.triangles.push_back({index[T[f][0]], index[T[f][1]], index[T[f][2]]});
+      part.faceOrigin.push_back(fo[f]);
+    }
+  return part;
+}
+
 }  // namespace
 
 TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
@@ -202,40 +401,11 @@ TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
   requireFacesAndFiniteCoordinates(mesh, "the mesh");
   requireCompact(mesh);
   reportProgress(options.progress, 0, "Finding the loop");
-  const std::vector<Point3> P = positionsOf(mesh);
   const std::vector<Triangle> T = trianglesOf(mesh);
-  const int n = int(P.size());
   const std::vector<EdgeUse> uses = edgeUses(T);
-  const Adjacency adj = adjacencyOf(uses, n);
-
-  std::vector<int> loop;
+  const Adjacency adj = adjacencyOf(uses, int(mesh.vert.size()));
   bool directed = true;
-  if (!options.loop.empty()) {
-    loop = options.loop;
-    if (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
-    for (int v : loop) requireVertex(mesh, v, "the loop");
-    if (loop.size() < 3) throw InvalidInputError("the loop needs at least three vertices");
-    std::vector<char> seen(n, 0);
-    for (int v : loop) {
-      if (seen[v])
-        throw InvalidInputError("the loop passes " + describeVertex(mesh, v) +
-                                " twice: a trim loop must be simple");
-      seen[v] = 1;
-    }
-    for (std::size_t k = 0; k < loop.size(); ++k) {
-      const int a = loop[k], b = loop[(k + 1) % loop.size()];
-      if (!adj.joined(a, b))
-        throw InvalidInputError("the loop is broken between " + describeVertex(mesh, a) + " and " +
-                                describeVertex(mesh, b) + ": they share no edge");
-    }
-  } else if (!options.selected_vertices.empty()) {
-    loop = loopFromSelection(mesh, adj, options.selected_vertices);
-    directed = false;
-  } else if (!options.picked_vertices.empty()) {
-    loop = loopFromPicks(mesh, adj, options.picked_vertices);
-  } else {
-    throw InvalidInputError("no trim loop given: select a closed loop of vertices, or give it");
-  }
+  result.loop = loopOf(mesh, adj, options, directed);
   if (options.keep_face >= int(T.size()))
     throw InvalidInputError("keep_face " + std::to_string(options.keep_face) +
                             " is out of range (the mesh has " + std::to_string(T.size()) +
@@ -243,166 +413,33 @@ TrimResult trimAlongLoop(Mesh& mesh, const TrimOptions& options) {
   if (options.keep_face < 0 && !directed)
     throw InvalidInputError(
         "a loop recovered from a selection has no direction: select a face on the side to keep");
-  result.loop = loop;
-  reportProgress(options.progress, 30, "Classifying faces");
 
-  // Loop edges, keyed undirected, with the loop's direction.
-  std::unordered_map<std::uint64_t, std::pair<int, int>> loopEdges;
-  for (std::size_t k = 0; k < loop.size(); ++k) {
-    const int a = loop[k], b = loop[(k + 1) % loop.size()];
-    loopEdges[undirectedKey(a, b)] = {a, b};
-  }
-  // Faces joined across every edge that is not on the loop.
-  std::vector<int> parent(T.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  std::function<int(int)> root = [&](int f) {
-    while (parent[f] != f) f = parent[f] = parent[parent[f]];
-    return f;
-  };
-  struct LoopUse {
-    int face;
-    bool along;  // runs the loop edge in the loop's direction
-    int a, b;
-  };
-  std::vector<LoopUse> loopUses;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].u == uses[i].u && uses[j].v == uses[i].v) ++j;
-    const auto it = loopEdges.find(undirectedKey(uses[i].u, uses[i].v));
-    if (it == loopEdges.end()) {
-      for (std::size_t k = i + 1; k < j; ++k) parent[root(uses[k].face)] = root(uses[i].face);
-    } else {
-      for (std::size_t k = i; k < j; ++k)
-        loopUses.push_back({uses[k].face, T[uses[k].face][uses[k].corner] == it->second.first,
-                            it->second.first, it->second.second});
-    }
-    i = j;
-  }
-  // 0 unknown, 1 keep, 2 remove, per face-component root.
-  std::vector<char> side(T.size(), 0);
-  auto notSeparating = [&](int a, int b) {
-    return TopologyError(
-        "the loop does not separate the mesh: the faces on both sides of its "
-        "edge from " +
-        describeVertex(mesh, a) + " to " + describeVertex(mesh, b) +
-        " are connected without crossing the loop (e.g. a loop around a handle "
-        "or across a strip)");
-  };
-  // The same component on both sides of one loop edge: nothing separates.
-  {
-    std::unordered_map<std::uint64_t, std::pair<int, int>> sides;  // edge -> (along, against) root
-    for (const LoopUse& u : loopUses) {
-      auto& s = sides.try_emplace(undirectedKey(u.a, u.b), -1, -1).first->second;
-      (u.along ? s.first : s.second) = root(u.face);
-      if (s.first >= 0 && s.first == s.second) throw notSeparating(u.a, u.b);
-    }
-  }
-  if (options.keep_face < 0) {
-    for (const LoopUse& u : loopUses) {
-      const int r = root(u.face);
-      const char want = u.along ? 1 : 2;
-      if (side[r] != 0 && side[r] != want)
-        throw TopologyError(
-            "the side to keep cannot be decided by the loop's direction near " +
-            describeVertex(mesh, u.a) +
-            ": the faces along the loop are inconsistently oriented, or the loop does not "
-            "separate the mesh; select a face on the side to keep");
-      side[r] = want;
-    }
-  } else {
-    // Two-colour the components: across a loop edge the sides differ.
-    std::unordered_map<int, std::vector<std::pair<int, bool>>> across;  // root -> (root, along)
-    std::unordered_map<std::uint64_t, std::vector<std::pair<int, bool>>> byEdge;
-    for (const LoopUse& u : loopUses)
-      byEdge[undirectedKey(u.a, u.b)].push_back({root(u.face), u.along});
-    for (const auto& [key, list] : byEdge)
-      for (const auto& x : list)
-        for (const auto& y : list)
-          if (x.second != y.second) across[x.first].push_back({y.first, true});
-    const int keepRoot = root(options.keep_face);
-    if (!across.count(keepRoot) && std::none_of(loopUses.begin(), loopUses.end(),
-                                                [&](auto& u) { return root(u.face) == keepRoot; }))
-      throw InvalidInputError("face " + std::to_string(options.keep_face) +
-                              " is not next to the loop on either side (it lies on a part of the "
-                              "mesh the loop does not touch)");
-    side[keepRoot] = 1;
-    std::vector<int> stack{keepRoot};
-    while (!stack.empty()) {
-      const int r = stack.back();
-      stack.pop_back();
-      for (const auto& [other, unused] : across[r]) {
-        (void)unused;
-        const char want = side[r] == 1 ? 2 : 1;
-        if (side[other] == 0) {
-          side[other] = want;
-          stack.push_back(other);
-        } else if (side[other] != want) {
-          for (const LoopUse& u : loopUses)
-            if (root(u.face) == other) throw notSeparating(u.a, u.b);
-        }
-      }
-    }
-    // Components on the loop that no loop edge ties to the kept side (a
-    // loop edge on a border has one face): the loop's direction relative to
-    // the kept side decides.
-    int keepAlong = 0;
-    for (const LoopUse& u : loopUses)
-      if (side[root(u.face)] != 0) keepAlong += (side[root(u.face)] == 1) == u.along ? 1 : -1;
-    for (const LoopUse& u : loopUses) {
-      const int r = root(u.face);
-      if (side[r] == 0) side[r] = (u.along == (keepAlong >= 0)) ? 1 : 2;
-    }
-  }
+  reportProgress(options.progress, 30, "Classifying faces");
+  LoopComponents components = componentsAcross(T, uses, result.loop);
+  requireSeparating(mesh, components);
+  const std::vector<char> side =
+      options.keep_face < 0 ? sidesByDirection(mesh, components, T.size())
+                            : sidesFromKeptFace(mesh, components, T.size(), options.keep_face);
 
   // Split the faces; provenance follows every element.
   reportProgress(options.progress, 70, "Writing");
-  VertexOriginHandle vo = vertexOrigins(mesh);
-  FaceOriginHandle fo = faceOrigins(mesh);
-  std::vector<char> onLoop(n, 0);
-  for (int v : loop) onLoop[v] = 1;
-  std::vector<char> usedByKept(n, 0), usedByRemoved(n, 0), usedAtAll(n, 0);
-  std::vector<char> removeFace(T.size(), 0);
+  std::vector<char> onLoop(mesh.vert.size(), 0), removeFace(T.size(), 0);
+  for (int v : result.loop) onLoop[v] = 1;
   for (std::size_t f = 0; f < T.size(); ++f) {
-    removeFace[f] = side[root(int(f))] == 2;
-    for (int v : T[f]) (removeFace[f] ? usedByRemoved : usedByKept)[v] = 1;
-    for (int v : T[f]) usedAtAll[v] = 1;
+    removeFace[f] = side[components.root(int(f))] == 2;
     if (onLoop[T[f][0]] && onLoop[T[f][1]] && onLoop[T[f][2]]) ++result.faces_on_loop;
   }
-  auto part = [&](bool removed, std::vector<int>& index) {
-    std::vector<Point3> points;
-    std::vector<VertexOrigin> vorig;
-    index.assign(n, -1);
-    for (int v = 0; v < n; ++v) {
-      const bool keep =
-          removed ? usedByRemoved[v]
-                  : (usedByKept[v] || !usedAtAll[v] || !options.remove_unreferenced_vertices);
-      if (!keep) continue;
-      index[v] = int(points.size());
-      points.push_back(P[v]);
-      vorig.push_back(vo[v]);
-    }
-    std::vector<Triangle> tris;
-    std::vector<FaceOrigin> forig;
-    for (std::size_t f = 0; f < T.size(); ++f)
-      if (bool(removeFace[f]) == removed) {
-        tris.push_back({index[T[f][0]], index[T[f][1]], index[T[f][2]]});
-        forig.push_back(fo[f]);
-      }
-    return std::make_tuple(points, tris, vorig, forig);
-  };
   std::vector<int> removedIndex;
-  {
-    const auto [points, tris, vorig, forig] = part(true, removedIndex);
-    buildMesh(result.removed, points, tris, vorig, forig);
-  }
+  const Part removed = partOf(mesh, removeFace, true, true, removedIndex);
+  const Part kept =
+      partOf(mesh, removeFace, false, options.remove_unreferenced_vertices, result.vertex_index);
+  buildMesh(result.removed, removed.points, removed.triangles, removed.vertexOrigin,
+            removed.faceOrigin);
   result.border_edges_before = borderEdgesOf(T);
-  {
-    const auto [points, tris, vorig, forig] = part(false, result.vertex_index);
-    result.faces_kept = tris.size();
-    result.faces_removed = T.size() - tris.size();
-    result.border_edges_after = borderEdgesOf(tris);
-    buildMesh(mesh, points, tris, vorig, forig);
-  }
+  result.faces_kept = kept.triangles.size();
+  result.faces_removed = T.size() - kept.triangles.size();
+  result.border_edges_after = borderEdgesOf(kept.triangles);
+  buildMesh(mesh, kept.points, kept.triangles, kept.vertexOrigin, kept.faceOrigin);
   reportProgress(options.progress, 100, "Done");
   result.time_ms = msSince(start);
   return result;
