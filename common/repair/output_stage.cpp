@@ -510,7 +510,7 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
 StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Triangle>& triangles,
                             const std::vector<char>& movable, const std::vector<char>& changed,
                             const OutputStageOptions& stage) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   StoredOutput out;
   out.scalar = stage.scalar;
   const std::vector<Point3> reference = points;
@@ -522,8 +522,7 @@ StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Trian
     const Triangle& t = triangles[f];
     out.degenerate_new_faces += changed[f] && collinear(points[t[0]], points[t[1]], points[t[2]]);
   }
-  out.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  out.time_ms = msSince(start);
   return out;
 }
 
@@ -718,7 +717,7 @@ std::size_t splitStoredAgain(SplitResult& r, const std::vector<const Mesh*>& inp
       break;
     }
     reportProgress(stage.progress, 97, "Splitting the stored result where it crosses");
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     Mesh& old = r.merged;
     SplitOptions again;
     again.between_meshes = false;
@@ -822,8 +821,7 @@ std::size_t splitStoredAgain(SplitResult& r, const std::vector<const Mesh*>& inp
     r.merged = next.merged;
     r.curve_edges_welded = r.merged_curve_edges.size();
     countCurves(r.merged.vert.size(), r.merged_curve_edges, r.curve_loops, r.open_curves);
-    r.time_ms +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    r.time_ms += msSince(start);
     left = stillCrossing;
   }
   // (Where planar overlaps were kept once, the merged output no longer
@@ -885,7 +883,7 @@ bool keepIfBetter(SplitResult& r, StoredOutput& out, SplitResult& candidate,
 StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
                           const SplitOptions& options, const OutputStageOptions& stage) {
   requireMergedOutput(r, "storing for the host");
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   StoredOutput out;
   out.scalar = stage.scalar;
   reportProgress(

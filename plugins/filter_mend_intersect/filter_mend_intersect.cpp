@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "common/base/timing.h"
 #include "common/exact/intersections.h"
 #include "common/repair/output_stage.h"
 #include "common/repair/patches/patches.h"
@@ -363,7 +364,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   options.progress = progressWithin(progressFrom(cb), 0, 94);
   const bool merge = parameters.getEnum("output") == 1;
   options.separate_meshes = !merge;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   SplitResult r = splitAlongIntersections(in.meshes, options);
   // Welding and removing duplicate faces may be all there was to do (a
   // layer that met itself only through duplicate faces): that result is
@@ -405,8 +406,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
     remaining = storedIntersectingPairs(r, stored, !merge);
   }
   // The whole computation once (the core's time_ms adds up the splits it ran).
-  r.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.time_ms = msSince(start);
   if (nothingMet) Log("  the layers do not intersect: the merged layer holds them as they are");
   logStored(stored, r);
   if (verify)

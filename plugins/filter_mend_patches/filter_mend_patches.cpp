@@ -4,8 +4,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "common/repair/inspect/inspect.h"
+#include "common/base/timing.h"
 #include "common/exact/intersections.h"
+#include "common/repair/inspect/inspect.h"
 #include "common/repair/output_stage.h"
 #include "common/repair/patches/patch_ops.h"
 #include "common/repair/patches/patches.h"
@@ -33,8 +34,6 @@ static_assert(kDifference - kUnion + 1 == kBooleanOperations);
 BooleanOperation operationOf(int keep) {
   return BooleanOperation(keep - kUnion);
 }
-
-using Clock = std::chrono::steady_clock;
 
 // The chosen layers as one core mesh (layer matrices applied) with the
 // per-face labels the patch functions take.
@@ -316,7 +315,7 @@ void PatchesPlugin::paint(MeshDocument& md, const RichParameterList& parameters,
     reportProgress(progressFrom(cb), 50, "Classifying patches");
     classifyPatches(a.mesh, a.labels, p);
   }
-  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  const double ms = msSince(start);
   JsonObject report = toJson(p);
   report.set("time_ms", ms);
   publishReport(parameters, report);
@@ -390,7 +389,7 @@ void PatchesPlugin::select(MeshDocument& md, const RichParameterList& parameters
       .set("patches_selected", patches)
       .set("faces_selected", faces)
       .set("selected_ids", ids)
-      .set("time_ms", std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      .set("time_ms", msSince(start));
   publishReport(parameters, report);
 }
 

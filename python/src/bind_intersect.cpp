@@ -2,9 +2,10 @@
 // removal on arrays; reading and writing mesh files.
 #include <chrono>
 
-#include "common/repair/inspect/inspect.h"
+#include "common/base/timing.h"
 #include "common/exact/intersections.h"
 #include "common/io/mesh_io.h"
+#include "common/repair/inspect/inspect.h"
 #include "common/repair/output_stage.h"
 #include "common/repair/selfintersect/selfintersect.h"
 #include "common/repair/split/split.h"
@@ -167,7 +168,7 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   c.core.progress = progressWithin(call.progress(), 0, 94);
   std::vector<const Mesh*> pointers;
   for (const Mesh& m : inputs) pointers.push_back(&m);
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   SplitResult r = call([&] { return splitAlongIntersections(pointers, c.core); });
   // The output stage (output_stage.h), as the MeshLab filter runs it for its host.
   OutputStageOptions stage;
@@ -181,8 +182,7 @@ py::dict splitArrays(py::handle meshes, py::kwargs kwargs) {
   if (c.verify)  // by the checker's rule, on what is returned as the output
     remaining = call([&] { return storedIntersectingPairs(r, stored, c.core.separate_meshes); });
   // The whole computation once (the core's time_ms adds up the splits it ran).
-  r.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.time_ms = msSince(start);
   JsonObject report = toJson(r);
   addToReport(stored, report);
   if (c.verify) report.set("remaining_intersecting_pairs", remaining);

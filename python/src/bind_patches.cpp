@@ -3,8 +3,9 @@
 // on arrays.
 #include <chrono>
 
-#include "common/repair/inspect/inspect.h"
+#include "common/base/timing.h"
 #include "common/exact/intersections.h"
+#include "common/repair/inspect/inspect.h"
 #include "common/repair/patches/patch_ops.h"
 #include "common/repair/patches/patches.h"
 #include "common/repair/split/split.h"
@@ -16,11 +17,6 @@ namespace meshmend::python {
 namespace {
 
 const MeshArgument kOneMesh;
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // What bounds and tells the patches apart, as given from Python; turned into
 // core FaceLabels once the mesh is known.

@@ -1,4 +1,5 @@
 #include "common/repair/inspect/inspect.h"
+#include "common/base/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -330,7 +331,7 @@ class Inspector {
 InspectResult inspect(const Mesh& mesh, const InspectOptions& options) {
   if (std::size_t(mesh.vn) != mesh.vert.size() || std::size_t(mesh.fn) != mesh.face.size())
     throw InvalidInputError("inspect() needs a compact mesh (no deleted vertices or faces)");
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const std::vector<Point3> points = positionsOf(mesh);
   const std::vector<Triangle> triangles = trianglesOf(mesh);
   InspectResult result = Inspector(points, triangles, options).run();
@@ -344,8 +345,7 @@ InspectResult inspect(const Mesh& mesh, const InspectOptions& options) {
       for (std::size_t f = 0; f < found.face_involved[0].size(); ++f)
         if (found.face_involved[0][f]) result.face_defects[f] |= kFaceSelfIntersecting;
   }
-  result.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.time_ms = msSince(start);
   return result;
 }
 

@@ -1,4 +1,5 @@
 #include "common/repair/patches/patch_ops.h"
+#include "common/base/timing.h"
 
 #include <chrono>
 #include <sstream>
@@ -148,7 +149,7 @@ void check(RemovePatchesResult& r, Scalar scalar) {
 
 RemovePatchesResult removePatches(const Mesh& mesh, const FaceLabels& labels, Patches p,
                                   const RemovePatchesOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   RemovePatchesResult r;
   reportProgress(options.progress, 0, "Choosing patches");
   const PatchChoice choice = choiceOf(mesh, labels, p, options, r);
@@ -172,8 +173,7 @@ RemovePatchesResult removePatches(const Mesh& mesh, const FaceLabels& labels, Pa
     reportProgress(options.progress, 80, "Checking the result");
     check(r, options.scalar);
   }
-  r.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.time_ms = msSince(start);
   return r;
 }
 

@@ -1,4 +1,5 @@
 #include "common/repair/selfintersect/selfintersect.h"
+#include "common/base/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -319,14 +320,14 @@ void checkContract(Removal& w) {
 }
 
 double millisecondsSince(std::chrono::steady_clock::time_point& lap) {
-  const auto now = std::chrono::steady_clock::now();
+  const auto now = Clock::now();
   const double ms = std::chrono::duration<double, std::milli>(now - lap).count();
   lap = now;
   return ms;
 }
 
 SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   auto lap = start;
   checkOptions(options);
   Removal w(input, options);
@@ -350,8 +351,7 @@ SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptio
   measureOutput(w);
   checkContract(w);
   ms.verify = millisecondsSince(lap);
-  w.r.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  w.r.time_ms = msSince(start);
   return std::move(w.r);
 }
 

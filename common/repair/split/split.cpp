@@ -560,7 +560,7 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
     r.merged_snapped_face.clear();
   }
   reportProgress(options.progress, 100, "Done");
-  r.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  r.time_ms = msSince(start);
   return r;
 }
 
