@@ -4,6 +4,7 @@
 
 #include "common/base/timing.h"
 #include "common/exact/intersections.h"
+#include "common/repair/inspect/inspect.h"
 #include "common/repair/output_stage.h"
 #include "common/repair/patches/patches.h"
 #include "common/repair/split/split.h"
@@ -207,6 +208,20 @@ Inputs inputsOf(MeshDocument& md, const RichParameterList& parameters) {
   return in;
 }
 
+// A float host rounded each layer's coordinates when it loaded the file.
+// Where a layer's detail spans few float steps, that alone can make faces
+// cross that do not in the file: the split works on what the layer holds
+// and cannot undo it, but it says so (inspect.h's precision note), per layer.
+std::vector<std::string> floatStorageNotes(const Inputs& in) {
+  std::vector<std::string> notes;
+  if (!kHostStoresFloat) return notes;
+  for (std::size_t i = 0; i < in.meshes.size(); ++i) {
+    const std::string note = precisionNote(inspect(*in.meshes[i], InspectOptions{}));
+    if (!note.empty()) notes.push_back(layerName(*in.layers[i]) + ": " + note);
+  }
+  return notes;
+}
+
 }  // namespace
 
 void IntersectPlugin::apply(QAction* a, MeshDocument& md, const RichParameterList& parameters,
@@ -408,6 +423,8 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   // The whole computation once (the core's time_ms adds up the splits it ran).
   r.time_ms = msSince(start);
   if (nothingMet) Log("  the layers do not intersect: the merged layer holds them as they are");
+  const std::vector<std::string> precision = floatStorageNotes(in);
+  for (const std::string& note : precision) Log("  warning: %s", note.c_str());
   logStored(stored, r);
   if (verify)
     Log("  check of the written %s result: %zu intersecting pairs remain%s", kHostPrecision,
@@ -417,6 +434,7 @@ void IntersectPlugin::intersectAndSplit(MeshDocument& md, const RichParameterLis
   JsonObject report = toJson(r);
   addToReport(stored, report);
   if (verify) report.set("remaining_intersecting_pairs", remaining);
+  if (!precision.empty()) report.set("float_storage_notes", precision);
   std::vector<std::string> names;
   for (MeshModel* m : layers) names.push_back(toStd(m->label()));
   report.set("layers", names).set("output", merge ? "merged" : "separate");

@@ -316,3 +316,20 @@ def test_split_self_intersections_sample_on_a_clean_mesh_succeeds_unchanged(tmp_
     assert "does not intersect itself" in run.log and "unchanged" in run.log
     check = meshcheck(out)
     assert check["faces"] == 12 and check["vertices"] == 8 and check["volume"] == 1
+
+
+def test_split_in_a_float_host_names_detail_that_float_storage_rounds(tmp_path):
+    """A part at 20,000 whose detail spans a few float steps (2 mm at 2e4:
+    about one float step, 0.002): MeshLab 2020.09 stores it in float on
+    loading, and the split's log and report say so for that layer only."""
+    V, F = cube()
+    fine = [(2e4 + 0.002 * x, 2e4 + y, 2e4 + z) for x, y, z in V]
+    coarse = [(2e4 + x - 0.5, 2e4 + y - 0.5, 2e4 + z - 0.5) for x, y, z in V]
+    run, _ = split_merged(tmp_path, (fine, F), (coarse, F))
+    notes = run.report.get("float_storage_notes", [])
+    assert len(notes) == 1, run.log
+    assert "float steps" in notes[0] and "double host" in notes[0]
+    assert "warning:" in run.log and "float steps" in run.log
+    # Ordinary detail: no note.
+    run, _ = split_merged(tmp_path, (V, F), (shifted(V, 0.5), F))
+    assert "float_storage_notes" not in run.report
