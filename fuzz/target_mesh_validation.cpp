@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "common/base/errors.h"
-#include "common/repair/inspect/inspect.h"
-#include "common/exact/intersections.h"
 #include "common/base/mesh.h"
+#include "common/exact/intersections.h"
+#include "common/repair/inspect/inspect.h"
 #include "fuzz/fuzz_input.h"
 
 namespace meshmend::fuzz {
@@ -27,7 +27,9 @@ void checkInspection(const Mesh& mesh, const InspectResult& r, bool finite) {
   check(r.consistently_oriented == (r.orientation_inconsistent_edges == 0), "orientation flag");
   check(r.border_loops <= r.border_edges, "at most one loop per border edge");
   check(finite == (r.non_finite_vertices == 0), "non-finite vertices counted");
-  if (finite && mesh.fn > 0) {
+  check(r.coordinate_binades == magnitudesOf(positionsOf(mesh), trianglesOf(mesh)).binades(),
+        "the span of the faces' coordinates");
+  if (finite && mesh.fn > 0 && r.coordinate_binades <= kMaxCoordinateBinades) {
     check(r.self_intersecting_pairs.has_value(), "pairs counted on finite faces");
     check(*r.self_intersecting_pairs == selfIntersectingPairs(mesh),
           "inspect and selfIntersectingPairs count the same pairs");
@@ -54,8 +56,10 @@ void meshValidation(const std::uint8_t* data, std::size_t size) {
   } catch (const InvalidInputError&) {
     refused = true;
   }
-  check(refused == (d.triangles.empty() || !finite),
-        "a mesh is refused exactly when it has no face or a non-finite coordinate");
+  const bool wide = finite && magnitudesOf(d.points, d.triangles).binades() > kMaxCoordinateBinades;
+  check(refused == (d.triangles.empty() || !finite || wide),
+        "a mesh is refused exactly when it has no face, a non-finite coordinate or "
+        "coordinates spanning more than kMaxCoordinateBinades");
   InspectOptions options;
   options.mark_defects = true;
   options.self_intersections = true;

@@ -3,12 +3,13 @@
     python3 tests/summary.py RESULTS_DIR [--stages FILE]
 
 RESULTS_DIR holds JUnit XML files: CTest's (one per ctest run; a GoogleTest
-case is one CTest test) and pytest's (one per pytest suite, named after the
-CTest test that ran it). A CTest test that ran a pytest suite counts as that
+case is one CTest test), pytest's (one per pytest suite, named after the
+CTest test that ran it) and scripts/fuzz's (fuzz*.xml, a case per target). A CTest test that ran a pytest suite counts as that
 suite's cases; if the suite wrote no XML (it crashed), as one failure.
 Prints the failed and skipped cases with their reasons and ends with
 
-    tests: N passed, N failed, N skipped (GoogleTest N, pytest N, other checks N)
+    tests: N passed, N failed, N skipped (GoogleTest N, pytest N, fuzz targets N,
+    other checks N)
 
 Exit status 1 if a case failed, or, in CI (CI=true), if a case was skipped
 because something was missing ("missing:" reasons: ../shared, the checker,
@@ -60,6 +61,12 @@ def collect(results):
                 outcomes.append(("pytest", f"{stem}: {name}", outcome, message))
         except ET.ParseError as e:
             outcomes.append(("pytest", stem, "failed", f"unreadable results: {e}"))
+    for fuzz_xml in sorted(results.glob("fuzz*.xml")):
+        try:
+            for name, outcome, message in cases(fuzz_xml):
+                outcomes.append(("fuzz", name, outcome, message))
+        except ET.ParseError as e:
+            outcomes.append(("fuzz", fuzz_xml.stem, "failed", f"unreadable results: {e}"))
     return outcomes
 
 
@@ -83,9 +90,10 @@ def main():
             shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
             print(f"  {len(names)} x {message or 'no reason given'}: {shown}")
     passed = sum(1 for o in outcomes if o[2] == "passed")
-    kinds = {k: sum(1 for o in outcomes if o[0] == k) for k in ("gtest", "pytest", "check")}
+    kinds = {k: sum(1 for o in outcomes if o[0] == k) for k in ("gtest", "pytest", "fuzz", "check")}
     print(f"tests: {passed} passed, {len(failed) + len(required)} failed, {len(skipped) - len(required)} skipped "
-          f"(GoogleTest {kinds['gtest']}, pytest {kinds['pytest']}, other checks {kinds['check']})")
+          f"(GoogleTest {kinds['gtest']}, pytest {kinds['pytest']}, fuzz targets {kinds['fuzz']}, "
+          f"other checks {kinds['check']})")
     return 1 if failed or required or not outcomes else 0
 
 

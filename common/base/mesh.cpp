@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "common/base/errors.h"
@@ -329,6 +330,49 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh) {
   return out;
 }
 
+void CoordinateMagnitudes::add(const Point3& p) {
+  for (int k = 0; k < 3; ++k) {
+    const double a = std::fabs(p[k]);
+    if (a == 0 || !std::isfinite(a)) continue;
+    smallest = std::min(smallest, a);
+    largest = std::max(largest, a);
+  }
+}
+
+void CoordinateMagnitudes::add(const CoordinateMagnitudes& other) {
+  smallest = std::min(smallest, other.smallest);
+  largest = std::max(largest, other.largest);
+}
+
+double CoordinateMagnitudes::binades() const {
+  return largest > 0 ? std::log2(largest) - std::log2(smallest) : 0;
+}
+
+CoordinateMagnitudes magnitudesOf(const std::vector<Point3>& points,
+                                  const std::vector<Triangle>& triangles) {
+  std::vector<bool> used(points.size(), false);
+  for (const Triangle& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      if (t[k] >= 0 && std::size_t(t[k]) < points.size()) used[std::size_t(t[k])] = true;
+  CoordinateMagnitudes m;
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (used[v]) m.add(points[v]);
+  return m;
+}
+
+void requireCoordinateSpan(const CoordinateMagnitudes& m, const std::string& what) {
+  if (m.binades() <= kMaxCoordinateBinades) return;
+  std::ostringstream s;
+  s.precision(3);
+  s << what << ": its coordinates span " << std::lround(m.binades()) << " binades (magnitudes from "
+    << m.smallest << " to " << m.largest << "); exact decisions take at most "
+    << kMaxCoordinateBinades << " (every float mesh is within them). Coordinates below "
+    << std::ldexp(m.largest, -int(kMaxCoordinateBinades))
+    << " are far below the mesh's precision: set them to zero (or scale the mesh so that they "
+       "are not needed), then run again";
+  throw InvalidInputError(s.str());
+}
+
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what) {
   if (mesh.fn == 0) throw InvalidInputError(what + " has no faces: load or select a triangle mesh");
   for (std::size_t i = 0; i < mesh.vert.size(); ++i) {
@@ -342,6 +386,11 @@ void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what)
                                   " uses it: repair the file, or delete the faces that use it");
     throw InvalidInputError(bad + "; no face uses it: run \"Remove Unreferenced Vertices\" first");
   }
+  CoordinateMagnitudes m;
+  for (const Face& f : mesh.face)
+    if (!f.IsD())
+      for (int k = 0; k < 3; ++k) m.add(f.cP(k));
+  requireCoordinateSpan(m, what);
 }
 
 }  // namespace meshmend

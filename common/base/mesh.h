@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -236,8 +237,34 @@ inline Point3 storedAs(const Point3& p, Scalar s) {
 // coordinate (at least the smallest normal step, so that it is never 0).
 double scalarStep(const Point3& p, Scalar s);
 
+// The span of the coordinates MeshMend decides on exactly: their nonzero
+// magnitudes lie within 2^kMaxCoordinateBinades of each other. The rationals
+// of intersection points and of the exact fallbacks grow with that span (a
+// mesh from 1e-315 to 1e304 needs integers of thousands of bits, and a split
+// of it minutes of GMP arithmetic). Floats span 277 binades (2^-149 to
+// 2^128), so no mesh a float host stores is refused.
+inline constexpr double kMaxCoordinateBinades = 280;
+
+// The smallest nonzero and the largest magnitude among finite coordinates.
+struct CoordinateMagnitudes {
+  double smallest = std::numeric_limits<double>::infinity();
+  double largest = 0;
+  void add(const Point3& p);
+  void add(const CoordinateMagnitudes& other);
+  // log2(largest / smallest); 0 without a nonzero coordinate.
+  double binades() const;
+};
+// Over the corners of the faces (unused vertices cost the arithmetic nothing).
+CoordinateMagnitudes magnitudesOf(const std::vector<Point3>& points,
+                                  const std::vector<Triangle>& triangles);
+
+// Throws InvalidInputError naming `what` when `m` spans more than
+// kMaxCoordinateBinades, saying which coordinates to set to zero.
+void requireCoordinateSpan(const CoordinateMagnitudes& m, const std::string& what);
+
 // Throws InvalidInputError naming `what` (e.g. "layer 'bunny'") when the mesh
-// has no faces or a non-finite coordinate.
+// has no faces or a non-finite coordinate, or its faces' coordinates span
+// more than requireCoordinateSpan takes.
 void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what);
 
 }  // namespace meshmend

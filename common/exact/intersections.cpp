@@ -229,14 +229,19 @@ struct alignas(64) WorkerFindings {
   std::size_t candidates = 0;
 };
 
+// The meshes' coordinates together: crossings between them are decided on
+// both (requireCoordinateSpan).
 void requireFacesAndFinite(const std::vector<const MeshArrays*>& meshes) {
+  CoordinateMagnitudes all;
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     if (meshes[m]->triangles.empty())
       throw InvalidInputError("mesh " + std::to_string(m) + " has no faces");
     for (const Point3& p : meshes[m]->points)
       if (!isFinite(p))
         throw InvalidInputError("mesh " + std::to_string(m) + " has a non-finite coordinate");
+    all.add(magnitudesOf(meshes[m]->points, meshes[m]->triangles));
   }
+  requireCoordinateSpan(all, meshes.size() == 1 ? "the mesh" : "the meshes together");
 }
 
 // Each mesh's own pairs, from a tree of its faces' boxes; returns the

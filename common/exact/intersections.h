@@ -61,7 +61,8 @@ struct FindIntersectionsResult {
 
 // Finds every intersecting pair among `meshes` (compact, finite coordinates,
 // all in one frame). Degenerate (collinear) faces are skipped, as in CGAL.
-// Throws InvalidInputError for a non-finite coordinate.
+// Throws InvalidInputError for a non-finite coordinate or coordinates that
+// together span more than kMaxCoordinateBinades (mesh.h).
 FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
                                           const FindIntersectionsOptions& options = {});
 // The same on plain arrays (every vertex index in range).

@@ -249,8 +249,15 @@ class Rounder {
           const std::vector<char>& newFace, const std::vector<char>& movable, Scalar scalar,
           std::vector<Point3>& P)
       : ref_(reference), T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
+    CoordinateMagnitudes m;
+    for (const Point3& p : reference) m.add(p);
+    floor_ = std::ldexp(m.largest, -int(kMaxCoordinateBinades));
     P_ = reference;
-    for (Point3& p : P_) p = storedAs(p, scalar);
+    for (std::size_t v = 0; v < P_.size(); ++v) {
+      P_[v] = storedAs(P_[v], scalar);
+      if (v < movable_.size() && movable_[v])
+        for (int k = 0; k < 3; ++k) P_[v][k] = withinSpan(P_[v][k]);
+    }
   }
 
   // Re-rounds while defects are left, at most `passes` passes per reach and
@@ -295,7 +302,10 @@ class Rounder {
       for (const auto& p : crossing_)
         for (std::uint32_t f : p) addCorners(f);
       for (std::uint32_t f : flat) addCorners(f);
-      for (int v : candidates) moved[v] = reround(v, reach);
+      for (int v : candidates) {
+        if (tests_ >= budget_) break;  // the bound holds within a pass too
+        moved[v] = reround(v, reach);
+      }
     }
     bounded = tests_ >= budget_ && !crossing_.empty();
     rerounded = 0;
@@ -435,7 +445,10 @@ class Rounder {
   bool reround(int v, int reach) {
     const Point3 start = P_[v];
     std::array<std::vector<double>, 3> choices;
-    for (int k = 0; k < 3; ++k) choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
+    for (int k = 0; k < 3; ++k) {
+      choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
+      for (double& c : choices[k]) c = withinSpan(c);
+    }
     std::vector<std::array<std::uint8_t, 3>> order;
     for (std::size_t i = 0; i < choices[0].size(); ++i)
       for (std::size_t j = 0; j < choices[1].size(); ++j)
@@ -457,6 +470,12 @@ class Rounder {
     return best != start;
   }
 
+  // A new vertex's coordinate below floor_ (the largest magnitude over
+  // 2^kMaxCoordinateBinades) is stored as zero: a curve point a hair from a
+  // coordinate plane can round to 1e-320 beside inputs at 1, and the stored
+  // mesh must stay within the span that exact operations take (mesh.h).
+  double withinSpan(double x) const { return std::fabs(x) < floor_ ? 0.0 : x; }
+
   const std::vector<Point3>& ref_;
   const std::vector<Triangle>& T_;
   const std::vector<char>& newFace_;
@@ -469,6 +488,7 @@ class Rounder {
   std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
   Rows others_, around_;
   std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
+  double floor_ = 0;
 
  public:
   std::size_t tests() const { return tests_; }

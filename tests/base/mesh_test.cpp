@@ -124,6 +124,30 @@ TEST(Mesh, RequireFacesNamesTheLayer) {
   EXPECT_NO_THROW(requireFacesAndFiniteCoordinates(testing::tetrahedron(), "x"));
 }
 
+TEST(Mesh, CoordinateSpanCoversEveryFloatAndRefusesWider) {
+  // Every float mesh: a subnormal float beside FLT_MAX (277 binades).
+  const double tiny = std::numeric_limits<float>::denorm_min();
+  const double big = std::numeric_limits<float>::max();
+  const Mesh floats = makeMesh({{tiny, 0, 0}, {big, 0, 0}, {0, big, 0}}, {{0, 1, 2}});
+  EXPECT_NEAR(magnitudesOf(positionsOf(floats), trianglesOf(floats)).binades(), 277, 1);
+  EXPECT_NO_THROW(requireFacesAndFiniteCoordinates(floats, "x"));
+  // Double coordinates from 1e-200 to 1e100 (997 binades): refused, naming
+  // the span and the coordinates to set to zero.
+  const Mesh wide = makeMesh({{1e-200, 0, 0}, {1e100, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  try {
+    requireFacesAndFiniteCoordinates(wide, "layer 'part'");
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("layer 'part': its coordinates span 997 binades"), std::string::npos) << m;
+    EXPECT_NE(m.find("set them to zero"), std::string::npos) << m;
+  }
+  // Zeros and unused vertices do not count.
+  const Mesh unused = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1e-300, 0, 0}}, {{0, 1, 2}});
+  EXPECT_EQ(magnitudesOf(positionsOf(unused), trianglesOf(unused)).binades(), 0);
+  EXPECT_NO_THROW(requireFacesAndFiniteCoordinates(unused, "x"));
+}
+
 TEST(Mesh, WeldCoincidentVerticesClosesASeam) {
   // A box whose top four faces use their own copies of the top corners.
   Mesh b = testing::box();

@@ -75,6 +75,22 @@ TEST(Intersections, SharedVertexAndSharedEdgeRules) {
   EXPECT_EQ(findIntersections({&fan}).self_pairs[0], 0u);
 }
 
+TEST(Intersections, MeshesWhoseCoordinatesSpanTooMuchTogetherAreRefused) {
+  // Each mesh alone spans a few binades; together 1e-200 beside 1e100.
+  const Mesh small = makeMesh({{1e-200, 0, 0}, {2e-200, 0, 0}, {0, 1e-200, 0}}, {{0, 1, 2}});
+  const Mesh large = makeMesh({{1e100, 0, 0}, {2e100, 0, 0}, {0, 1e100, 0}}, {{0, 1, 2}});
+  EXPECT_NO_THROW(findIntersections({&small}, FindIntersectionsOptions{}));
+  EXPECT_NO_THROW(findIntersections({&large}, FindIntersectionsOptions{}));
+  try {
+    findIntersections({&small, &large}, FindIntersectionsOptions{});
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the meshes together: its coordinates span"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Intersections, DuplicatePointsAreDifferentVertices) {
   // Two triangles that share an edge geometrically but not by index touch.
   const Mesh seam = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}},

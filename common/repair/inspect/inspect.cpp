@@ -335,7 +335,9 @@ InspectResult inspect(const Mesh& mesh, const InspectOptions& options) {
   const std::vector<Point3> points = positionsOf(mesh);
   const std::vector<Triangle> triangles = trianglesOf(mesh);
   InspectResult result = Inspector(points, triangles, options).run();
-  if (options.self_intersections && result.non_finite_vertices == 0 && mesh.fn > 0) {
+  result.coordinate_binades = magnitudesOf(points, triangles).binades();
+  if (options.self_intersections && result.non_finite_vertices == 0 && mesh.fn > 0 &&
+      result.coordinate_binades <= kMaxCoordinateBinades) {
     FindIntersectionsOptions find;
     find.cross = false;
     const FindIntersectionsResult found = findIntersections({&mesh}, find);
@@ -383,6 +385,7 @@ JsonObject toJson(const InspectResult& r) {
       .set("min_angle_deg", r.min_angle_deg)
       .set("mean_min_angle_deg", r.mean_min_angle_deg)
       .set("max_abs_coordinate", r.max_abs_coordinate)
+      .set("coordinate_binades", r.coordinate_binades)
       .set("shortest_edge", r.shortest_edge)
       .set("float_steps_in_shortest_edge", r.float_steps_in_shortest_edge)
       .set("double_steps_in_shortest_edge", r.double_steps_in_shortest_edge);
@@ -434,6 +437,11 @@ std::string summarize(const InspectResult& r) {
   if (r.genus) s << ", genus " << *r.genus;
   const std::string precision = precisionNote(r);
   if (!precision.empty()) s << ". Precision: " << precision;
+  if (r.coordinate_binades > kMaxCoordinateBinades)
+    s << ". Coordinates span " << std::lround(r.coordinate_binades) << " binades: beyond the "
+      << kMaxCoordinateBinades
+      << " MeshMend decides on exactly, so self-intersections are not counted and its "
+         "filters refuse the mesh (set the tiniest coordinates to zero)";
   return s.str();
 }
 

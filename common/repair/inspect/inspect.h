@@ -74,8 +74,13 @@ struct InspectResult {
   double shortest_edge = 0;
   double float_steps_in_shortest_edge = 0;
   double double_steps_in_shortest_edge = 0;
+  // log2 of the largest over the smallest nonzero |coordinate| of the faces'
+  // corners: beyond kMaxCoordinateBinades (mesh.h) MeshMend's exact
+  // operations refuse the mesh, and self-intersections are not counted.
+  double coordinate_binades = 0;
   // With the self_intersections option (the rule of CGAL's self_intersections,
-  // as in intersections.h); empty otherwise, without faces or with non-finite coordinates.
+  // as in intersections.h); empty otherwise, without faces, with non-finite
+  // coordinates or beyond kMaxCoordinateBinades.
   std::optional<std::size_t> self_intersecting_pairs;
   std::optional<std::size_t> self_intersecting_faces;
   double time_ms = 0;                        // compute time of inspect()

@@ -1,5 +1,6 @@
 #include "common/repair/inspect/inspect.h"
 
+#include <cmath>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -57,6 +58,19 @@ TEST(Inspect, DetailOfAFewFloatStepsIsNamed) {
   // Past FLT_MAX a float holds no coordinate at all: 0 steps.
   for (Point3& q : p) q = q * 1e35;
   EXPECT_EQ(inspect(makeMesh(p, trianglesOf(tetrahedron()))).float_steps_in_shortest_edge, 0.0);
+}
+
+TEST(Inspect, CoordinatesSpanningTooMuchAreNamedAndNotCounted) {
+  InspectOptions o;
+  o.self_intersections = true;
+  const Mesh wide = makeMesh({{1e-300, 0, 0}, {1e10, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  const InspectResult r = inspect(wide, o);
+  EXPECT_NEAR(r.coordinate_binades, std::log2(1e10) - std::log2(1e-300), 1e-9);
+  EXPECT_FALSE(r.self_intersecting_pairs.has_value());
+  EXPECT_NE(summarize(r).find("self-intersections are not counted"), std::string::npos);
+  const InspectResult ok = inspect(testing::tetrahedron(), o);
+  EXPECT_TRUE(ok.self_intersecting_pairs.has_value());
+  EXPECT_EQ(summarize(ok).find("binades"), std::string::npos);
 }
 
 TEST(Inspect, SphereVolumeAndGenus) {
