@@ -3,6 +3,7 @@
 import pytest
 
 from conftest import ROOT, cube, meshcheck, mlx, run_server, write_off, write_ply
+import cad_cases
 from shapes import tube
 
 SELECT = "MeshMend: Select Intersecting Faces"
@@ -333,3 +334,27 @@ def test_split_in_a_float_host_names_detail_that_float_storage_rounds(tmp_path):
     # Ordinary detail: no note.
     run, _ = split_merged(tmp_path, (V, F), (shifted(V, 0.5), F))
     assert "float_storage_notes" not in run.report
+
+
+@pytest.mark.parametrize("case", sorted(cad_cases.CASES))
+def test_cad_case_through_the_sample_in_the_float_host(tmp_path, case):
+    """The CAD-like cases of tests/cad_cases.py (written in double; MeshLab
+    2020.09 stores them in float on loading) through
+    samples/intersect_split.mlx: the written layer has 0 intersecting pairs
+    and 0 degenerate faces by meshcheck, and the report's
+    remaining_intersecting_pairs is meshcheck's count; or the filter
+    refuses ('All or nothing' is on in the sample), saying why, and writes
+    nothing."""
+    parts = cad_cases.CASES[case]()
+    inputs = [write_off(tmp_path / f"part{i}.off", V, F) for i, (V, F) in enumerate(parts)]
+    script = (ROOT / "samples" / "intersect_split.mlx").read_text().replace(
+        'name="report_file" value=""', 'name="report_file" value="{report0}"')
+    out = tmp_path / "merged.ply"
+    run = run_server(tmp_path, inputs, script, outputs=[out])
+    if run.returncode != 0:
+        assert "All or nothing" in run.log and "left unchanged" in run.log, run.log[-2000:]
+        assert not out.exists()
+        return
+    check = meshcheck(out)
+    assert check["self_intersecting_pairs"] == 0 == run.report["remaining_intersecting_pairs"], run.report
+    assert check["degenerate_faces"] == 0, check

@@ -6,6 +6,7 @@ import subprocess
 
 import pytest
 
+import cad_cases
 from conftest import DATA, MESHCHECK, ROOT, cube, meshcheck, mlx, need, require_shared_data, run_server, \
     write_off
 
@@ -261,3 +262,43 @@ def test_select_patches_touching_the_selected_faces(tmp_path):
     assert f"selected 1 of 4 patches ({patch['faces']} faces)" in run.log
     assert selected["patches"] == 4 and selected["patches_selected"] == 1
     assert selected["faces_selected"] == patch["faces"] and selected["selected_ids"] == [2]
+
+
+def chain_steps(count, keep):
+    """Steps that combine layer 0 with layers 1..count in turn: each split
+    (merged) makes layer count + i, painted and cut to the boolean `keep`
+    in place, and the next step takes it as its first layer."""
+    steps, current = [], 0
+    for i in range(1, count + 1):
+        steps += [(SPLIT, {"mode": 1, "first_layer": current, "second_layer": i, "output": 1,
+                           "overlaps_once": False, "all_or_nothing": True}),
+                  (PAINT, {}),
+                  (REMOVE, {"keep": keep, "report_file": "{report%d}" % (i - 1)})]
+        current = count + i
+    return steps
+
+
+@pytest.mark.parametrize("operation", ["union", "difference"])
+def test_ten_chained_booleans_in_the_float_host_stay_valid_inputs(tmp_path, operation):
+    """Closure under repetition through MeshLab 2020.09 (float): ten unions
+    of a tile with copies moved by a fraction of its size, or ten holes
+    drilled one after another (tests/cad_cases.py), each result the next
+    split's first layer. Every intermediate layer, as written, is closed,
+    edge-manifold, free of intersecting pairs and of degenerate faces by
+    meshcheck, and its report's remaining_intersecting_pairs is meshcheck's."""
+    first, others = cad_cases.union_tiles(10) if operation == "union" else cad_cases.drill_holes(10)
+    inputs = [write_off(tmp_path / f"part{i}.off", V, F) for i, (V, F) in enumerate([first] + others)]
+    keep = 1 if operation == "union" else 3
+    outputs = [(tmp_path / f"step{i}.ply", 10 + i) for i in range(1, 11)]
+    run = run_server(tmp_path, inputs, mlx(*chain_steps(10, keep)), outputs=outputs)
+    assert run.returncode == 0, run.log[-3000:]
+    assert len(run.reports) == 10
+    for (path, _), report in zip(outputs, run.reports):
+        check = meshcheck(path)
+        assert check["is_closed"] and check["non_manifold_edges"] == 0, (path.name, check)
+        assert check["self_intersecting_pairs"] == 0 == report["remaining_intersecting_pairs"], path.name
+        assert check["degenerate_faces"] == 0, (path.name, check)
+    last = meshcheck(outputs[-1][0])
+    if operation == "difference":  # ten through holes in one plate
+        assert last["connected_components"] == 1
+        assert last["vertices"] - last["edges"] + last["faces"] == 2 - 2 * 10

@@ -26,7 +26,7 @@ sys.path.insert(0, str(BUILD / "python"))
 sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared with the meshlabserver tests
 
 import meshmend as mm  # noqa: E402
-from environment import MESHCHECK, Host, need, require_meshcheck  # noqa: E402
+from environment import DATA, MESHCHECK, Host, need, require_meshcheck, require_shared_data  # noqa: E402
 from shapes import tube, write_off  # noqa: E402
 import cad_cases  # noqa: E402
 
@@ -866,6 +866,55 @@ def test_ten_chained_unions_and_differences_stay_valid_inputs(tmp_path, in_float
     drilled = meshcheck(write_off(tmp_path / "drilled.off", V, F))
     euler = drilled["vertices"] - drilled["edges"] + drilled["faces"]
     assert drilled["connected_components"] == 1 and euler == 2 - 2 * 10  # ten through holes
+
+
+# ---------------------------------------------------------------- the pairs and self-intersecting meshes of ../shared/data
+
+CORPUS_PAIRS = [("pairs/blobby.off", "pairs/eight.off"), ("pairs/cheburashka.off", "pairs/decimated-knight.off"),
+                ("pairs/cube.obj", "pairs/sphere.obj"), ("pairs/xcylinder.obj", "pairs/ycylinder.obj"),
+                ("pairs/ycylinder.obj", "pairs/zcylinder.obj"), ("pairs/sphere.obj", "pairs/xcylinder.obj"),
+                ("pairs/ballA.off", "pairs/ballB.off")]
+CORPUS_SELF = ["self_intersecting/cow.off", "self_intersecting/pig.off", "self_intersecting/self_intersectA.obj"]
+
+
+def corpus_mesh(name, in_float):
+    """A mesh of ../shared/data as the module reads it; in float, rounded
+    once as a float host stores it on loading."""
+    require_shared_data()
+    V, F = mm.read_mesh(DATA / name)
+    return (V.astype(np.float32).astype(np.float64) if in_float else V), F
+
+
+@pytest.mark.parametrize("in_float", [False, True], ids=["double", "float"])
+@pytest.mark.parametrize("a,b", CORPUS_PAIRS, ids=[f"{a}+{b}" for a, b in CORPUS_PAIRS])
+def test_corpus_pair_is_exact_once_stored(tmp_path, a, b, in_float):
+    """Each pair of ../shared/data split with the options of
+    samples/intersect_split.mlx: the merged result as stored has 0
+    intersecting pairs and no degenerate face by meshcheck, and the report's
+    remaining_intersecting_pairs is meshcheck's count."""
+    out = mm.intersect_and_split(*corpus_mesh(a, in_float), *corpus_mesh(b, in_float), self=True,
+                                 weld_duplicates=True, remove_duplicate_faces=True, overlaps_once=True,
+                                 separate_meshes=False, round_to_float=in_float)
+    check = stored_check(tmp_path, "merged", *out.merged, in_float)
+    assert out.report["remaining_intersecting_pairs"] == check["self_intersecting_pairs"] == 0, out.report
+    assert out.report["degenerate_new_faces"] == 0 and check["degenerate_faces"] == 0, check
+
+
+@pytest.mark.parametrize("in_float", [False, True], ids=["double", "float"])
+@pytest.mark.parametrize("name", CORPUS_SELF)
+def test_corpus_self_intersecting_mesh_is_exact_once_split(tmp_path, name, in_float):
+    """Each self-intersecting mesh of ../shared/data split along its own
+    curves (samples/split_self_intersections.mlx's options): as stored, 0
+    intersecting pairs by meshcheck, no degenerate face the input did not
+    have, and the report's count is meshcheck's."""
+    V, F = corpus_mesh(name, in_float)
+    before = stored_check(tmp_path, "input", V, F, in_float)
+    out = mm.split_self_intersections(V, F, weld_duplicates=True, remove_duplicate_faces=True,
+                                      round_to_float=in_float)
+    check = stored_check(tmp_path, "split", *out.merged, in_float)
+    assert out.report["remaining_intersecting_pairs"] == check["self_intersecting_pairs"] == 0, out.report
+    assert out.report["degenerate_new_faces"] == 0, out.report
+    assert check["degenerate_faces"] <= before["degenerate_faces"], check
 
 
 # ---------------------------------------------------------------- files and other libraries
