@@ -140,7 +140,7 @@ def main():
         for m in ms:
             ms.set_current_mesh(m.id())
             path = os.path.join(job["save"], f"{m.id()}.ply")
-            ms.save_current_mesh(path, binary=False)
+            ms.save_current_mesh(path, binary=True)  # the host's scalar, exactly
             out["saved"][m.id()] = path
     sys.stdout.flush()
     print(json.dumps(out))

@@ -7,11 +7,13 @@ where it differs), its result dict holds its report, errors arrive as
 pymeshlab exceptions with the meshes unchanged, and a plugin built for
 another MeshLab or scalar is refused with a message that says so."""
 import json
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
-from conftest import (BUILD, DATA, PLUGIN_DIR, VENDOR, Host, filters, float_exact, meshcheck, mlx, need, read_ply,
+import cad_cases
+from conftest import (BUILD, DATA, ROOT, PLUGIN_DIR, VENDOR, Host, filters, float_exact, meshcheck, mlx, need, read_ply,
                       require_shared_data, run_server, write_off, write_ply)
 from test_clearance import nested_spheres
 from test_stitch import indices, joined, sphere, two_sheets
@@ -352,3 +354,92 @@ def test_trim_stitch_and_close_gaps(host, tmp_path):
                                  [("meshmend_close_gaps", {})])
     compare(ours, theirs, out)
     assert theirs[0]["border_edges_after"] < theirs[0]["border_edges_before"]
+
+
+# ---- CAD-like cases in the double hosts ------------------------------------------
+
+def sample_params(name):
+    """The parameters of a sample script as pymeshlab takes them."""
+    convert = {"RichBool": lambda v: v == "true", "RichEnum": int, "RichMesh": int, "RichInt": int,
+               "RichFloat": float, "RichString": str}
+    root = ET.parse(ROOT / "samples" / name).getroot()
+    return {p.get("name"): convert[p.get("type")](p.get("value")) for p in root.iter("Param")}
+
+
+@pytest.mark.parametrize("case", sorted(cad_cases.CASES))
+def test_cad_case_through_the_sample_in_the_double_host(host, tmp_path, case):
+    """The CAD-like cases of tests/cad_cases.py, written in double, through
+    Intersect and Split with samples/intersect_split.mlx's options: the
+    double host stores the result with 0 intersecting pairs and 0
+    degenerate faces by meshcheck on the saved (binary, double) layer, and
+    the report's remaining_intersecting_pairs is meshcheck's count."""
+    parts = cad_cases.CASES[case]()
+    inputs = [write_off(tmp_path / f"part{i}.off", V, F) for i, (V, F) in enumerate(parts)]
+    report = tmp_path / "report.json"
+    params = {**sample_params("intersect_split.mlx"), "report_file": str(report)}
+    out = job(host, tmp_path, inputs, [("meshmend_intersect_and_split", params)], save=tmp_path / "saved")
+    assert "error" not in out["steps"][0], out["steps"][0]
+    merged = next(l for l in out["layers"] if l["label"] == "intersected")
+    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
+    r = json.loads(report.read_text())
+    assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
+    assert check["degenerate_faces"] == 0 and check["faces"] == merged["faces"], check
+    assert r["host_scalar"] == "double"
+
+
+@pytest.mark.parametrize("operation", ["union", "difference"])
+def test_ten_chained_booleans_in_the_double_host_stay_valid_inputs(host, tmp_path, operation):
+    """Closure under repetition in the double host: the chains of
+    test_patches.py (ten unions of tiles, ten holes drilled), each result the
+    next split's first layer; every intermediate layer, saved as the host
+    stores it, is closed, edge-manifold, free of intersecting pairs and of
+    degenerate faces by meshcheck, and its report's
+    remaining_intersecting_pairs is meshcheck's."""
+    first, others = cad_cases.union_tiles(10) if operation == "union" else cad_cases.drill_holes(10)
+    inputs = [write_off(tmp_path / f"part{i}.off", V, F) for i, (V, F) in enumerate([first] + others)]
+    keep = 1 if operation == "union" else 3
+    steps, reports, current = [], [], 0
+    for i in range(1, 11):
+        reports.append(tmp_path / f"remove{i}.json")
+        steps += [("meshmend_intersect_and_split", {"mode": 1, "first_layer": current, "second_layer": i,
+                                                    "output": 1, "overlaps_once": False,
+                                                    "all_or_nothing": True}),
+                  ("meshmend_paint_patches", {}),
+                  ("meshmend_remove_patches", {"keep": keep, "report_file": str(reports[-1])})]
+        current = 10 + i
+    out = job(host, tmp_path, inputs, steps, save=tmp_path / "saved")
+    for k, step in enumerate(out["steps"]):
+        assert "error" not in step, (k, step)
+    ids = {l["id"] for l in out["layers"]}
+    assert ids >= set(range(11, 21)), ids
+    for i, path in zip(range(11, 21), reports):
+        check = meshcheck(tmp_path / "saved" / f"{i}.ply")
+        report = json.loads(path.read_text())
+        assert check["is_closed"] and check["non_manifold_edges"] == 0, (i, check)
+        assert check["self_intersecting_pairs"] == 0 == report["remaining_intersecting_pairs"], i
+        assert check["degenerate_faces"] == 0, (i, check)
+
+
+CORPUS_PAIRS = [("pairs/blobby.off", "pairs/eight.off"), ("pairs/cheburashka.off", "pairs/decimated-knight.off"),
+                ("pairs/cube.obj", "pairs/sphere.obj"), ("pairs/xcylinder.obj", "pairs/ycylinder.obj"),
+                ("pairs/ycylinder.obj", "pairs/zcylinder.obj"), ("pairs/sphere.obj", "pairs/xcylinder.obj"),
+                ("pairs/ballA.off", "pairs/ballB.off")]
+
+
+@pytest.mark.parametrize("a,b", CORPUS_PAIRS, ids=[f"{a}+{b}" for a, b in CORPUS_PAIRS])
+def test_corpus_pair_through_the_sample_in_the_double_host(host, tmp_path, a, b):
+    """Each pair of ../shared/data through Intersect and Split with
+    samples/intersect_split.mlx's options in the double host: 0 intersecting
+    pairs and 0 degenerate faces by meshcheck on the saved layer, and the
+    report's remaining_intersecting_pairs is meshcheck's count."""
+    require_shared_data()
+    report = tmp_path / "report.json"
+    params = {**sample_params("intersect_split.mlx"), "report_file": str(report)}
+    out = job(host, tmp_path, [DATA / a, DATA / b], [("meshmend_intersect_and_split", params)],
+              save=tmp_path / "saved")
+    assert "error" not in out["steps"][0], out["steps"][0]
+    merged = next(l for l in out["layers"] if l["label"] == "intersected")
+    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
+    r = json.loads(report.read_text())
+    assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
+    assert check["degenerate_faces"] == 0, check
