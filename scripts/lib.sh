@@ -12,6 +12,9 @@ JOBS="${MESHMEND_JOBS:-$(nproc)}"
 CACHE="${MESHMEND_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/meshmend}"
 export CCACHE_DIR="${CCACHE_DIR:-$CACHE/ccache}"
 export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-8G}"
+# Paths inside the clone hashed relative to it: another clone's build hits
+# the cache too.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$MESHMEND_ROOT}"
 
 say() { printf '\033[1m==> %s\033[0m\n' "$*"; }
 note() { printf '    %s\n' "$*"; }
