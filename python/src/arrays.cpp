@@ -138,6 +138,12 @@ py::array_t<std::int32_t> intArray(const std::vector<int>& values) {
   return out;
 }
 
+py::list stringList(const std::vector<std::string>& values) {
+  py::list out;
+  for (const std::string& v : values) out.append(v);
+  return out;
+}
+
 py::array_t<std::int32_t> pairArray(const std::vector<std::array<int, 2>>& pairs) {
   py::array_t<std::int32_t> out({py::ssize_t(pairs.size()), py::ssize_t(2)});
   std::int32_t* p = out.mutable_data();

@@ -52,6 +52,7 @@ py::tuple meshTuple(const Mesh& mesh);  // (vertices, faces)
 
 // 1-D int32 array of `values`; (k, 2) int32 array of index pairs.
 py::array_t<std::int32_t> intArray(const std::vector<int>& values);
+py::list stringList(const std::vector<std::string>& values);  // a list of str
 py::array_t<std::int32_t> pairArray(const std::vector<std::array<int, 2>>& pairs);
 
 // Per face of `mesh`: the input mesh (layer) it came from.

@@ -293,7 +293,7 @@ py::dict removeArrays(py::handle vertices, py::handle faces, py::kwargs kwargs) 
   out["removed"] = c.removed_mesh ? py::object(meshTuple(r.removed)) : py::none();
   JsonObject report = toJson(r);
   py::dict d = dictOf(report);
-  if (!r.notes.empty()) d["notes"] = py::cast(r.notes);
+  if (!r.notes.empty()) d["notes"] = stringList(r.notes);
   out["report"] = d;
   return out;
 }
@@ -366,7 +366,7 @@ py::dict selectArrays(py::handle vertices, py::handle faces, int by, const std::
       py::array_t<bool>(py::ssize_t(selected.size()), reinterpret_cast<bool*>(selected.data()));
   out["patch_of_face"] = intArray(p.patch_of_face);
   py::dict d = dictOf(report);
-  if (!r.notes.empty()) d["notes"] = py::cast(r.notes);
+  if (!r.notes.empty()) d["notes"] = stringList(r.notes);
   out["report"] = d;
   return out;
 }

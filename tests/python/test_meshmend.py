@@ -700,6 +700,18 @@ def test_enforce_clearance_refuses_intersecting_meshes_and_tau_0(two_spheres, ne
 # ---------------------------------------------------------------- patches, booleans
 
 
+def test_a_boolean_with_an_open_part_returns_its_notes(two_spheres):
+    """A part with a hole is classified by its fractional winding numbers:
+    the report says so in `notes`, a list of str (a boolean of the open
+    Stanford bunny and the dragon raised TypeError on that list)."""
+    (V1, F1), (V2, F2) = two_spheres
+    cut = np.asarray(F1)[1:]  # one face off: the first part is open
+    result = mm.boolean(V1, cut, V2, F2)
+    notes = result.report["notes"]
+    assert isinstance(notes, list) and notes and all(isinstance(n, str) for n in notes), notes
+    assert any("open" in n for n in notes), notes
+
+
 def test_paint_classify_and_keep_booleans(two_spheres, tmp_path):
     (V1, F1), (V2, F2) = two_spheres
     split = mm.intersect_and_split(V1, F1, V2, F2)
