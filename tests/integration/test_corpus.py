@@ -128,7 +128,7 @@ def test_split_of_closed_pairs_leaves_no_intersection(tmp_path, a, b):
     r, check = run.report, meshcheck(out)
     assert r["remaining_intersecting_pairs"] == 0
     assert r["open_curves"] == 0 and r["curve_loops"] >= 1
-    assert check["self_intersecting_pairs"] == 0
+    assert check["self_intersecting_pairs"] == 0 and check["degenerate_faces"] == 0
     assert check["is_closed"] and check["border_edges"] == 0
     assert check["non_manifold_edges"] == r["curve_edges"]
 

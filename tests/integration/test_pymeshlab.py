@@ -443,3 +443,23 @@ def test_corpus_pair_through_the_sample_in_the_double_host(host, tmp_path, a, b)
     r = json.loads(report.read_text())
     assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
     assert check["degenerate_faces"] == 0, check
+
+
+@pytest.mark.parametrize("name", ["self_intersecting/cow.off", "self_intersecting/pig.off",
+                                  "self_intersecting/self_intersectA.obj"])
+def test_corpus_self_intersecting_mesh_through_the_sample_in_the_double_host(host, tmp_path, name):
+    """Each self-intersecting mesh of ../shared/data split along its own
+    curves with samples/split_self_intersections.mlx's options in the double
+    host: 0 intersecting pairs by meshcheck on the saved layer, no degenerate
+    face the input did not have, and the report's count is meshcheck's."""
+    require_shared_data()
+    report = tmp_path / "report.json"
+    params = {**sample_params("split_self_intersections.mlx"), "report_file": str(report)}
+    out = job(host, tmp_path, [DATA / name], [("meshmend_intersect_and_split", params)],
+              save=tmp_path / "saved")
+    assert "error" not in out["steps"][0], out["steps"][0]
+    merged = next(l for l in out["layers"] if l["label"] == "intersected")
+    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
+    r = json.loads(report.read_text())
+    assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
+    assert check["degenerate_faces"] <= meshcheck(DATA / name)["degenerate_faces"], check
