@@ -19,10 +19,10 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/exact/intersections.h"
-#include "common/io/mesh_io.h"
 #include "common/base/parallel.h"
+#include "common/exact/intersections.h"
 #include "common/exact/triangle_intersection.h"
+#include "common/io/mesh_io.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
@@ -49,43 +49,11 @@ long cgalSelfIntersections(const SurfaceMesh& tm) {
   return pairs;
 }
 
-// For inputs that are not a valid Surface_mesh (non-manifold edges): CGAL's
-// box_self_intersection_d on the face boxes, then the same rule as
-// PMP::self_intersections, decided with CGAL's exact predicates (Epick).
+// For inputs that are not a valid Surface_mesh (non-manifold edges): the
+// same rule as PMP::self_intersections on the soup (cgal_mesh.h).
 long cgalSoupSelfIntersections(const Mesh& m) {
-  using CgalBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
-  std::vector<K::Triangle_3> tris;
-  std::vector<CgalBox> boxes;
-  const std::vector<Triangle> idx = trianglesOf(m);
-  for (std::size_t f = 0; f < m.face.size(); ++f) {
-    tris.push_back(cgalTriangle(m, f));
-    if (!tris.back().is_degenerate()) boxes.emplace_back(tris.back().bbox(), f);
-  }
-  long pairs = 0;
-  CGAL::box_self_intersection_d(
-      boxes.begin(), boxes.end(), [&](const CgalBox& x, const CgalBox& y) {
-        const std::size_t f = x.info(), g = y.info();
-        const Triangle &a = idx[f], &b = idx[g];
-        const SharedCorners c = sharedCorners(a, b);  // which corners, by index
-        const int shared = c.count, ia = c.ia, ib = c.ib;
-        const K::Triangle_3 &ta = tris[f], &tb = tris[g];
-        bool hit = false;
-        if (shared == 0) {
-          hit = CGAL::do_intersect(ta, tb);
-        } else if (shared == 1) {
-          hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
-                CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
-        } else if (shared == 2) {
-          const int apexA = ia, apexB = ib;
-          const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
-          hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
-                CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
-        } else {
-          hit = true;
-        }
-        pairs += hit;
-      });
-  return pairs;
+  long degenerate = 0;
+  return soupPairs(soupOf(m), degenerate);
 }
 
 long cgalCross(const Mesh& a, const Mesh& b) {

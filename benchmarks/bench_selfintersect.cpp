@@ -61,19 +61,7 @@ double msSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-// A triangle soup: what every method's output is measured on.
-struct Soup {
-  std::vector<K::Point_3> points;
-  std::vector<std::vector<std::size_t>> triangles;
-};
-
-Soup soupOf(const Mesh& m) {
-  Soup s;
-  for (const Point3& p : positionsOf(m)) s.points.emplace_back(p[0], p[1], p[2]);
-  for (const Triangle& t : trianglesOf(m))
-    s.triangles.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  return s;
-}
+using meshmend::bench::soupOf;  // and the core mesh's (cgal_mesh.h)
 
 Soup soupOf(SurfaceMesh& tm) {
   tm.collect_garbage();  // vertex indices 0..n-1
@@ -121,52 +109,6 @@ Outcome* sharedOutcome() {
       mmap(nullptr, sizeof(Outcome), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
   if (p == MAP_FAILED) throw std::runtime_error("mmap failed");
   return new (p) Outcome();
-}
-
-// Intersecting pairs of a soup that is not a polygon mesh: CGAL's
-// box_self_intersection_d and exact predicates, with the rule of
-// PMP::self_intersections (faces sharing a vertex intersect if an opposite
-// edge meets the other face; sharing an edge, if they fold onto each other).
-long soupPairs(const Soup& s, long& degenerate) {
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
-  std::vector<K::Triangle_3> tris;
-  std::vector<Box> boxes;
-  degenerate = 0;
-  for (std::size_t f = 0; f < s.triangles.size(); ++f) {
-    const auto& t = s.triangles[f];
-    tris.emplace_back(s.points[t[0]], s.points[t[1]], s.points[t[2]]);
-    if (tris.back().is_degenerate())
-      ++degenerate;
-    else
-      boxes.emplace_back(tris.back().bbox(), f);
-  }
-  long pairs = 0;
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& x, const Box& y) {
-    const auto &a = s.triangles[x.info()], &b = s.triangles[y.info()];
-    const K::Triangle_3 &ta = tris[x.info()], &tb = tris[y.info()];
-    int shared = 0, ia = -1, ib = -1;  // corners of a and b on a shared vertex
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (a[i] == b[j]) ++shared, ia = i, ib = j;
-    bool hit = false;
-    if (shared == 0) {
-      hit = CGAL::do_intersect(ta, tb);
-    } else if (shared == 1) {
-      hit = CGAL::do_intersect(tb, K::Segment_3(ta[(ia + 1) % 3], ta[(ia + 2) % 3])) ||
-            CGAL::do_intersect(ta, K::Segment_3(tb[(ib + 1) % 3], tb[(ib + 2) % 3]));
-    } else if (shared == 2) {
-      int apexA = 0, apexB = 0;  // the corners off the shared edge
-      while (std::count(b.begin(), b.end(), a[apexA])) ++apexA;
-      while (std::count(a.begin(), a.end(), b[apexB])) ++apexB;
-      const K::Point_3 &p = ta[(apexA + 1) % 3], &q = ta[(apexA + 2) % 3];
-      hit = CGAL::coplanar(p, q, ta[apexA], tb[apexB]) &&
-            CGAL::coplanar_orientation(p, q, ta[apexA], tb[apexB]) == CGAL::POSITIVE;
-    } else {
-      hit = true;
-    }
-    pairs += hit;
-  });
-  return pairs;
 }
 
 std::size_t findRoot(std::vector<std::size_t>& parent, std::size_t x) {
