@@ -5,6 +5,7 @@
 #include "common/base/errors.h"
 #include "common/exact/intersections.h"
 #include "common/repair/output_stage.h"
+#include "common/repair/patches/patch_ops.h"
 #include "common/repair/patches/patches.h"
 #include "common/repair/split/split.h"
 #include "fuzz/fuzz_input.h"
@@ -67,10 +68,7 @@ void booleans(const std::uint8_t* data, std::size_t size) {
     so.separate_meshes = false;
     so.weld_duplicates = operation & 8;
     SplitResult split = splitAlongIntersections({&ma, &mb}, so);
-    FaceLabels labels;
-    labels.curve_edges = curveEdgeFlags(split.merged, split.merged_curve_edges);
-    FaceOriginHandle fo = faceOrigins(split.merged);
-    for (int f = 0; f < split.merged.fn; ++f) labels.part.push_back(fo[f].layer);
+    const FaceLabels labels = mergedOutputLabels(split);
     Patches patches = paintPatches(split.merged, labels);
     classifyPatches(split.merged, labels, patches);
     const BooleanOperation op = BooleanOperation(operation % kBooleanOperations);

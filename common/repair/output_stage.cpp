@@ -249,9 +249,10 @@ class Rounder {
           const std::vector<char>& newFace, const std::vector<char>& movable, Scalar scalar,
           std::vector<Point3>& P)
       : ref_(reference), T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
-    CoordinateMagnitudes m;
-    for (const Point3& p : reference) m.add(p);
-    floor_ = std::ldexp(m.largest, -int(kMaxCoordinateBinades));
+    double largest = 0;
+    for (const Point3& p : reference)
+      largest = std::max({largest, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
+    floor_ = std::ldexp(largest, -int(kMaxCoordinateBinades));
     P_ = reference;
     for (std::size_t v = 0; v < P_.size(); ++v) {
       P_[v] = storedAs(P_[v], scalar);

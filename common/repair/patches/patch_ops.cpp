@@ -34,6 +34,14 @@ std::vector<int> parsePatchIds(const std::string& text, std::size_t patches) {
   return ids;
 }
 
+FaceLabels mergedOutputLabels(SplitResult& split) {
+  FaceLabels labels;
+  labels.curve_edges = curveEdgeFlags(split.merged, split.merged_curve_edges);
+  FaceOriginHandle fo = faceOrigins(split.merged);
+  for (std::size_t f = 0; f < split.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
+  return labels;
+}
+
 std::vector<std::string> partNotes(const Patches& p) {
   std::vector<std::string> notes;
   for (int part = 0; part < p.parts; ++part)

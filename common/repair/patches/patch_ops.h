@@ -12,6 +12,7 @@
 #include "common/base/mesh.h"
 #include "common/base/progress.h"
 #include "common/repair/patches/patches.h"
+#include "common/repair/split/split.h"
 
 namespace meshmend {
 
@@ -24,6 +25,11 @@ std::vector<int> parsePatchIds(const std::string& text, std::size_t patches);
 // (a fractional winding number near their holes) and parts taken turned
 // (closed, pointing inward).
 std::vector<std::string> partNotes(const Patches& patches);
+
+// The labels of intersect-and-split's merged output: its curve edges, and
+// as each face's part the input mesh it came from (the split's merged mesh
+// is not changed; its provenance handle is not const).
+FaceLabels mergedOutputLabels(SplitResult& split);
 
 // How Select Patches chooses (the filter's `by`, in its order).
 enum class PatchSelection {

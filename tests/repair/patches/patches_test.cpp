@@ -1,4 +1,5 @@
 #include "common/repair/patches/patches.h"
+#include "common/repair/patches/patch_ops.h"
 
 #include <gtest/gtest.h>
 
@@ -27,15 +28,6 @@ struct SplitPair {
   double volumeA = 0, volumeB = 0;
 };
 
-// The labels intersect-and-split gives its merged output: curves and parts.
-FaceLabels labelsOf(SplitResult& r) {
-  FaceLabels labels;
-  labels.curve_edges = curveEdgeFlags(r.merged, r.merged_curve_edges);
-  FaceOriginHandle fo = faceOrigins(r.merged);
-  for (std::size_t f = 0; f < r.merged.face.size(); ++f) labels.part.push_back(fo[f].layer);
-  return labels;
-}
-
 SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {
   const Mesh a = uvSphere(24, 32), b = uvSphere(20, 28, radiusB, offset);
   SplitOptions o;
@@ -44,7 +36,7 @@ SplitPair splitSpheres(Point3 offset, double radiusB = 1.0) {
   SplitPair pair;
   pair.volumeA = *inspect(a).volume;
   pair.volumeB = *inspect(b).volume;
-  pair.labels = labelsOf(r);
+  pair.labels = mergedOutputLabels(r);
   pair.mesh = r.merged;
   return pair;
 }
@@ -153,7 +145,7 @@ TEST(Patches, UnionOfBoxesSharingASideIsOneClosedBox) {
   const Mesh a = testing::gridCube(2), b = testing::moved(a, {1, 0, 0});
   SplitResult r = splitAlongIntersections({&a, &b});
   EXPECT_GT(r.coincident_faces, 0u);
-  const FaceLabels labels = labelsOf(r);
+  const FaceLabels labels = mergedOutputLabels(r);
   Patches p = paintPatches(r.merged, labels);
   classifyPatches(r.merged, labels, p);
   EXPECT_TRUE(p.part_closed[0] && p.part_closed[1]);
@@ -184,7 +176,7 @@ TEST(Patches, InsideOutPartsAreClassifiedAsTurned) {
   const Mesh a = uvSphere(24, 32), b = uvSphere(20, 28, 1.0, {0.9, 0.13, 0.07});
   auto volumesOf = [](const Mesh& x, const Mesh& y, std::vector<bool>* insideOut) {
     SplitResult r = splitAlongIntersections({&x, &y});
-    const FaceLabels labels = labelsOf(r);
+    const FaceLabels labels = mergedOutputLabels(r);
     Patches p = paintPatches(r.merged, labels);
     classifyPatches(r.merged, labels, p);
     if (insideOut) *insideOut = p.part_inside_out;
@@ -233,7 +225,7 @@ TEST(Patches, BooleansOfBoxesOverlappingInPlanes) {
     SCOPED_TRACE(c.name);
     const Mesh b = testing::moved(a, c.offset);
     SplitResult r = splitAlongIntersections({&a, &b});
-    const FaceLabels labels = labelsOf(r);
+    const FaceLabels labels = mergedOutputLabels(r);
     Patches p = paintPatches(r.merged, labels);
     classifyPatches(r.merged, labels, p);
     const double expected[] = {c.union_volume, c.intersection_volume, c.difference_volume};
@@ -279,7 +271,7 @@ TEST(Patches, APlanarOverlapWithAnOpenPartIsKeptOnce) {
   const Mesh a = makeMesh(points, all), b = makeMesh(points, open);
   ASSERT_EQ(open.size() + 8, all.size());
   SplitResult r = splitAlongIntersections({&a, &b});
-  const FaceLabels labels = labelsOf(r);
+  const FaceLabels labels = mergedOutputLabels(r);
   Patches p = paintPatches(r.merged, labels);
   classifyPatches(r.merged, labels, p);
   EXPECT_TRUE(p.part_closed[0]);
@@ -338,7 +330,7 @@ TEST(Patches, APatchOnBothSidesOfAnOpenPartIsSplit) {
   o.separate_meshes = false;
   SplitResult r = splitAlongIntersections({&small, &big}, o);
   ASSERT_GT(r.open_curves, 0u);
-  const FaceLabels labels = labelsOf(r);
+  const FaceLabels labels = mergedOutputLabels(r);
   Patches p = paintPatches(r.merged, labels);
   const std::size_t painted = p.patches.size();
   classifyPatches(r.merged, labels, p);

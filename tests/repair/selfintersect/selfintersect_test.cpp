@@ -8,6 +8,7 @@
 #include "common/base/errors.h"
 #include "common/exact/intersections.h"
 #include "common/repair/inspect/inspect.h"
+#include "common/repair/patches/patch_ops.h"
 #include "common/repair/patches/patches.h"
 #include "common/repair/split/split.h"
 #include "tests/mesh_builders.h"
@@ -65,10 +66,7 @@ double unionVolumeByWindingNumbers(const Mesh& a, const Mesh& b) {
   SplitOptions so;
   so.separate_meshes = false;
   SplitResult split = splitAlongIntersections({&a, &b}, so);
-  FaceLabels labels;
-  labels.curve_edges = curveEdgeFlags(split.merged, split.merged_curve_edges);
-  FaceOriginHandle fo = faceOrigins(split.merged);
-  for (int f = 0; f < split.merged.fn; ++f) labels.part.push_back(fo[f].layer);
+  const FaceLabels labels = mergedOutputLabels(split);
   Patches patches = paintPatches(split.merged, labels);
   classifyPatches(split.merged, labels, patches);
   const PatchChoice choice = choosePatches(patches, BooleanOperation::kUnion);
