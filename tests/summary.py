@@ -20,6 +20,16 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 
+def gtest_skip_reason(output):
+    """The message of a GTEST_SKIP: the line after GoogleTest's
+    'file:line: Skipped'."""
+    lines = output.splitlines()
+    for i, line in enumerate(lines[:-1]):
+        if line.endswith(": Skipped"):
+            return lines[i + 1].strip()
+    return ""
+
+
 def cases(xml_path):
     """(name, outcome, message) of every test case of a JUnit file; outcome
     is passed, failed or skipped."""
@@ -36,6 +46,8 @@ def cases(xml_path):
             yield name, "failed", (message or "").strip()
         elif skipped is not None or status in ("notrun", "disabled"):
             message = skipped.get("message", "") if skipped is not None else status
+            if message == "SKIP_REGULAR_EXPRESSION_MATCHED":  # a GTEST_SKIP: its own words
+                message = gtest_skip_reason(case.findtext("system-out") or "") or message
             yield name, "skipped", (message or "").strip()
         else:
             yield name, "passed", ""

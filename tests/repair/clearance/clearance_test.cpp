@@ -587,7 +587,7 @@ TEST(EnforceClearance, QuantisedScanFromTheCorpus) {
   // a codec would: non-adjacent faces come within 0.0029; tau = 0.004.
   const std::filesystem::path path =
       std::filesystem::path(__FILE__).parent_path() / "../../../../shared/data/scanned/spot.obj";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "corpus absent: " << path;
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing: " << path << " (the real meshes live in ../shared beside the project)";
   const Mesh original = readMesh(path.string());
   const std::vector<Point3> p = positionsOf(original);
   Point3 lo = p[0], hi = p[0];
