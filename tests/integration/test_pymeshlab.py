@@ -358,12 +358,12 @@ def test_trim_stitch_and_close_gaps(host, tmp_path):
 
 # ---- CAD-like cases in the double hosts ------------------------------------------
 
-def sample_params(name):
-    """The parameters of a sample script as pymeshlab takes them."""
+def sample_params(name, step=0):
+    """The parameters of a sample script's filter `step` as pymeshlab takes them."""
     convert = {"RichBool": lambda v: v == "true", "RichEnum": int, "RichMesh": int, "RichInt": int,
                "RichFloat": float, "RichString": str}
-    root = ET.parse(ROOT / "samples" / name).getroot()
-    return {p.get("name"): convert[p.get("type")](p.get("value")) for p in root.iter("Param")}
+    step = ET.parse(ROOT / "samples" / name).getroot().findall("filter")[step]
+    return {p.get("name"): convert[p.get("type")](p.get("value")) for p in step.iter("Param")}
 
 
 @pytest.mark.parametrize("case", sorted(cad_cases.CASES))
@@ -443,6 +443,30 @@ def test_corpus_pair_through_the_sample_in_the_double_host(host, tmp_path, a, b)
     r = json.loads(report.read_text())
     assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
     assert check["degenerate_faces"] == 0, check
+
+
+@pytest.mark.parametrize("a,b", CORPUS_PAIRS, ids=[f"{a}+{b}" for a, b in CORPUS_PAIRS])
+def test_corpus_pair_union_in_the_double_host(host, tmp_path, a, b):
+    """The union of each pair of ../shared/data in the double host
+    (samples/keep_outer_surface.mlx's filters): closed and edge-manifold
+    where both parts are closed, and free of intersecting pairs, by
+    meshcheck on the saved layer; the report's count is meshcheck's."""
+    require_shared_data()
+    report = tmp_path / "report.json"
+    sample = "keep_outer_surface.mlx"
+    out = job(host, tmp_path, [DATA / a, DATA / b],
+              [("meshmend_intersect_and_split", sample_params(sample, 0)),
+               ("meshmend_paint_patches", sample_params(sample, 1)),
+               ("meshmend_remove_patches", {**sample_params(sample, 2), "report_file": str(report)})],
+              save=tmp_path / "saved")
+    for k, step in enumerate(out["steps"]):
+        assert "error" not in step, (k, step)
+    union = next(l for l in out["layers"] if l["label"] == "intersected")
+    check = meshcheck(tmp_path / "saved" / f"{union['id']}.ply")
+    r = json.loads(report.read_text())
+    assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
+    if meshcheck(DATA / a)["is_closed"] and meshcheck(DATA / b)["is_closed"]:
+        assert check["is_closed"] and check["non_manifold_edges"] == 0, check
 
 
 @pytest.mark.parametrize("name", ["self_intersecting/cow.off", "self_intersecting/pig.off",
