@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bench_files import machine, write_off
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"
 
@@ -201,15 +203,6 @@ def strip_triangles(strip):
                 out.append((a, b, c) if j % 2 == 0 else (b, a, c))
         run = []
     return out
-
-
-def write_off(path, V, F):
-    """OFF with every coordinate written exactly (shortest round-trip repr)."""
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
-        f.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
-        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in F.tolist())
-    return path
 
 
 def compact(V, F):
@@ -1070,7 +1063,6 @@ def main():
     parser.add_argument("--keep", help="work folder to keep (holes, fills, patches, results.json)")
     parser.add_argument("--only", help="one mesh (e.g. spot), for a quick look")
     args = parser.parse_args()
-    from run import machine  # the machine line every section uses
     build = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
     print(section(build, args.repeat, machine(), args.keep, args.only))
 

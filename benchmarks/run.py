@@ -26,7 +26,6 @@ import argparse
 import gzip
 import json
 import os
-import platform
 import re
 import shutil
 import statistics
@@ -35,6 +34,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from bench_files import machine, write_off
 
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = Path(os.environ.get("MESHMEND_BUILD_DIR", ROOT / "build"))
@@ -117,18 +118,6 @@ BUILTIN = """<!DOCTYPE FilterScript>
  <filter name="Select Self Intersecting Faces"/>
 </FilterScript>
 """
-
-
-def machine():
-    cpu = "?"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores ({cpu}), {platform.system()} {platform.release()}"
 
 
 def threads_used():
@@ -260,14 +249,6 @@ def uv_sphere_arrays(centre, radius, rings, segments):
             faces += [(a, c, b), (b, c, d)]
     faces += [(ring(rings - 1, j), south, ring(rings - 1, j + 1)) for j in range(segments)]
     return points, faces
-
-
-def write_off(path, points, faces):
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(points)} {len(faces)} 0\n")
-        f.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in points)
-        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in faces)
-    return path
 
 
 def uv_sphere(path, centre, radius, rings, segments):

@@ -20,11 +20,12 @@ def tube(axis, n=24, rings=4, r=0.5, h=2.0):
 
 
 def write_off(path, V, F):
-    """A triangle mesh as an OFF file, coordinates written exactly (repr)."""
+    """A mesh as an OFF file (triangles or polygons), coordinates written
+    exactly (repr). Returns the path."""
     with open(path, "w") as f:
         f.write(f"OFF\n{len(V)} {len(F)} 0\n")
         for v in V:
             f.write(" ".join(repr(float(c)) for c in v) + "\n")
         for t in F:
-            f.write("3 " + " ".join(str(int(i)) for i in t) + "\n")
+            f.write(f"{len(t)} " + " ".join(str(int(i)) for i in t) + "\n")
     return path

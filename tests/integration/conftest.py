@@ -15,6 +15,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.append(str(ROOT / "tests"))  # shapes.py and environment.py, shared with the Python module's tests
+from shapes import write_off  # noqa: E402,F401
 from environment import (BUILD, DATA, MESHCHECK, SHARED, VENDOR, Host, meshcheck, need,  # noqa: E402,F401
                          require_meshcheck, require_shared_data)
 
@@ -98,21 +99,6 @@ def run_server(tmp_path, inputs, script_text, outputs=(), timeout=600):
 
 # ---- small meshes in every format ------------------------------------------
 
-def _write_counted(path, header, V, F):
-    """OFF and ASCII PLY share their body: vertex lines, then counted face lines."""
-    with open(path, "w") as f:
-        f.write(header)
-        for v in V:
-            f.write(" ".join(repr(float(c)) for c in v) + "\n")
-        for t in F:
-            f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
-    return path
-
-
-def write_off(path, V, F):
-    return _write_counted(path, f"OFF\n{len(V)} {len(F)} 0\n", V, F)
-
-
 def float_exact(src, dst):
     """A copy of the OFF file `src` whose coordinates are floats (rounded
     once, written exactly), faces (triangles or polygons) as they are: a float
@@ -129,10 +115,17 @@ def float_exact(src, dst):
 
 
 def write_ply(path, V, F):
-    return _write_counted(
-        path, f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"
-              f"property float z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n",
-        V, F)
+    """An ASCII PLY file (float coordinates in the header; values written
+    exactly, as the readers round them)."""
+    with open(path, "w") as f:
+        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty float x\nproperty float y\n"
+                f"property float z\nelement face {len(F)}\nproperty list uchar int vertex_indices\n"
+                "end_header\n")
+        for v in V:
+            f.write(" ".join(repr(float(c)) for c in v) + "\n")
+        for t in F:
+            f.write(f"{len(t)} " + " ".join(map(str, t)) + "\n")
+    return path
 
 
 def write_obj(path, V, F):

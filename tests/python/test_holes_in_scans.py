@@ -30,6 +30,7 @@ sys.path.append(str(ROOT / "tests"))
 
 import meshmend as mm  # noqa: E402
 from environment import DATA, MESHCHECK, need  # noqa: E402
+from shapes import write_off  # noqa: E402
 
 PEER_HOLEFILL = Path(os.environ.get("MESHMEND_PEER_HOLEFILL",
                                     MESHCHECK.parent / "peer_holefill"))
@@ -140,15 +141,14 @@ def border_loops(F):
     return lengths
 
 
-def write_off(path, V, F):
+def write_compact(path, V, F):
+    """The faces F and only the vertices they use, as an OFF file; returns
+    the arrays written."""
     used = np.unique(F)
     remap = np.full(len(V), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     V, F = V[used], remap[F]
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
-        f.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
-        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in F.tolist())
+    write_off(path, V, F)
     return V, F
 
 
@@ -179,7 +179,7 @@ def round_hole(V, F, seed_face, target, tmp_path, name, original):
             break
     for _, step, kept, longest, removed in sorted(tried, key=lambda t: t[:2])[:6]:
         path = tmp_path / f"{name}.off"
-        hV, hF = write_off(path, V, kept)
+        hV, hF = write_compact(path, V, kept)
         check = meshcheck(path)
         if check["connected_components"] == 1 and check["non_manifold_edges"] == 0 and \
                 check["non_manifold_vertices"] <= original["non_manifold_vertices"] and \
