@@ -283,7 +283,7 @@ def test_split_of_a_layer_that_meets_itself_only_through_duplicates(tmp_path):
     assert check["faces"] == 12 and check["self_intersecting_pairs"] == 0
 
 
-def test_split_refuses_a_layer_that_collapses_when_welded(tmp_path):
+def test_split_refuses_a_layer_whose_faces_all_collapse(tmp_path):
     """A unit cube at 1e8, where a float step is 8: as MeshLab stores it, all
     its corners are one point."""
     V, F = cube()
@@ -293,7 +293,7 @@ def test_split_refuses_a_layer_that_collapses_when_welded(tmp_path):
                           "weld_duplicate_vertices": True, "report_file": "{report0}"}))
     run = run_server(tmp_path, [a, b], script)
     assert run.returncode != 0 and not run.reports
-    assert "no face left" in run.log and "near the origin" in run.log
+    assert "no face with three corners at distinct positions" in run.log and "near the origin" in run.log
 
 
 def test_split_sample_runs(tmp_path):

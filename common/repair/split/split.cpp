@@ -72,6 +72,13 @@ namespace {
 // The inputs as arrays, with their seams closed when asked; each keeps the
 // input index of its vertices and faces. Meshes side by side; an error
 // names the first mesh at fault.
+bool hasFaceWithArea(const MeshArrays& mesh) {
+  const std::vector<Point3>& P = mesh.points;
+  for (const Triangle& t : mesh.triangles)
+    if (P[t[0]] != P[t[1]] && P[t[1]] != P[t[2]] && P[t[2]] != P[t[0]]) return true;
+  return false;
+}
+
 std::vector<WeldedArrays> prepareInputs(const std::vector<const Mesh*>& meshes,
                                         const SplitOptions& options, SplitResult& r) {
   std::vector<WeldedArrays> inputs(meshes.size());
@@ -96,12 +103,15 @@ std::vector<WeldedArrays> prepareInputs(const std::vector<const Mesh*>& meshes,
       },
       1);
   for (std::size_t m = 0; m < meshes.size(); ++m) {
-    if (inputs[m].mesh.triangles.empty())
+    // Faces with two corners at one position have no area, and the merged
+    // output welds them away: a mesh of only such faces would come out empty.
+    if (!hasFaceWithArea(inputs[m].mesh))
       throw InvalidInputError(
           "mesh " + std::to_string(m) +
-          " has no face left once its coincident vertices are welded: every face had two "
-          "corners at one position (as where coordinates are very large for the mesh's size, "
-          "stored in float); move the mesh near the origin first, or do not weld");
+          " has no face with three corners at distinct positions: every face has two corners "
+          "at one position (as where coordinates are very large for the mesh's size, stored "
+          "in float), so nothing of it would be left; move the mesh near the origin first, or "
+          "check the file");
     r.vertices_welded += inputs[m].vertices_merged;
     r.duplicate_faces_removed += duplicateFaces[m];
   }

@@ -172,6 +172,25 @@ TEST(Split, CurveThroughAVertexAndAlongAnEdge) {
   for (const Mesh& m : r.meshes) EXPECT_TRUE(check(m).is_closed);
 }
 
+TEST(Split, AMeshWhoseFacesAllHaveNoAreaIsRefusedNotEmptied) {
+  // Two vertices at one position, every face using both: welded or not,
+  // the merged output would have no face (found by fuzzing: an empty
+  // result in place of a refusal).
+  const Mesh flat = makeMesh({{0, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {1, 0, 3}});
+  for (bool weld : {false, true}) {
+    SplitOptions o;
+    o.weld_duplicates = weld;
+    try {
+      splitAlongIntersections({&flat}, o);
+      ADD_FAILURE() << "expected InvalidInputError (weld " << weld << ")";
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find("no face with three corners at distinct positions"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(Split, SelfIntersectionsOfOneMesh) {
   // Two overlapping cubes given as one mesh.
   std::vector<Point3> p = positionsOf(box());
