@@ -315,6 +315,7 @@ class HoleFiller {
     // many: then they grow by size_growth per layer towards the middle.
     FrontSettings settings;
     settings.merge = options_.merge_distance;
+    settings.maxTriangles = 10 * options_.uniform_face_limit;
     const double uniformFaces = std::abs(signedArea(d.uv)) / (0.433 * meanSize * meanSize);
     if (!std::isfinite(uniformFaces) || !(meanSize > 0) || !std::isfinite(meanSize)) {
       c.problem =

@@ -51,7 +51,8 @@ class AdvancingFront {
     const std::size_t expected = countOf(area / (0.43 * cell * cell)) + n;
     points_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
     edgeGrid_ = std::make_unique<Grid>(lo, hi, cell, 2 * expected + 16);
-    budget_ = 8 * (countOf(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000;
+    budget_ = std::min(8 * (countOf(area / (0.43 * minSize_ * minSize_)) + 4 * n) + 1000,
+                       settings.maxTriangles);
     for (const auto& [a, b] : existingEdges) edges_.insert(edgeKey(a, b));
     for (std::size_t i = 0; i < n; ++i)
       nodes_.push_back({int(i), int((i + n - 1) % n), int((i + 1) % n)});

@@ -22,6 +22,10 @@ struct FrontSettings {
   double growth = 1;       // target size growth per front layer (1: uniform triangles)
   double maxSize = 1e300;  // cap on the target size
   double merge = 0.6;      // merge distance, relative to the target size
+  // Work bound: the front stops (the hole not covered) past this many
+  // triangles. Its own estimate from the smallest border size can reach
+  // millions where one border edge is a thousandth of the others.
+  std::size_t maxTriangles = 200000;
 };
 
 struct Front {
