@@ -20,6 +20,28 @@ using namespace clearance_detail;
 
 namespace {
 
+// A move by tau must be representable where the layers lie: below one step
+// of the stored scalar at the largest coordinate, no vertex can move by that
+// little, and the pairs short of tau cannot even be told from touching ones.
+void requireRepresentableTau(const std::vector<Mesh*>& layers, const ClearanceOptions& options) {
+  double largest = 0;
+  for (const Mesh* m : layers)
+    for (const Vertex& v : m->vert)
+      if (!v.IsD())
+        largest =
+            std::max({largest, std::fabs(v.cP()[0]), std::fabs(v.cP()[1]), std::fabs(v.cP()[2])});
+  const Scalar scalar = options.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+  const double step = scalarStep(Point3(largest, 0, 0), scalar);
+  if (options.tau > step) return;
+  std::ostringstream m;
+  m.precision(3);
+  m << "tau (" << options.tau << ") is not more than one step of " << toString(scalar)
+    << " at these coordinates (" << step << " at " << largest
+    << "): no vertex can move by so little. Choose tau above " << step
+    << ", or move the parts nearer the origin";
+  throw InvalidInputError(m.str());
+}
+
 void checkOptions(const std::vector<Mesh*>& layers, const ClearanceOptions& options) {
   const double tau = options.tau;
   if (!(tau > 0) || !std::isfinite(tau))
@@ -28,6 +50,7 @@ void checkOptions(const std::vector<Mesh*>& layers, const ClearanceOptions& opti
     throw InvalidInputError("max_displacement must be a finite distance >= 0 (0 = no cap)");
   if (!(options.active_margin >= 0)) throw InvalidInputError("active_margin must be >= 0");
   checkCommon(std::vector<const Mesh*>(layers.begin(), layers.end()), options.exclusion_rings);
+  requireRepresentableTau(layers, options);
   if (options.locked.empty()) return;
   if (options.locked.size() != layers.size())
     throw InvalidInputError("locked must hold one list per layer (" +

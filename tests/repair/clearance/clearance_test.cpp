@@ -450,6 +450,31 @@ TEST(EnforceClearance, TooManyShortPairsIsAWorkBoundAndNothingMoves) {
   EXPECT_GT(enforceClearance(layers, o).violating_pairs_before, 1000u);
 }
 
+TEST(EnforceClearance, TauNotMoreThanOneStepOfTheCoordinatesIsRefused) {
+  // Grids 0.3 apart moved to 1e20, where a double step is 16384: a tau of
+  // 1e-3 cannot be a move (found by fuzzing: coordinates at 1e35 and tau
+  // 3e-41 gave "reached" with pairs at distance 0 left).
+  Mesh a = gridSquare(3, 0), b = gridSquare(3, 0.3, false);
+  for (Mesh* m : {&a, &b})
+    for (Vertex& v : m->vert) v.P() = v.cP() * 1e20;
+  const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);
+  std::vector<Mesh*> layers{&a, &b};
+  ClearanceOptions o;
+  o.tau = 1e-3;
+  o.scope = ClearanceScope::kBetweenLayers;
+  try {
+    enforceClearance(layers, o);
+    ADD_FAILURE() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not more than one step of double"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(positionsOf(a), pa);
+  EXPECT_EQ(positionsOf(b), pb);
+  o.tau = 1e19;  // a distance these coordinates can hold: taken
+  EXPECT_NO_THROW(enforceClearance(layers, o));
+}
+
 TEST(EnforceClearance, CancelledLeavesTheLayersUntouched) {
   Mesh a = gridSquare(3, 0), b = gridSquare(3, 0.3, false);
   const std::vector<Point3> pa = positionsOf(a), pb = positionsOf(b);
@@ -587,7 +612,9 @@ TEST(EnforceClearance, QuantisedScanFromTheCorpus) {
   // a codec would: non-adjacent faces come within 0.0029; tau = 0.004.
   const std::filesystem::path path =
       std::filesystem::path(__FILE__).parent_path() / "../../../../shared/data/scanned/spot.obj";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing: " << path << " (the real meshes live in ../shared beside the project)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << "missing: " << path
+                 << " (the real meshes live in ../shared beside the project)";
   const Mesh original = readMesh(path.string());
   const std::vector<Point3> p = positionsOf(original);
   Point3 lo = p[0], hi = p[0];
