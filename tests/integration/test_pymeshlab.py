@@ -366,6 +366,18 @@ def sample_params(name, step=0):
     return {p.get("name"): convert[p.get("type")](p.get("value")) for p in step.iter("Param")}
 
 
+def split_by_sample(host, tmp_path, inputs, sample):
+    """Intersect and Split with a sample's options in the host: meshcheck on
+    the merged layer as saved (binary, the host's scalar), the report, and
+    the layer's description."""
+    report = tmp_path / "report.json"
+    params = {**sample_params(sample), "report_file": str(report)}
+    out = job(host, tmp_path, inputs, [("meshmend_intersect_and_split", params)], save=tmp_path / "saved")
+    assert "error" not in out["steps"][0], out["steps"][0]
+    merged = next(l for l in out["layers"] if l["label"] == "intersected")
+    return meshcheck(tmp_path / "saved" / f"{merged['id']}.ply"), json.loads(report.read_text()), merged
+
+
 @pytest.mark.parametrize("case", sorted(cad_cases.CASES))
 def test_cad_case_through_the_sample_in_the_double_host(host, tmp_path, case):
     """The CAD-like cases of tests/cad_cases.py, written in double, through
@@ -375,13 +387,7 @@ def test_cad_case_through_the_sample_in_the_double_host(host, tmp_path, case):
     the report's remaining_intersecting_pairs is meshcheck's count."""
     parts = cad_cases.CASES[case]()
     inputs = [write_off(tmp_path / f"part{i}.off", V, F) for i, (V, F) in enumerate(parts)]
-    report = tmp_path / "report.json"
-    params = {**sample_params("intersect_split.mlx"), "report_file": str(report)}
-    out = job(host, tmp_path, inputs, [("meshmend_intersect_and_split", params)], save=tmp_path / "saved")
-    assert "error" not in out["steps"][0], out["steps"][0]
-    merged = next(l for l in out["layers"] if l["label"] == "intersected")
-    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
-    r = json.loads(report.read_text())
+    check, r, merged = split_by_sample(host, tmp_path, inputs, "intersect_split.mlx")
     assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
     assert check["degenerate_faces"] == 0 and check["faces"] == merged["faces"], check
     assert r["host_scalar"] == "double"
@@ -433,14 +439,7 @@ def test_corpus_pair_through_the_sample_in_the_double_host(host, tmp_path, a, b)
     pairs and 0 degenerate faces by meshcheck on the saved layer, and the
     report's remaining_intersecting_pairs is meshcheck's count."""
     require_shared_data()
-    report = tmp_path / "report.json"
-    params = {**sample_params("intersect_split.mlx"), "report_file": str(report)}
-    out = job(host, tmp_path, [DATA / a, DATA / b], [("meshmend_intersect_and_split", params)],
-              save=tmp_path / "saved")
-    assert "error" not in out["steps"][0], out["steps"][0]
-    merged = next(l for l in out["layers"] if l["label"] == "intersected")
-    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
-    r = json.loads(report.read_text())
+    check, r, _ = split_by_sample(host, tmp_path, [DATA / a, DATA / b], "intersect_split.mlx")
     assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
     assert check["degenerate_faces"] == 0, check
 
@@ -477,13 +476,6 @@ def test_corpus_self_intersecting_mesh_through_the_sample_in_the_double_host(hos
     host: 0 intersecting pairs by meshcheck on the saved layer, no degenerate
     face the input did not have, and the report's count is meshcheck's."""
     require_shared_data()
-    report = tmp_path / "report.json"
-    params = {**sample_params("split_self_intersections.mlx"), "report_file": str(report)}
-    out = job(host, tmp_path, [DATA / name], [("meshmend_intersect_and_split", params)],
-              save=tmp_path / "saved")
-    assert "error" not in out["steps"][0], out["steps"][0]
-    merged = next(l for l in out["layers"] if l["label"] == "intersected")
-    check = meshcheck(tmp_path / "saved" / f"{merged['id']}.ply")
-    r = json.loads(report.read_text())
+    check, r, _ = split_by_sample(host, tmp_path, [DATA / name], "split_self_intersections.mlx")
     assert check["self_intersecting_pairs"] == 0 == r["remaining_intersecting_pairs"], r
     assert check["degenerate_faces"] <= meshcheck(DATA / name)["degenerate_faces"], check
