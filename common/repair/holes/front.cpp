@@ -1,5 +1,7 @@
 #include "common/repair/holes/front.h"
 
+#include <cmath>
+
 #include <algorithm>
 #include <memory>
 #include <numeric>
@@ -424,9 +426,24 @@ TrianglesAround::TrianglesAround(const std::vector<Triangle>& triangles, std::si
     for (int v : triangles[t]) triangles_[std::size_t(next[std::size_t(v)]++)] = int(t);
 }
 
-Front advanceFront(const std::vector<Vec2>& boundary, const std::vector<double>& sizes,
-                   const std::vector<std::pair<int, int>>& existingEdges,
-                   const FrontSettings& settings) {
+namespace {
+
+// A domain whose coordinates leave 1e-50..1e50 (nonzero) makes every
+// orientation test of the front fall to GMP: such a domain is run centred
+// and scaled to unit size (coordinates below 1e-40 of it taken as 0), and
+// its new vertices mapped back. Other domains run as they are.
+bool needsNormalising(const std::vector<Vec2>& uv) {
+  for (const Vec2& p : uv)
+    for (double c : {p.x, p.y}) {
+      const double m = std::fabs(c);
+      if (m != 0 && (m < 1e-50 || m > 1e50)) return true;
+    }
+  return false;
+}
+
+Front runFront(const std::vector<Vec2>& boundary, const std::vector<double>& sizes,
+               const std::vector<std::pair<int, int>>& existingEdges,
+               const FrontSettings& settings) {
   AdvancingFront front(boundary, sizes, existingEdges, settings);
   Front out;
   out.covered = front.run();
@@ -434,6 +451,35 @@ Front advanceFront(const std::vector<Vec2>& boundary, const std::vector<double>&
   out.size = std::move(front.size);
   out.parent = std::move(front.parent);
   out.triangles = std::move(front.triangles);
+  return out;
+}
+
+}  // namespace
+
+Front advanceFront(const std::vector<Vec2>& boundary, const std::vector<double>& sizes,
+                   const std::vector<std::pair<int, int>>& existingEdges,
+                   const FrontSettings& settings) {
+  if (boundary.empty() || !needsNormalising(boundary))
+    return runFront(boundary, sizes, existingEdges, settings);
+  Vec2 lo = boundary[0], hi = boundary[0];
+  for (const Vec2& p : boundary) lo = boxLo(lo, p), hi = boxHi(hi, p);
+  const Vec2 centre = 0.5 * (lo + hi);
+  const double extent = std::max(hi.x - lo.x, hi.y - lo.y);
+  if (!(extent > 0) || !std::isfinite(extent))
+    return runFront(boundary, sizes, existingEdges, settings);
+  const double scale = 1 / extent, back = extent;
+  auto local = [&](double c) { return std::fabs(c) < 1e-40 ? 0.0 : c; };
+  std::vector<Vec2> uv;
+  for (const Vec2& p : boundary)
+    uv.push_back({local((p.x - centre.x) * scale), local((p.y - centre.y) * scale)});
+  std::vector<double> localSizes;
+  for (double s : sizes) localSizes.push_back(s * scale);
+  FrontSettings localSettings = settings;
+  localSettings.maxSize = std::min(settings.maxSize * scale, 1e300);
+  Front out = runFront(uv, localSizes, existingEdges, localSettings);
+  for (std::size_t v = 0; v < out.uv.size(); ++v)
+    out.uv[v] = v < boundary.size() ? boundary[v] : centre + back * out.uv[v];
+  for (double& s : out.size) s *= back;
   return out;
 }
 
