@@ -1,10 +1,8 @@
 #include "filter_mend_clearance.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
-#include "common/base/timing.h"
 #include "common/repair/clearance/clearance.h"
 #include "common/repair/edit_contract.h"
 #include "plugins/bridge/filter_support.h"
@@ -183,20 +181,26 @@ Chosen chosenLayers(MeshDocument& md, const RichParameterList& parameters) {
   return {{a, b}, scope == kBetweenTwo ? ClearanceScope::kBetweenLayers : ClearanceScope::kBoth};
 }
 
-// The chosen layers as core meshes in one frame: every layer's matrix is
-// applied, so that distances are those the user sees (and a percentage of
-// the document's diagonal means the same for every scope).
+// The chosen layers as core meshes in their own frames, with the layers'
+// matrices as the core's placements: the core measures where the viewer
+// shows them (a percentage of the document's diagonal means the same for
+// every scope) and stores moved vertices in each layer's frame.
 struct Inputs {
   Chosen chosen;
   std::vector<Mesh> cores;
+  std::vector<Placement> placements;
+  bool anyMatrix = false;
 };
 
 void readInputs(MeshDocument& md, const RichParameterList& parameters, Inputs& in) {
   in.chosen = chosenLayers(md, parameters);
   in.cores = std::vector<Mesh>(in.chosen.layers.size());
   for (std::size_t i = 0; i < in.chosen.layers.size(); ++i) {
-    toCore(in.chosen.layers[i]->cm, in.cores[i], {int(i), true});
+    const CMeshO& cm = in.chosen.layers[i]->cm;
+    toCore(cm, in.cores[i], {int(i), false});
     requireFacesAndFiniteCoordinates(in.cores[i], layerName(*in.chosen.layers[i]));
+    in.placements.push_back(Placement::Construct(cm.Tr));
+    in.anyMatrix |= !(cm.Tr == Matrix44m::Identity());
   }
 }
 
@@ -285,6 +289,7 @@ void ClearancePlugin::measure(MeshDocument& md, const RichParameterList& paramet
   readInputs(md, parameters, in);
   const std::vector<MeshModel*>& layers = in.chosen.layers;
   options.scope = in.chosen.scope;
+  options.placements = in.placements;
   std::vector<const Mesh*> meshes;
   for (const Mesh& m : in.cores) meshes.push_back(&m);
   const ClearanceMeasure r = measureClearance(meshes, options);
@@ -373,153 +378,45 @@ std::size_t lockSelected(Inputs& in, ClearanceOptions& options) {
   return count;
 }
 
-// The layers' frames. A layer placed by a matrix other than the identity is
-// not float in the common frame: the core's rounding (round_to_float)
-// shifts it by up to half a float step of its placed coordinates, and the
-// moved vertices round once more in the layer's own frame. The solve aims
-// beyond tau by more than both; the distances and displacements reported
-// are then measured on the exact input and on what the layers will store.
-struct Frames {
-  bool anyMatrix = false;
-  ClearanceMeasureOptions check;
-  ClearanceMeasure exactBefore;  // with a matrix: the input, exactly
-  // Per layer, per vertex in the common frame: exactly, and as the core
-  // takes it (rounded to float for a float host); a vertex the core did not
-  // move comes back as the latter.
-  std::vector<std::vector<Point3>> exact, rounded;
-};
-
-Frames framesOf(const Inputs& in, const ClearanceOptions& options) {
-  Frames f;
-  for (MeshModel* m : in.chosen.layers) f.anyMatrix |= !(m->cm.Tr == Matrix44m::Identity());
-  f.check.tau = options.tau;
-  f.check.scope = options.scope;
-  f.check.exclusion_rings = options.exclusion_rings;
-  std::vector<const Mesh*> cores;
-  for (const Mesh& m : in.cores) cores.push_back(&m);
-  if (f.anyMatrix) f.exactBefore = measureClearance(cores, f.check);
-  f.exact.resize(in.cores.size());
-  f.rounded.resize(in.cores.size());
-  for (std::size_t l = 0; l < in.cores.size(); ++l)
-    for (const Vertex& v : in.cores[l].vert) {
-      f.exact[l].push_back(v.cP());
-      f.rounded[l].push_back(kHostStoresFloat ? roundedToFloat(v.cP()) : v.cP());
-    }
-  return f;
-}
-
-// Per layer, the moved vertices (MeshLab's indices) in the layer's own
-// frame: back through the inverse matrix. The others keep their stored
-// coordinates bit for bit.
+// Per layer, the vertices the core moved (MeshLab's indices) and their new
+// positions in the layer's frame; the others keep theirs bit for bit.
 using Moves = std::vector<std::vector<std::pair<int, HostPoint>>>;
 
-Moves movesInLayerFrames(Inputs& in, const Frames& frames) {
+Moves movesOf(const Inputs& in) {
   Moves moves(in.cores.size());
   for (std::size_t l = 0; l < in.cores.size(); ++l) {
     const CMeshO& cm = in.chosen.layers[l]->cm;
-    const bool identity = cm.Tr == Matrix44m::Identity();
-    const vcg::Matrix44d inverse = vcg::Inverse(vcg::Matrix44d::Construct(cm.Tr));
-    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
+    VertexOriginHandle vo = vertexOrigins(const_cast<Mesh&>(in.cores[l]));
     for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
       const Point3& p = in.cores[l].vert[v].cP();
-      if (p == frames.rounded[l][v]) continue;
-      moves[l].emplace_back(vo[v].vertex, HostPoint::Construct(identity ? p : Point3(inverse * p)));
+      if (p != Point3::Construct(cm.vert[vo[v].vertex].cP()))
+        moves[l].emplace_back(vo[v].vertex, HostPoint::Construct(p));
     }
   }
   return moves;
 }
 
-// The outcome as the layers will store it. Without matrices it is the
-// core's own (it checked its float result); with them, it is measured
-// again on the stored floats placed by the matrices.
-struct Stored {
-  double minBefore = 0, minAfter = 0;
-  std::size_t pairsBefore = 0, pairsAfter = 0;
-  double maxMove = 0, meanMoved = 0, meanAll = 0;
-  bool reached = false;
-};
-
-Stored storedOutcome(const ClearanceResult& r, const Frames& frames, const Moves& moves,
-                     Inputs& in) {
-  Stored s{r.min_distance_before,    r.min_distance_after,
-           r.violating_pairs_before, r.violating_pairs_after,
-           r.max_displacement,       r.mean_displacement_moved,
-           r.mean_displacement_all,  r.reached};
-  if (!frames.anyMatrix) return s;
-  const ClearanceMeasure& before = frames.exactBefore;
-  s.minBefore = before.found ? before.min_distance : s.minBefore;
-  s.pairsBefore = before.violating_pairs;
-  // The cores are not needed in the common frame any more (only their face
-  // provenance is): they take the positions as they will be stored.
-  std::size_t vertices = 0, moved = 0;
-  double sum = 0;
-  s.maxMove = 0;
-  for (std::size_t l = 0; l < in.cores.size(); ++l) {
-    const CMeshO& cm = in.chosen.layers[l]->cm;
-    const vcg::Matrix44d tr = vcg::Matrix44d::Construct(cm.Tr);
-    std::vector<int> slot(cm.vert.size(), -1);
-    VertexOriginHandle vo = vertexOrigins(in.cores[l]);
-    for (std::size_t v = 0; v < in.cores[l].vert.size(); ++v) {
-      slot[vo[v].vertex] = int(v);
-      in.cores[l].vert[v].P() = frames.exact[l][v];
-    }
-    for (const auto& [vertex, p] : moves[l]) {
-      const int v = slot[vertex];
-      in.cores[l].vert[v].P() = tr * Point3::Construct(p);
-      const double d = Point3(in.cores[l].vert[v].cP() - frames.exact[l][v]).Norm();
-      s.maxMove = std::max(s.maxMove, d);
-      sum += d;
-      moved += d > 0;
-    }
-    vertices += in.cores[l].vert.size();
-  }
-  s.meanMoved = moved ? sum / double(moved) : 0;
-  s.meanAll = vertices ? sum / double(vertices) : 0;
-  std::vector<const Mesh*> cores;
-  for (const Mesh& m : in.cores) cores.push_back(&m);
-  const ClearanceMeasure after = measureClearance(cores, frames.check);
-  s.minAfter = after.found ? after.min_distance : s.minAfter;
-  s.pairsAfter = after.violating_pairs;
-  s.reached = r.reached && s.pairsAfter == 0;
-  return s;
-}
-
-JsonObject enforceReport(const ClearanceResult& r, const Stored& s, const Frames& frames,
-                         const std::vector<std::string>& failures, const Inputs& in,
-                         std::size_t lockedCount, double ms) {
+JsonObject enforceReport(const ClearanceResult& r, const std::vector<std::string>& failures,
+                         const Inputs& in, std::size_t lockedCount) {
   JsonObject report = toJson(r);
   reportContract(report, failures);
-  report.set("unchanged", s.pairsBefore == 0);
-  if (s.reached != r.reached) report.set("reached", false).set("stop_reason", "rounding");
-  report.set("scope", toString(in.chosen.scope))
+  return report.set("unchanged", r.violating_pairs_before == 0)
+      .set("scope", toString(in.chosen.scope))
       .set("layers", labels(in.chosen.layers))
+      .set("layer_matrices", in.anyMatrix)
       .set("locked_vertices", lockedCount)
-      .set("short_pairs", pairsJson(r.short_pairs, in.cores))
-      .set("time_ms", ms);
-  if (!frames.anyMatrix) return report;
-  // What the layers hold, placed by their matrices; the solve's own values
-  // (on the input rounded to float in the common frame) are kept beside.
-  return report.set("min_distance_before", s.minBefore)
-      .set("violating_pairs_before", s.pairsBefore)
-      .set("min_distance_after", s.minAfter)
-      .set("violating_pairs_after", s.pairsAfter)
-      .set("max_displacement", s.maxMove)
-      .set("mean_displacement", s.meanMoved)
-      .set("mean_displacement_moved", s.meanMoved)
-      .set("mean_displacement_all", s.meanAll)
-      .set("solve", JsonObject()
-                        .set("min_distance_before", r.min_distance_before)
-                        .set("min_distance_after", r.min_distance_after)
-                        .set("violating_pairs_after", r.violating_pairs_after)
-                        .set("max_displacement", r.max_displacement));
+      .set("short_pairs", pairsJson(r.short_pairs, in.cores));
 }
 
 // Why tau was not reached, and what to try.
-std::string whyNotReached(const ClearanceResult& r) {
-  if (r.reached)
-    return "rounding to the layers' own frames (their matrices) took some pairs back below tau: "
-           "apply the matrices first (Filters > Normals, Curvatures and Orientation > Matrix: "
-           "Freeze Current Matrix) and run again";
+std::string whyNotReached(const ClearanceResult& r, bool anyMatrix) {
+  if (r.stop_reason == "rounding" && anyMatrix)
+    return "storing the moved vertices in the layers' own frames (their matrices) took some "
+           "pairs back below tau: apply the matrices first (Filters > Normals, Curvatures and "
+           "Orientation > Matrix: Freeze Current Matrix) and run again";
+  if (r.stop_reason == "rounding")
+    return "rounding to float took some pairs back below tau: a double-precision MeshLab keeps "
+           "them, or choose a slightly larger tau";
   if (r.stop_reason == "locked")
     return "every pair still short has only locked (selected) or capped vertices: deselect "
            "some, raise the max displacement, or lower tau";
@@ -542,9 +439,7 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   options.scope = in.chosen.scope;
   const bool lock = parameters.getBool("lock_selected");
   const std::size_t lockedCount = lock ? lockSelected(in, options) : 0;
-  auto start = std::chrono::steady_clock::now();
-  const Frames frames = framesOf(in, options);
-  double ownMs = msSince(start);
+  options.placements = in.placements;
 
   std::vector<Mesh*> meshes;
   for (Mesh& m : in.cores) meshes.push_back(&m);
@@ -554,25 +449,18 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   } catch (const TopologyError& e) {
     throw TopologyError(std::string(e.what()) + " (" + layerList(layers) + ")");
   }
-  start = std::chrono::steady_clock::now();
-  const Moves moves = movesInLayerFrames(in, frames);
-  if (frames.anyMatrix)
-    reportProgress(options.progress, 98, "MeshMend: checking the stored result");
-  const Stored s = storedOutcome(r, frames, moves, in);
-  ownMs += msSince(start);
+  const Moves moves = movesOf(in);
 
   // The contract (clearance.h), on what the layers will hold.
-  const std::vector<std::string> failures =
-      clearanceContractFailures(s.minBefore, s.minAfter, r.new_intersecting_pairs);
+  const std::vector<std::string> failures = clearanceContractFailures(r);
   requireContract(failures, "Enforce Minimum Clearance", parameters.getBool("keep_partial"),
                   "Try a smaller tau or a max displacement, or turn on 'Keep a partial result' "
                   "to see what was made");
-  publishReport(parameters,
-                enforceReport(r, s, frames, failures, in, lockedCount, r.time_ms + ownMs));
-  if (s.pairsBefore == 0) {
+  publishReport(parameters, enforceReport(r, failures, in, lockedCount));
+  if (r.violating_pairs_before == 0) {
     Log("MeshMend: no pair of faces is closer than tau = %.6g (the closest: %.6g): nothing to "
         "move; the layers are unchanged",
-        r.tau, s.minBefore);
+        r.tau, r.min_distance_before);
     reportProgress(options.progress, 100, "MeshMend: done");
     return;
   }
@@ -595,25 +483,25 @@ void ClearancePlugin::enforce(MeshDocument& md, const RichParameterList& paramet
   if (layers.size() > 1)
     where = "layers '" + toStd(layers[0]->label()) + "' and '" + toStd(layers[1]->label()) + "'";
   Log("MeshMend: clearance %s %s, tau = %.6g: %s", scopeText, where.c_str(), r.tau,
-      s.reached ? "reached" : "NOT reached");
-  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", s.minBefore, s.minAfter,
-      s.pairsBefore, s.pairsAfter);
+      r.reached ? "reached" : "NOT reached");
+  Log("  minimum distance %.6g -> %.6g; pairs closer than tau %zu -> %zu", r.min_distance_before,
+      r.min_distance_after, r.violating_pairs_before, r.violating_pairs_after);
   Log("  %zu vertices moved (%zu locked): max displacement %.6g (no solution moves less than "
       "%.6g), mean %.6g; %d iterations, %.0f ms",
-      r.vertices_moved, lockedCount, s.maxMove, r.displacement_lower_bound, s.meanMoved,
-      r.iterations, r.time_ms + ownMs);
-  if (frames.anyMatrix)
+      r.vertices_moved, lockedCount, r.max_displacement, r.displacement_lower_bound,
+      r.mean_displacement_moved, r.iterations, r.time_ms);
+  if (in.anyMatrix)
     Log("  layer matrices applied; moved vertices written back in each layer's frame");
   if (lock && lockedCount == 0) Log("  note: no vertex is selected, so none was locked");
   if (r.vertices_capped) Log("  %zu vertices stopped at the max displacement", r.vertices_capped);
-  if (!s.reached) {
-    Log("  tau not reached: %s", whyNotReached(r).c_str());
+  if (!r.reached) {
+    Log("  tau not reached: %s", whyNotReached(r, in.anyMatrix).c_str());
     for (std::size_t i = 0; i < r.short_pairs.size(); ++i)
       Log("  short pair %zu: %s", i + 1, describe(r.short_pairs[i], in.cores, layers).c_str());
   }
   for (const std::string& w : r.warnings) Log("  warning: %s", w.c_str());
   if (r.new_intersecting_pairs)
-    Log("  check: %zu intersecting pairs in the float result", r.new_intersecting_pairs);
+    Log("  check: %zu intersecting pairs in the stored result", r.new_intersecting_pairs);
   for (const std::string& f : failures)
     Log("  warning: PARTIAL result (kept as asked): %s", f.c_str());
   reportProgress(options.progress, 100, "MeshMend: done");

@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include <vcg/math/matrix44.h>
+
 #include "common/base/json.h"
 #include "common/base/mesh.h"
 #include "common/base/progress.h"
@@ -37,6 +39,11 @@ enum class ClearanceScope {
   kBoth,
 };
 const char* toString(ClearanceScope scope);
+
+// Where a layer lies in the common frame: p ↦ M p, an affine matrix with an
+// inverse (MeshLab's layer matrix). Tau, the distances, the closest points
+// and the displacements are all in the common frame.
+using Placement = vcg::Matrix44d;
 
 // One pair of faces and where they come closest.
 struct ClearancePair {
@@ -60,6 +67,8 @@ struct ClearanceMeasureOptions {
   // the edge length measures the gaps between sheets, not the mesh's own
   // resolution. 1 or 2.
   int exclusion_rings = 1;
+  // Per layer, its placement; empty = every layer as it is (the identity).
+  std::vector<Placement> placements;
   // Local clearances (per vertex) and the histogram stop at this distance; 0
   // = 2τ, or 2 × the minimum when tau is 0.
   double local_max = 0;
@@ -87,9 +96,10 @@ struct ClearanceMeasure {
   double time_ms = 0;
 };
 
-// Measures the clearance of `layers` (compact, finite coordinates, all in one
-// frame). Throws InvalidInputError for a negative tau, bad options, or a
-// layer without faces or with a non-finite coordinate.
+// Measures the clearance of `layers` (compact, finite coordinates, placed by
+// options.placements). Throws InvalidInputError for a negative tau, bad
+// options or placements, or a layer without faces or with a non-finite
+// coordinate.
 ClearanceMeasure measureClearance(const std::vector<const Mesh*>& layers,
                                   const ClearanceMeasureOptions& options = {});
 
@@ -99,6 +109,12 @@ struct ClearanceOptions {
   double tau = 0;
   ClearanceScope scope = ClearanceScope::kBoth;  // which face pairs must be tau apart
   int exclusion_rings = 1;  // adjacency of faces, as in ClearanceMeasureOptions
+  // Per layer, its placement; empty = every layer as it is. The layers are
+  // read and written in their own frames: the solve works on the placed
+  // positions, and each moved vertex is stored in its layer's frame (rounded
+  // there, see round_to_float), placed again and checked there, so the
+  // result describes what the layers hold as the user sees them.
+  std::vector<Placement> placements;
   // Per layer, per vertex: vertices that must not move (e.g. MeshLab's
   // selection). Empty, or one list per layer of that layer's vertex count.
   std::vector<std::vector<char>> locked;
@@ -120,7 +136,8 @@ struct ClearanceOptions {
   // the input is taken as rounded to float (no change for MeshLab's meshes),
   // the solve aims a few float steps of the largest coordinate beyond tau,
   // and the rounded result is checked again (distances, exact intersections).
-  // Displacements are then measured from the rounded input.
+  // Displacements are then measured from the rounded input. A placed layer
+  // is rounded in its own frame, where it is stored.
   bool round_to_float = false;
   std::size_t max_listed_pairs = 10;  // pairs still short listed in the result
   Progress progress;                  // called once per iteration
@@ -132,8 +149,9 @@ struct ClearanceResult {
   // "reached", "iterations" (max_iterations used up), "stalled" (the line
   // search found no step that helps: locked vertices, the cap, or a tau the
   // shape cannot allow), "locked" (every pair still short has only locked or
-  // capped vertices), "rounding" (tau was reached, but rounding to float
-  // brought pairs back under it: see warnings).
+  // capped vertices), "rounding" (tau was reached, but storing the moved
+  // vertices, rounded to float or through a placement, brought pairs back
+  // under it: see warnings).
   std::string stop_reason;
   double min_distance_before = 0, min_distance_after = 0;  // over pairs in scope
   std::size_t violating_pairs_before = 0;                  // face pairs closer than tau
@@ -163,12 +181,14 @@ struct ClearanceResult {
   } stage_ms;
 };
 
-// Moves the vertices of `layers` (compact, finite coordinates, one frame) so
+// Moves the vertices of `layers` (compact, finite coordinates, placed by
+// options.placements) so
 // that every pair in scope is at least tau apart, if it can. Preconditions:
 // tau > 0 (InvalidInputError) and no intersecting faces within a layer or,
 // when the scope includes them, between layers (TopologyError naming the
 // MeshMend filter that resolves them). Positions are written back at the end,
-// also when tau was not reached (the result says so and lists the pairs
+// in each layer's own frame (a vertex that did not move keeps its
+// coordinates bit for bit), also when tau was not reached (the result says so and lists the pairs
 // still short); on an exception the layers are untouched.
 ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOptions& options);
 

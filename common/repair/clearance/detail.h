@@ -67,7 +67,9 @@ struct Soup {
   int rings = 1;
   double diagonal = 0;
 
-  Soup(const std::vector<const Mesh*>& layers, ClearanceScope s, int exclusionRings);
+  // The layers' points placed in the common frame (none: as they are).
+  Soup(const std::vector<const Mesh*>& layers, ClearanceScope s, int exclusionRings,
+       const std::vector<Placement>& placements = {});
 
   std::size_t faces() const { return triangles.size(); }
   int layers() const { return int(vertexOffset.size()) - 1; }
@@ -153,8 +155,13 @@ std::vector<ClearancePair> listShortest(const Soup& soup, const std::vector<Poin
                                         std::vector<NearPair> pairs, double below,
                                         std::size_t count);
 
-// What measuring and enforcing both require of the layers and the rings.
-void checkCommon(const std::vector<const Mesh*>& layers, int rings);
+// What measuring and enforcing both require of the layers, the rings and
+// the placements (none, or one affine invertible matrix per layer).
+void checkCommon(const std::vector<const Mesh*>& layers, int rings,
+                 const std::vector<Placement>& placements);
+
+// Is the placement the identity (the layer's frame is the common one)?
+bool isIdentity(const Placement& m);
 
 // ---- one enforcement (enforce.cpp, step.cpp, line_search.cpp) ---------------------
 
@@ -170,8 +177,11 @@ struct Separation {
   const ClearanceOptions& options;
   Soup soup;
   Targets targets;
-  std::vector<Point3>& P;      // current positions (soup.points)
-  std::vector<Point3> P0;      // the input's positions (rounded, with round_to_float)
+  std::vector<Point3>& P;  // current positions (soup.points)
+  std::vector<Point3> P0;  // the input's positions (rounded, with round_to_float)
+  // With placements: per vertex, its position in its layer's own frame as
+  // it will be written back (the input's, until a move is stored).
+  std::vector<Point3> own;
   std::vector<char> locked;    // per vertex: may not move
   std::vector<char> capped;    // per vertex: reached max_displacement
   std::vector<NearPair> near;  // the active pairs: in scope, closer than targets.near
@@ -179,7 +189,7 @@ struct Separation {
   std::size_t candidates = 0;  // pair distances computed
 
   Separation(const std::vector<const Mesh*>& layers, const ClearanceOptions& o)
-      : options(o), soup(layers, o.scope, o.exclusion_rings), P(soup.points) {}
+      : options(o), soup(layers, o.scope, o.exclusion_rings, o.placements), P(soup.points) {}
 };
 
 // One linearised step: the moved vertices and each one's displacement.

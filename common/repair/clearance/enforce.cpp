@@ -49,7 +49,8 @@ void checkOptions(const std::vector<Mesh*>& layers, const ClearanceOptions& opti
   if (!(options.max_displacement >= 0) || !std::isfinite(options.max_displacement))
     throw InvalidInputError("max_displacement must be a finite distance >= 0 (0 = no cap)");
   if (!(options.active_margin >= 0)) throw InvalidInputError("active_margin must be >= 0");
-  checkCommon(std::vector<const Mesh*>(layers.begin(), layers.end()), options.exclusion_rings);
+  checkCommon(std::vector<const Mesh*>(layers.begin(), layers.end()), options.exclusion_rings,
+              options.placements);
   requireRepresentableTau(layers, options);
   if (options.locked.empty()) return;
   if (options.locked.size() != layers.size())
@@ -109,15 +110,41 @@ std::vector<char> lockedVertices(const Soup& soup, const ClearanceOptions& optio
   return locked;
 }
 
-// Rounding to float moves each point by at most 2^-24 of its largest
-// coordinate in each axis, so two faces by twice √3 times that: the solve
-// aims beyond tau by four times this, and the result is checked again.
-Targets targetsFor(const Soup& soup, const ClearanceOptions& options) {
-  double maxCoordinate = 0;
-  for (const Point3& p : soup.points)
-    for (int k = 0; k < 3; ++k) maxCoordinate = std::max(maxCoordinate, std::abs(p[k]));
-  const double roundingMargin =
-      options.round_to_float ? 8 * std::sqrt(3.0) * std::ldexp(maxCoordinate, -24) : 0;
+bool placed(const ClearanceOptions& options, int layer) {
+  return !options.placements.empty() && !isIdentity(options.placements[layer]);
+}
+
+// The largest move storing can make in one axis: rounding to float moves a
+// coordinate by at most 2^-24 of the largest in its layer's frame, which a
+// placement carries to the common frame times its largest row sum; placing
+// and back in double add a few steps of 2^-53. Two faces move by twice √3
+// times that: the solve aims beyond tau by four times this, and the result
+// is checked again.
+double storingStep(const std::vector<Mesh*>& layers, const Soup& soup,
+                   const ClearanceOptions& options) {
+  double step = 0;
+  for (int l = 0; l < soup.layers(); ++l) {
+    double own = 0, there = 0, scale = 1;
+    for (const Vertex& v : layers[l]->vert)
+      for (int k = 0; k < 3; ++k) own = std::max(own, std::abs(v.cP()[k]));
+    for (int v = soup.vertexOffset[l]; v < soup.vertexOffset[l + 1]; ++v)
+      for (int k = 0; k < 3; ++k) there = std::max(there, std::abs(soup.points[v][k]));
+    if (placed(options, l)) {
+      const Placement& m = options.placements[l];
+      scale = 0;
+      for (int i = 0; i < 3; ++i)
+        scale = std::max(scale, std::abs(m.ElementAt(i, 0)) + std::abs(m.ElementAt(i, 1)) +
+                                    std::abs(m.ElementAt(i, 2)));
+      step = std::max(step, std::ldexp(scale * own + there, -50));
+    }
+    if (options.round_to_float) step = std::max(step, std::ldexp(scale * own, -24));
+  }
+  return step;
+}
+
+Targets targetsFor(const std::vector<Mesh*>& layers, const Soup& soup,
+                   const ClearanceOptions& options) {
+  const double roundingMargin = 8 * std::sqrt(3.0) * storingStep(layers, soup, options);
   Targets t;
   t.reached = options.tau * (1 + 1e-9) + roundingMargin;  // "done" for the solve
   t.goal = t.reached + 1e-4 * options.tau;                // aimed at by each linearised step
@@ -218,6 +245,29 @@ void separate(Separation& s) {
   }
 }
 
+// With placements, each moved vertex as its layer will store it: its move
+// taken back to the layer's frame (the move, not the position, so that the
+// error scales with the move and axes it does not move along stay as they
+// are), rounded there, and placed again (no re-rounding: the margin of
+// targetsFor covers it, and verifyStored measures what is left).
+void storeThroughPlacements(Separation& s, const std::vector<char>& movedVertex) {
+  for (int l = 0; l < s.soup.layers(); ++l) {
+    const Placement& m = s.options.placements[l];
+    const Placement inverse = vcg::Inverse(m);
+    for (int v = s.soup.vertexOffset[l]; v < s.soup.vertexOffset[l + 1]; ++v) {
+      if (!movedVertex[v]) continue;
+      const Point3 move = s.P[v] - s.P0[v];
+      Point3 own = s.own[v];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) own[i] += inverse.ElementAt(i, j) * move[j];
+      if (s.options.round_to_float) own = roundedToFloat(own);
+      s.own[v] = own;
+      s.P[v] = placed(s.options, l) ? Point3(m * own) : own;  // identity: no rounding
+    }
+  }
+  s.result.stored.scalar = s.options.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+}
+
 // The output as it will be stored: the moved vertices through the output
 // stage (output_stage.h; re-rounded where rounding would make a face around
 // them cross another), then every pair with a face around a moved vertex
@@ -233,9 +283,13 @@ void verifyStored(Separation& s) {
     const Triangle& t = soup.triangles[f];
     changed[f] = movedVertex[t[0]] || movedVertex[t[1]] || movedVertex[t[2]];
   }
-  OutputStageOptions stage;
-  stage.scalar = s.options.round_to_float ? Scalar::kFloat : Scalar::kDouble;
-  s.result.stored = storeNewPoints(P, soup.triangles, movedVertex, changed, stage);
+  if (s.options.placements.empty()) {
+    OutputStageOptions stage;
+    stage.scalar = s.options.round_to_float ? Scalar::kFloat : Scalar::kDouble;
+    s.result.stored = storeNewPoints(P, soup.triangles, movedVertex, changed, stage);
+  } else {
+    storeThroughPlacements(s, movedVertex);
+  }
   s.result.rounded_to_float = s.options.round_to_float;
 
   std::vector<Box> boxes;
@@ -279,11 +333,17 @@ void concludeOutcome(Separation& s) {
   if (r.reached) {
     r.stop_reason = "reached";
   } else if (r.stop_reason == "reached") {
-    // Only rounding to float can get here.
+    // Only storing (rounding, placements) can get here.
     r.stop_reason = "rounding";
-    r.warnings.push_back("rounding to float left " + std::to_string(r.violating_pairs_after) +
+    const std::string how = s.options.placements.empty()
+                                ? "rounding to float"
+                                : "storing the moved vertices in their layers' own frames";
+    r.warnings.push_back(how + " left " + std::to_string(r.violating_pairs_after) +
                          " pairs short of tau and " + std::to_string(r.new_intersecting_pairs) +
-                         " intersecting pairs");
+                         " intersecting pairs" +
+                         (s.options.placements.empty()
+                              ? std::string()
+                              : ": apply the placements to the layers first and run again"));
   }
   r.short_pairs = listShortest(s.soup, s.P, s.near, tau, s.options.max_listed_pairs);
   if (!r.reached && r.stop_reason == "stalled")
@@ -322,16 +382,21 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
   s.result.tau = options.tau;
   // With round_to_float everything works on the input as MeshLab stores it
   // (a no-op for a mesh that comes from MeshLab), so that only the moved
-  // vertices are rounded at the end, within the margin the solve keeps.
-  if (options.round_to_float)
-    for (Point3& p : s.P) p = roundedToFloat(p);
+  // vertices are rounded at the end, within the margin the solve keeps. A
+  // placed layer is stored in its own frame: it is read as it is.
+  for (int l = 0; l < s.soup.layers(); ++l)
+    for (int v = s.soup.vertexOffset[l]; v < s.soup.vertexOffset[l + 1]; ++v) {
+      if (options.round_to_float && !placed(options, l)) s.P[v] = roundedToFloat(s.P[v]);
+      if (!options.placements.empty())
+        s.own.push_back(layers[l]->vert[v - s.soup.vertexOffset[l]].cP());
+    }
   auto t0 = Clock::now();
   requireSeparateSurfaces(s.soup, options.scope);
   s.result.stage_ms.check = msSince(t0);
 
   s.locked = lockedVertices(s.soup, options);
   s.capped.assign(s.P.size(), 0);
-  s.targets = targetsFor(s.soup, options);
+  s.targets = targetsFor(layers, s.soup, options);
   s.P0 = s.P;
   detectShortPairs(s);
   separate(s);
@@ -344,10 +409,11 @@ ClearanceResult enforceClearance(std::vector<Mesh*>& layers, const ClearanceOpti
 
   // The last chance to cancel comes before the layers change.
   reportProgress(options.progress, 100, "Done");
+  const std::vector<Point3>& stored = options.placements.empty() ? s.P : s.own;
   for (int l = 0; l < s.soup.layers(); ++l) {
     Mesh& mesh = *layers[l];
     for (int i = 0; i < s.soup.vertexOffset[l + 1] - s.soup.vertexOffset[l]; ++i)
-      mesh.vert[i].P() = s.P[s.soup.vertexOffset[l] + i];
+      mesh.vert[i].P() = stored[s.soup.vertexOffset[l] + i];
   }
   s.result.time_ms = msSince(start);
   return s.result;

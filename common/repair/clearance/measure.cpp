@@ -31,9 +31,9 @@ ClearanceMeasure measureClearance(const std::vector<const Mesh*>& layers,
   if (!(options.local_max >= 0) || !std::isfinite(options.local_max))
     throw InvalidInputError("local_max must be a finite distance >= 0");
   if (options.histogram_bins < 1) throw InvalidInputError("histogram_bins must be at least 1");
-  checkCommon(layers, options.exclusion_rings);
+  checkCommon(layers, options.exclusion_rings, options.placements);
   reportProgress(options.progress, 0, "Preparing");
-  const Soup soup(layers, options.scope, options.exclusion_rings);
+  const Soup soup(layers, options.scope, options.exclusion_rings, options.placements);
   const std::vector<Point3>& P = soup.points;
 
   ClearanceMeasure m;

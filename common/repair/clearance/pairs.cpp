@@ -25,13 +25,16 @@ double gap2(const Box& x, const Box& y) {
 
 }  // namespace
 
-Soup::Soup(const std::vector<const Mesh*>& layers, ClearanceScope s, int exclusionRings)
+Soup::Soup(const std::vector<const Mesh*>& layers, ClearanceScope s, int exclusionRings,
+           const std::vector<Placement>& placements)
     : scope(s), rings(exclusionRings) {
   for (std::size_t l = 0; l < layers.size(); ++l) {
     vertexOffset.push_back(int(points.size()));
     faceOffset.push_back(int(triangles.size()));
     const int offset = int(points.size());
-    for (const Point3& p : positionsOf(*layers[l])) points.push_back(p);
+    const bool placed = !placements.empty() && !isIdentity(placements[l]);
+    for (const Point3& p : positionsOf(*layers[l]))
+      points.push_back(placed ? Point3(placements[l] * p) : p);
     for (Triangle t : trianglesOf(*layers[l])) {
       for (int& v : t) v += offset;
       triangles.push_back(t);
@@ -237,12 +240,33 @@ std::vector<ClearancePair> listShortest(const Soup& soup, const std::vector<Poin
   return out;
 }
 
-void checkCommon(const std::vector<const Mesh*>& layers, int rings) {
+bool isIdentity(const Placement& m) {
+  return m == Placement::Identity();
+}
+
+void checkCommon(const std::vector<const Mesh*>& layers, int rings,
+                 const std::vector<Placement>& placements) {
   if (layers.empty()) throw InvalidInputError("no layer given");
   for (std::size_t l = 0; l < layers.size(); ++l)
     requireFacesAndFiniteCoordinates(*layers[l], "layer " + std::to_string(l));
   if (rings != 1 && rings != 2)
     throw InvalidInputError("exclusion_rings must be 1 or 2, not " + std::to_string(rings));
+  if (!placements.empty() && placements.size() != layers.size())
+    throw InvalidInputError("placements must hold one matrix per layer (" +
+                            std::to_string(layers.size()) + "), not " +
+                            std::to_string(placements.size()));
+  for (std::size_t l = 0; l < placements.size(); ++l) {
+    const Placement& m = placements[l];
+    bool finite = true;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) finite &= std::isfinite(m.ElementAt(i, j));
+    const bool affine = m.ElementAt(3, 0) == 0 && m.ElementAt(3, 1) == 0 &&
+                        m.ElementAt(3, 2) == 0 && m.ElementAt(3, 3) == 1;
+    const double det = finite ? m.Determinant() : 0;
+    if (!finite || !affine || !(std::fabs(det) > 0) || !std::isfinite(det))
+      throw InvalidInputError("the placement of layer " + std::to_string(l) +
+                              " is not an invertible affine matrix (finite, last row 0 0 0 1)");
+  }
 }
 
 }  // namespace meshmend::clearance_detail

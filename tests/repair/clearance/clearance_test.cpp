@@ -297,6 +297,78 @@ TEST(EnforceClearance, ParallelSquaresMoveHalfTheShortfallEach) {
   EXPECT_EQ(r.new_intersecting_pairs, 0u);
 }
 
+// Sheet b is stored at z = 0 turned a quarter round z; its placement turns
+// it back over [0,1]² and lifts it 0.3 above sheet a.
+Placement quarterTurnLifted() {
+  Placement m = Placement::Identity();
+  m.ElementAt(0, 0) = 0, m.ElementAt(0, 1) = 1, m.ElementAt(1, 0) = -1, m.ElementAt(1, 1) = 0;
+  m.ElementAt(1, 3) = 1, m.ElementAt(2, 3) = 0.3;
+  return m;
+}
+
+TEST(EnforceClearance, PlacedLayersAreSolvedPlacedAndStoredInTheirOwnFrames) {
+  for (bool toFloat : {false, true}) {
+    // b's own frame: (x, y) = (1 - y', x') of the placed sheet, stored as
+    // a float host holds it.
+    Mesh a = gridSquare(3, 0), b = gridSquare(3, 0, false);
+    for (Vertex& v : b.vert) v.P() = roundedToFloat(Point3(1 - v.cP()[1], v.cP()[0], 0));
+    const std::vector<Point3> ownB = positionsOf(b);
+    std::vector<Mesh*> layers{&a, &b};
+    ClearanceMeasureOptions mo;
+    mo.scope = ClearanceScope::kBetweenLayers;
+    mo.placements = {Placement::Identity(), quarterTurnLifted()};
+    EXPECT_NEAR(measureClearance(view(layers), mo).min_distance, 0.3, 1e-12);
+
+    ClearanceOptions o;
+    o.tau = 0.5;
+    o.scope = ClearanceScope::kBetweenLayers;
+    o.placements = mo.placements;
+    o.round_to_float = toFloat;
+    const ClearanceResult r = enforceClearance(layers, o);
+    EXPECT_TRUE(r.reached) << r.stop_reason;
+    EXPECT_NEAR(r.min_distance_before, 0.3, 1e-12);
+    EXPECT_GE(r.min_distance_after, 0.5);
+    EXPECT_NEAR(r.max_displacement, 0.1, 1e-3);  // half the shortfall each
+    // b moved along its own z (the solve's steps are normal to the sheets
+    // up to rounding), and is stored there as asked.
+    const std::vector<Point3> outB = positionsOf(b);
+    for (std::size_t v = 0; v < outB.size(); ++v) {
+      EXPECT_NEAR(outB[v][0], ownB[v][0], 1e-8);
+      EXPECT_NEAR(outB[v][1], ownB[v][1], 1e-8);
+      EXPECT_NEAR(outB[v][2], 0.1, 1e-3);
+      if (toFloat) {
+        EXPECT_EQ(outB[v][2], double(float(outB[v][2])));
+      }
+    }
+    // What the layers hold, placed, is what the result says.
+    mo.tau = o.tau;
+    const ClearanceMeasure after = measureClearance(view(layers), mo);
+    EXPECT_EQ(after.min_distance, r.min_distance_after);
+    EXPECT_EQ(after.violating_pairs, 0u);
+  }
+}
+
+TEST(EnforceClearance, PlacementsMustBeOnePerLayerAffineAndInvertible) {
+  Mesh a = square(0), b = square(0.3, false);
+  const std::vector<Point3> pa = positionsOf(a);
+  std::vector<Mesh*> layers{&a, &b};
+  ClearanceOptions o;
+  o.tau = 0.5;
+  Placement flat = Placement::Identity(), projective = Placement::Identity();
+  flat.ElementAt(2, 2) = 0;
+  projective.ElementAt(3, 0) = 1;
+  for (const std::vector<Placement>& bad : {std::vector<Placement>{Placement::Identity()},
+                                            {Placement::Identity(), flat},
+                                            {projective, Placement::Identity()}}) {
+    o.placements = bad;
+    EXPECT_THROW(enforceClearance(layers, o), InvalidInputError);
+    ClearanceMeasureOptions mo;
+    mo.placements = bad;
+    EXPECT_THROW(measureClearance(view(layers), mo), InvalidInputError);
+  }
+  EXPECT_EQ(positionsOf(a), pa);
+}
+
 TEST(EnforceClearance, LockedSideMakesTheOtherMoveTheWholeShortfall) {
   Mesh a = gridSquare(3, 0), b = gridSquare(3, 0.3, false);
   std::vector<Mesh*> layers{&a, &b};
