@@ -8,34 +8,25 @@
 // configuration); also measureClearance alone, the detection it repeats.
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <memory>
 
 #include "benchmarks/harness.h"
-#include "common/repair/clearance/clearance.h"
 #include "common/io/mesh_io.h"
+#include "common/repair/clearance/clearance.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
 
 int main(int argc, char** argv) {
-  int repeat = 3, limit = 600;
-  double tau = 0;
-  std::string file;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
-      limit = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--tau") && i + 1 < argc)
-      tau = std::atof(argv[++i]);
-    else
-      file = argv[i];
-  }
-  if (file.empty() || !(tau > 0)) {
-    std::fprintf(stderr, "usage: bench_clearance [--repeat N] [--limit SECONDS] --tau T FILE\n");
+  CommandLine args(argc, argv);
+  const int repeat = args.integer("--repeat", 3), limit = args.integer("--limit", 600);
+  const double tau = args.real("--tau", 0);
+  if (!args.complete(1, 1, "bench_clearance [--repeat N] [--limit SECONDS] --tau T FILE")) return 1;
+  if (!(tau > 0)) {
+    std::fprintf(stderr, "bench_clearance: --tau must be more than 0\n");
     return 1;
   }
+  const std::string file = args.files()[0];
   ClearanceOptions enforce;
   enforce.tau = tau;
   enforce.scope = ClearanceScope::kWithinLayers;

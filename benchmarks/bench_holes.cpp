@@ -39,7 +39,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -53,9 +52,9 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
-#include "common/repair/holes/holes.h"
-#include "common/io/mesh_io.h"
 #include "common/base/parallel.h"
+#include "common/io/mesh_io.h"
+#include "common/repair/holes/holes.h"
 
 using namespace meshmend;
 using namespace meshmend::bench;
@@ -315,34 +314,19 @@ std::vector<std::string> splitList(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 5, limit = 600, threads = 1;
-  std::string outDir, file;
-  bool bad = false;
-  std::vector<std::string> names = {"meshmend_biharmonic", "meshmend_regression",
-                                    "meshmend_harmonic",   "meshmend_flat",
-                                    "cgal_refine_fair",    "meshlab_close_holes"};
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
-      limit = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
-      threads = std::max(0, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--methods") && i + 1 < argc)
-      names = splitList(argv[++i]);
-    else if (!std::strcmp(argv[i], "--out-dir") && i + 1 < argc)
-      outDir = argv[++i];
-    else if (file.empty() && argv[i][0] != '-')
-      file = argv[i];
-    else
-      bad = true;
-  }
-  if (bad || file.empty()) {
-    std::fprintf(stderr,
-                 "usage: bench_holes [--repeat N] [--limit SECONDS] [--threads N (0: all)] "
-                 "[--methods a,b,...] [--out-dir DIR] FILE\n");
+  CommandLine args(argc, argv);
+  const int repeat = std::max(1, args.integer("--repeat", 5)), limit = args.integer("--limit", 600),
+            threads = std::max(0, args.integer("--threads", 1));
+  const std::string outDir = args.text("--out-dir", "");
+  const std::vector<std::string> names =
+      splitList(args.text("--methods",
+                          "meshmend_biharmonic,meshmend_regression,meshmend_harmonic,"
+                          "meshmend_flat,cgal_refine_fair,meshlab_close_holes"));
+  if (!args.complete(1, 1,
+                     "bench_holes [--repeat N] [--limit SECONDS] [--threads N (0: all)] "
+                     "[--methods a,b,...] [--out-dir DIR] FILE"))
     return 1;
-  }
+  const std::string file = args.files()[0];
   std::vector<JsonObject> results;
   for (const std::string& name : names) {
     const std::string stem = outDir.empty() ? "" : outDir + "/" + name;

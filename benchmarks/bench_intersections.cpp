@@ -15,7 +15,6 @@
 #include <CGAL/box_intersection_d.h>
 
 #include <cstdio>
-#include <cstring>
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
@@ -79,18 +78,10 @@ long cgalCross(const Mesh& a, const Mesh& b) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 5;
-  std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::atoi(argv[++i]);
-    else
-      files.push_back(argv[i]);
-  }
-  if (files.empty() || files.size() > 2) {
-    std::fprintf(stderr, "usage: bench_intersections [--repeat N] A [B]\n");
-    return 1;
-  }
+  CommandLine args(argc, argv);
+  const int repeat = args.integer("--repeat", 5);
+  if (!args.complete(1, 2, "bench_intersections [--repeat N] A [B]")) return 1;
+  const std::vector<std::string>& files = args.files();
   const std::string a = files[0], b = files.size() > 1 ? files[1] : "";
   std::vector<Method> methods;
   if (!b.empty()) {

@@ -36,7 +36,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <new>
 #include <numeric>
 
@@ -260,21 +259,10 @@ Method cgalMethod(const std::string& name, const std::string& file, int repeat, 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 3, limit = 600;
-  std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
-      limit = std::atoi(argv[++i]);
-    else
-      files.push_back(argv[i]);
-  }
-  if (files.size() != 1) {
-    std::fprintf(stderr, "usage: bench_selfintersect [--repeat N] [--limit SECONDS] FILE\n");
-    return 1;
-  }
-  const std::string file = files[0];
+  CommandLine args(argc, argv);
+  const int repeat = std::max(1, args.integer("--repeat", 3)), limit = args.integer("--limit", 600);
+  if (!args.complete(1, 1, "bench_selfintersect [--repeat N] [--limit SECONDS] FILE")) return 1;
+  const std::string file = args.files()[0];
   std::vector<Method> methods;
   std::vector<Outcome*> outcomes;
   outcomes.push_back(sharedOutcome());

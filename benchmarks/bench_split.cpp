@@ -29,7 +29,6 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <cstdio>
-#include <cstring>
 #include <optional>
 
 #include "benchmarks/cgal_mesh.h"
@@ -46,31 +45,15 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 namespace {}  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 3, limit = 600;
-  bool sample = false, autorefine = false, warm = false, outputStage = false;
-  std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--sample"))
-      sample = true;
-    else if (!std::strcmp(argv[i], "--output-stage"))
-      outputStage = true;
-    else if (!std::strcmp(argv[i], "--autorefine"))
-      autorefine = true;
-    else if (!std::strcmp(argv[i], "--warm-allocator"))
-      warm = true;
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
-      limit = std::atoi(argv[++i]);
-    else
-      files.push_back(argv[i]);
-  }
-  if (files.size() != 2) {
-    std::fprintf(stderr,
-                 "usage: bench_split [--repeat N] [--limit SECONDS] [--sample] [--autorefine] "
-                 "[--warm-allocator] [--output-stage] A B\n");
+  CommandLine args(argc, argv, {"--sample", "--output-stage", "--autorefine", "--warm-allocator"});
+  const int repeat = args.integer("--repeat", 3), limit = args.integer("--limit", 600);
+  const bool sample = args.flag("--sample"), autorefine = args.flag("--autorefine"),
+             warm = args.flag("--warm-allocator"), outputStage = args.flag("--output-stage");
+  if (!args.complete(2, 2,
+                     "bench_split [--repeat N] [--limit SECONDS] [--sample] [--autorefine] "
+                     "[--warm-allocator] [--output-stage] A B"))
     return 1;
-  }
+  const std::vector<std::string>& files = args.files();
   if (warm) warmAllocator();  // before the children fork: all methods alike
   const std::string a = files[0], b = files[1];
   std::vector<Method> methods;

@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <memory>
 
@@ -99,22 +98,12 @@ std::size_t borderEdgesOf(const SurfaceMesh& tm) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 5, limit = 600, paths = 0;
-  std::string file;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--limit") && i + 1 < argc)
-      limit = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--paths") && i + 1 < argc)
-      paths = std::atoi(argv[++i]);
-    else
-      file = argv[i];
-  }
-  if (file.empty() == (paths <= 0)) {
-    std::fprintf(stderr, "usage: bench_stitch [--repeat N] [--limit SECONDS] (--paths N | FILE)\n");
-    return 1;
-  }
+  CommandLine args(argc, argv);
+  const int repeat = args.integer("--repeat", 5), limit = args.integer("--limit", 600),
+            paths = args.integer("--paths", 0);
+  const char* usage = "bench_stitch [--repeat N] [--limit SECONDS] (--paths N | FILE)";
+  if (!args.complete(paths > 0 ? 0 : 1, paths > 0 ? 0 : 1, usage)) return 1;
+  const std::string file = paths > 0 ? "" : args.files()[0];
   std::vector<Method> methods;
   JsonObject out;
   if (paths > 0) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -147,6 +148,48 @@ void warmAllocator() {
   // would have reached (DEFAULT_MMAP_THRESHOLD_MAX, twice that for trimming).
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 64 << 20);
+}
+
+CommandLine::CommandLine(int argc, char** argv, std::set<std::string> flags)
+    : flags_(std::move(flags)) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0)
+      files_.push_back(arg);
+    else if (flags_.count(arg))
+      given_.insert(arg);
+    else if (i + 1 < argc)
+      values_[arg] = argv[++i];
+    else
+      malformed_ = true;
+  }
+}
+
+bool CommandLine::flag(const std::string& name) {
+  read_.insert(name);
+  return given_.count(name) > 0;
+}
+
+int CommandLine::integer(const std::string& name, int fallback) {
+  return int(std::lround(real(name, fallback)));
+}
+
+double CommandLine::real(const std::string& name, double fallback) {
+  const std::string t = text(name, "");
+  return t.empty() ? fallback : std::atof(t.c_str());
+}
+
+std::string CommandLine::text(const std::string& name, const std::string& fallback) {
+  read_.insert(name);
+  const auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+bool CommandLine::complete(std::size_t minFiles, std::size_t maxFiles, const char* usage) const {
+  bool ok = !malformed_ && files_.size() >= minFiles && files_.size() <= maxFiles;
+  for (const auto& [name, value] : values_) ok &= read_.count(name) > 0;
+  if (!ok) std::fprintf(stderr, "usage: %s\n", usage);
+  return ok;
 }
 
 }  // namespace meshmend::bench

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <functional>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -53,5 +55,26 @@ Measurement measure(const Method& method, int repeat, int timeLimitSeconds = 600
 void warmAllocator();
 
 JsonObject toJson(const Measurement& m);
+
+// A runner's command line: "--name value" options, the "--flag"s declared
+// as such, and the files, in any order. Each runner reads what it takes;
+// complete() then says whether that was all (no option left unread, the
+// number of files right) and prints the usage line when it was not.
+class CommandLine {
+ public:
+  CommandLine(int argc, char** argv, std::set<std::string> flags = {});
+  bool flag(const std::string& name);
+  int integer(const std::string& name, int fallback);
+  double real(const std::string& name, double fallback);
+  std::string text(const std::string& name, const std::string& fallback);
+  const std::vector<std::string>& files() const { return files_; }
+  bool complete(std::size_t minFiles, std::size_t maxFiles, const char* usage) const;
+
+ private:
+  std::set<std::string> flags_, given_, read_;
+  std::map<std::string, std::string> values_;
+  std::vector<std::string> files_;
+  bool malformed_ = false;  // an option without its value
+};
 
 }  // namespace meshmend::bench
