@@ -564,6 +564,23 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
   return false;
 }
 
+// Exact and sufficient for the same, by the planes' floating-point filters
+// alone: sharing an edge, the fourth corner off the other face's plane (a
+// face crosses that plane only along the edge); sharing one corner, the
+// other two corners of one face strictly on one side of the other's plane
+// (it meets that plane only at the corner). Most neighbours in a curved
+// surface; flat ones, which the filters cannot tell, go to the projection.
+bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const TrianglePoints& b) {
+  if (c.count == 2) return orient3dFiltered(a[0], a[1], a[2], b[c.ib]) != 0;
+  if (c.count != 1) return false;
+  auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int shared) {
+    const int side = orient3dFiltered(plane[0], plane[1], plane[2], face[(shared + 1) % 3]);
+    return side != 0 &&
+           side == orient3dFiltered(plane[0], plane[1], plane[2], face[(shared + 2) % 3]);
+  };
+  return oneSide(b, a, c.ia) || oneSide(a, b, c.ib);
+}
+
 }  // namespace
 
 namespace {
@@ -581,7 +598,7 @@ bool facesMeet(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
   if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
   const SharedCorners c = sharedCorners(ta, tb);
   if (c.count == 3 && !sameVertices) return false;
-  if (c.count < 3 && separatedInProjection(ta, a, tb, b)) return false;
+  if (c.count < 3 && (apartByPlanes(c, a, b) || separatedInProjection(ta, a, tb, b))) return false;
   return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
 }
 

@@ -22,6 +22,11 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
 // the four points are coplanar.
 int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
 
+// orient3d's floating-point stage alone: the exact sign where its error
+// bound certifies it, 0 where it cannot tell (the points coplanar or nearly
+// so). A cheap first test, for callers with an exact test to fall back on.
+int orient3dFiltered(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+
 // Exact: are the three points collinear (including coincident points)?
 bool collinear(const Point3& a, const Point3& b, const Point3& c);
 
