@@ -230,8 +230,7 @@ std::vector<double> roundingChoices(double x, int reach, Scalar scalar) {
   return out;
 }
 
-// The faces around each vertex (compressed rows) and, per changed face, its
-// candidate pairs both ways.
+// Items per index, in compressed rows (the changed faces around each vertex).
 struct Rows {
   std::vector<std::uint32_t> offsets, items;
   std::pair<const std::uint32_t*, const std::uint32_t*> row(std::size_t i) const {
@@ -273,7 +272,7 @@ class Rounder {
     budget_ = budget;
     if (crossing_.size() > giveUpAbove) return crossing_.size();
     if (crossing_.empty() && collapsedFaces().empty()) return 0;
-    buildRows();                            // only re-rounding needs them
+    buildAround();                          // only re-rounding needs it
     std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
     const std::vector<Point3> nearest = P_;
     // Each coordinate goes to one of the `reach` values below its unrounded
@@ -303,6 +302,7 @@ class Rounder {
       for (const auto& p : crossing_)
         for (std::uint32_t f : p) addCorners(f);
       for (std::uint32_t f : flat) addCorners(f);
+      addRows(candidates);
       for (int v : candidates) {
         if (tests_ >= budget_) break;  // the bound holds within a pass too
         moved[v] = reround(v, reach);
@@ -346,30 +346,12 @@ class Rounder {
       if (inPair[f]) degenerate_[f] = isFlat(std::uint32_t(f));
   }
 
-  // Per changed face, its candidates both ways, and per vertex the changed
-  // faces around it (compressed rows).
-  void buildRows() {
+  // Per vertex, the changed faces around it (compressed rows).
+  void buildAround() {
     changedIndex_.assign(T_.size(), -1);
     for (std::size_t i = 0; i < changed_.size(); ++i) changedIndex_[changed_[i]] = int(i);
-    // Faces with the same three vertices (a planar overlap kept in each
-    // part) coincide however their vertices are rounded: never a crossing.
-    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
-                                [&](const auto& p) { return sameVertices(T_[p[0]], T_[p[1]]); }),
-                 pairs_.end());
-    others_.offsets.assign(changed_.size() + 1, 0);
-    for (const auto& [f, g] : pairs_) {
-      ++others_.offsets[changedIndex_[f] + 1];
-      if (changedIndex_[g] >= 0) ++others_.offsets[changedIndex_[g] + 1];
-    }
-    for (std::size_t i = 0; i < changed_.size(); ++i) others_.offsets[i + 1] += others_.offsets[i];
-    others_.items.resize(others_.offsets.back());
-    {
-      std::vector<std::uint32_t> next(others_.offsets.begin(), others_.offsets.end() - 1);
-      for (const auto& [f, g] : pairs_) {
-        others_.items[next[changedIndex_[f]]++] = g;
-        if (changedIndex_[g] >= 0) others_.items[next[changedIndex_[g]]++] = f;
-      }
-    }
+    rows_.assign(changed_.size(), {});
+    hasRow_.assign(changed_.size(), 0);
     around_.offsets.assign(P_.size() + 1, 0);
     for (std::uint32_t f : changed_)
       for (int v : T_[f]) ++around_.offsets[v + 1];
@@ -378,6 +360,32 @@ class Rounder {
     std::vector<std::uint32_t> next(around_.offsets.begin(), around_.offsets.end() - 1);
     for (std::uint32_t f : changed_)
       for (int v : T_[f]) around_.items[next[v]++] = f;
+  }
+
+  // The candidates of each changed face around `vertices`, both ways, for
+  // the faces that have none yet: one pass over the pairs per pass of
+  // re-rounding, which touches a few vertices (all faces' rows at once cost
+  // more than the rest of re-rounding). Faces with the same three vertices
+  // (a planar overlap kept in each part) coincide however their vertices
+  // are rounded: never a crossing, never a candidate.
+  void addRows(const std::set<int>& vertices) {
+    bool any = false;
+    for (int v : vertices)
+      for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
+        char& has = hasRow_[std::size_t(changedIndex_[*f])];
+        if (!has) has = 2, any = true;  // 2: to be filled now
+      }
+    if (!any) return;
+    auto wanted = [&](std::uint32_t f) {
+      return changedIndex_[f] >= 0 && hasRow_[std::size_t(changedIndex_[f])] == 2;
+    };
+    for (const auto& [f, g] : pairs_) {
+      if (!wanted(f) && !wanted(g)) continue;
+      if (sameVertices(T_[f], T_[g])) continue;
+      if (wanted(f)) rows_[std::size_t(changedIndex_[f])].push_back(g);
+      if (wanted(g)) rows_[std::size_t(changedIndex_[g])].push_back(f);
+    }
+    for (char& has : hasRow_) has = has != 0;
   }
 
   bool isFlat(std::uint32_t f) const {
@@ -432,9 +440,9 @@ class Rounder {
     std::size_t n = 0;
     for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
       if ((n += 2 * collapsed(*f)) >= enough) return n;
-      for (auto [g, last] = others_.row(std::size_t(changedIndex_[*f])); g != last; ++g) {
+      for (std::uint32_t g : rows_[std::size_t(changedIndex_[*f])]) {
         ++tests_;
-        if ((n += facesIntersect(P_, T_, *f, *g)) >= enough) return n;
+        if ((n += facesIntersect(P_, T_, *f, g)) >= enough) return n;
       }
     }
     return n;
@@ -484,10 +492,12 @@ class Rounder {
   const Scalar scalar_;
   std::vector<Point3>& P_;
   std::vector<char> isChanged_, degenerate_;
+  std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
+  std::vector<char> hasRow_;
   std::vector<int> changedIndex_;
   std::vector<std::uint32_t> changed_;
   std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
-  Rows others_, around_;
+  Rows around_;
   std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
   double floor_ = 0;
 
