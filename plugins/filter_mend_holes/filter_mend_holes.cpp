@@ -49,9 +49,9 @@ QString HolesPlugin::filterInfo(FilterIDType) const {
 
 void HolesPlugin::initParameters(QAction*, MeshDocument&, RichParameterList& parameters) {
   const HoleFillOptions defaults;
-  parameters.addParam(
-      RichInt("max_boundary_edges", 0, "Max hole size (border edges)",
-              "Holes with more border edges than this are left open; 0 fills holes of any size."));
+  parameters.addParam(RichInt(
+      "max_boundary_edges", int(defaults.max_boundary_edges), "Max hole size (border edges)",
+      "Holes with more border edges than this are left open; 0 fills holes of any size."));
   parameters.addParam(RichFloat(
       "max_diameter", 0.5f, "Max hole diameter (fraction of the diagonal)",
       "Holes wider than this fraction of the bounding box diagonal are left open, so that the "

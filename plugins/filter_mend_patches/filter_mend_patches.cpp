@@ -20,14 +20,6 @@ using namespace meshmend::bridge;
 namespace {
 
 enum Layers { kCurrentLayer, kAllVisible };
-enum SelectBy {
-  kByIds,
-  kTouchingSelection,
-  kOutsideOthers,
-  kInsideAllOthers,
-  kInsidePart,
-  kUnionInterior
-};
 // The "keep" choices: the unselected patches, then the boolean operations in their order.
 enum Keep { kUnselected, kUnion, kIntersection, kDifference };
 static_assert(kDifference - kUnion + 1 == kBooleanOperations);
@@ -211,6 +203,9 @@ int PatchesPlugin::postconditions(QAction* a) const {
 }
 
 void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList& parameters) {
+  const PaintOptions paint;
+  const SelectPatchesOptions select;
+  const RemovePatchesOptions remove;
   parameters.addParam(RichEnum(
       "layers", kCurrentLayer,
       QStringList() << "The current layer"
@@ -220,16 +215,19 @@ void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList&
       "remember their input layer), or all visible layers together (each one a part)."));
   switch (ID(a)) {
     case PAINT_PATCHES:
-      parameters.addParam(RichBool("at_curves", true, "Stop at intersection curves",
+      parameters.addParam(RichBool("at_curves", paint.at_curves, "Stop at intersection curves",
                                    "Curve edges marked by 'Intersect and Split Layers' bound "
                                    "patches."));
-      parameters.addParam(RichBool("at_non_manifold", true, "Stop at non-manifold edges",
+      parameters.addParam(RichBool("at_non_manifold", paint.at_non_manifold,
+                                   "Stop at non-manifold edges",
                                    "Edges shared by three or more faces bound patches (the "
                                    "curves of a merged layer are such edges)."));
-      parameters.addParam(RichBool("at_colour_changes", false, "Stop at colour changes",
+      parameters.addParam(RichBool("at_colour_changes", paint.at_colour_changes,
+                                   "Stop at colour changes",
                                    "An edge between faces of different colour bounds patches "
                                    "(surface groups of a CAD export)."));
-      parameters.addParam(RichFloat("crease_angle", 0, "Stop at creases sharper than (degrees)",
+      parameters.addParam(RichFloat("crease_angle", float(paint.crease_angle_deg),
+                                    "Stop at creases sharper than (degrees)",
                                     "An edge whose faces' normals differ by more than this "
                                     "angle bounds patches; 0 = off."));
       parameters.addParam(RichBool("classify", true, "Classify inside / outside",
@@ -237,7 +235,7 @@ void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList&
                                    "each other part; on the outer surface or not)."));
       break;
     case SELECT_PATCHES:
-      parameters.addParam(RichEnum("by", kTouchingSelection,
+      parameters.addParam(RichEnum("by", int(select.by),  // the choices in PatchSelection's order
                                    QStringList() << "Patch ids"
                                                  << "Patches touching the selected faces"
                                                  << "Outside all other parts"
@@ -248,22 +246,23 @@ void PatchesPlugin::initParameters(QAction* a, MeshDocument&, RichParameterList&
       parameters.addParam(RichString("ids", "", "Patch ids",
                                      "For 'Patch ids': ids as listed by 'Paint Surface Patches', "
                                      "like 0, 3, 5-7."));
-      parameters.addParam(RichInt("part", 1, "Part",
+      parameters.addParam(RichInt("part", select.part, "Part",
                                   "For 'Inside one part': the part (input layer number, from "
                                   "0) the patches must lie inside."));
       break;
     default:
       parameters.addParam(RichEnum(
-          "keep", kUnion,
+          "keep", remove.keep ? kUnion + int(*remove.keep) : kUnselected,
           QStringList() << "All but the patches with a selected face"
                         << "Outer surface (union)"
                         << "Common interior (intersection)"
                         << "First part minus the others (difference)",
           "Keep", "What to keep: everything except the selected patches, or a boolean result."));
-      parameters.addParam(RichBool("removed_to_layer", false, "Move removed patches to a layer",
+      parameters.addParam(RichBool("removed_to_layer", remove.removed_mesh,
+                                   "Move removed patches to a layer",
                                    "Puts the removed patches into a new layer named 'removed "
                                    "patches' instead of deleting them."));
-      parameters.addParam(RichBool("verify", true, "Check the result",
+      parameters.addParam(RichBool("verify", remove.verify, "Check the result",
                                    "Counts intersecting pairs (exact), non-manifold and border "
                                    "edges of the result and logs them."));
       break;
