@@ -124,6 +124,38 @@ TEST(Intersections, AgreesWithBruteForceOnRandomSoups) {
   }
 }
 
+// Neighbours on a small integer grid: many pairs sharing an edge or a
+// corner are coplanar or nearly so, where the planes' filters cannot tell
+// and the projection or the exact test must.
+TEST(Intersections, FacesIntersectAgreesWithTheRulesOnNeighbours) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> coordinate(-2, 2);
+  std::uniform_real_distribution<double> jitter(-1e-15, 1e-15);
+  std::size_t meeting = 0, apart = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<Point3> p;
+    for (int k = 0; k < 4 + trial % 2; ++k) {
+      Point3 q(coordinate(rng), coordinate(rng), coordinate(rng));
+      if (trial % 3 == 0) q += Point3(jitter(rng), jitter(rng), jitter(rng));
+      p.push_back(q);
+    }
+    // Sharing an edge (four points) or one corner (five).
+    const std::vector<Triangle> t = p.size() == 4 ? std::vector<Triangle>{{0, 1, 2}, {1, 0, 3}}
+                                                  : std::vector<Triangle>{{0, 1, 2}, {0, 3, 4}};
+    if (collinear(p[t[0][0]], p[t[0][1]], p[t[0][2]]) ||
+        collinear(p[t[1][0]], p[t[1][1]], p[t[1][2]]))
+      continue;
+    const TrianglePoints a{p[t[0][0]], p[t[0][1]], p[t[0][2]]},
+        b{p[t[1][0]], p[t[1][1]], p[t[1][2]]};
+    const SharedCorners c = sharedCorners(t[0], t[1]);
+    const bool expected = intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+    ASSERT_EQ(facesIntersect(p, t, 0, 1), expected) << "trial " << trial;
+    (expected ? meeting : apart) += 1;
+  }
+  EXPECT_GT(meeting, 100u);  // both answers are exercised
+  EXPECT_GT(apart, 100u);
+}
+
 TEST(Intersections, LargeMeshSelfJoinMatchesBruteForceOnAPushedSphere) {
   // A sphere whose north cap is pushed through its south side.
   Mesh s = uvSphere(20, 30);
