@@ -568,15 +568,26 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 // alone: sharing an edge, the fourth corner off the other face's plane (a
 // face crosses that plane only along the edge); sharing one corner, the
 // other two corners of one face strictly on one side of the other's plane
-// (it meets that plane only at the corner). Most neighbours in a curved
+// (it meets that plane only at the corner); sharing none, all three
+// corners of one face strictly on one side. Most neighbours in a curved
 // surface; flat ones, which the filters cannot tell, go to the projection.
+// Each plane's normal is computed once for the corners tested against it.
 bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const TrianglePoints& b) {
   if (c.count == 2) return orient3dFiltered(a[0], a[1], a[2], b[c.ib]) != 0;
+  if (c.count == 0) {
+    auto allOnOneSide = [](const TrianglePoints& plane, const TrianglePoints& face) {
+      const PlaneFilter filter(plane[0], plane[1], plane[2]);
+      const int side = filter.filteredSide(plane[0], face[0]);
+      return side != 0 && side == filter.filteredSide(plane[0], face[1]) &&
+             side == filter.filteredSide(plane[0], face[2]);
+    };
+    return allOnOneSide(a, b) || allOnOneSide(b, a);
+  }
   if (c.count != 1) return false;
   auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int shared) {
-    const int side = orient3dFiltered(plane[0], plane[1], plane[2], face[(shared + 1) % 3]);
-    return side != 0 &&
-           side == orient3dFiltered(plane[0], plane[1], plane[2], face[(shared + 2) % 3]);
+    const PlaneFilter filter(plane[0], plane[1], plane[2]);  // one normal for both corners
+    const int side = filter.filteredSide(plane[0], face[(shared + 1) % 3]);
+    return side != 0 && side == filter.filteredSide(plane[0], face[(shared + 2) % 3]);
   };
   return oneSide(b, a, c.ia) || oneSide(a, b, c.ib);
 }

@@ -59,6 +59,12 @@ class PlaneFilter {
   // and a call cost as much as the filter (orient3d only when it cannot
   // decide).
   int side(const Point3& a, const Point3& b, const Point3& c, const Point3& p) const {
+    if (const int s = filteredSide(a, p)) return s;
+    return orient3d(a, b, c, p);
+  }
+  // The filter alone (a is the first corner): the sign where the rounded
+  // determinant decides it, else 0 (as orient3dFiltered).
+  int filteredSide(const Point3& a, const Point3& p) const {
     const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
     const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
     const double permanent =
@@ -69,7 +75,7 @@ class PlaneFilter {
       if (det > bound) return 1;
       if (-det > bound) return -1;
     }
-    return orient3d(a, b, c, p);
+    return 0;
   }
 
   // Shewchuk's forward error bound for orient3d's rounded determinant, and

@@ -124,36 +124,40 @@ TEST(Intersections, AgreesWithBruteForceOnRandomSoups) {
   }
 }
 
-// Neighbours on a small integer grid: many pairs sharing an edge or a
-// corner are coplanar or nearly so, where the planes' filters cannot tell
-// and the projection or the exact test must.
-TEST(Intersections, FacesIntersectAgreesWithTheRulesOnNeighbours) {
+// Faces on a small integer grid sharing an edge, one corner or none
+// (coplanar and jittered ones among them), where the plane and projection
+// filters decide most pairs: facesIntersect agrees with the exact rules.
+TEST(Intersections, FacesIntersectAgreesWithTheRulesOnNearbyFaces) {
   std::mt19937 rng(7);
   std::uniform_int_distribution<int> coordinate(-2, 2);
   std::uniform_real_distribution<double> jitter(-1e-15, 1e-15);
-  std::size_t meeting = 0, apart = 0;
-  for (int trial = 0; trial < 20000; ++trial) {
+  std::size_t meeting[3] = {0, 0, 0}, apart[3] = {0, 0, 0};
+  for (int trial = 0; trial < 30000; ++trial) {
+    const int shared = 2 - trial % 3;  // corners the two faces share
     std::vector<Point3> p;
-    for (int k = 0; k < 4 + trial % 2; ++k) {
+    for (int k = 0; k < 6 - shared; ++k) {
       Point3 q(coordinate(rng), coordinate(rng), coordinate(rng));
-      if (trial % 3 == 0) q += Point3(jitter(rng), jitter(rng), jitter(rng));
+      if ((trial / 3) % 3 == 0) q += Point3(jitter(rng), jitter(rng), jitter(rng));
       p.push_back(q);
     }
-    // Sharing an edge (four points) or one corner (five).
-    const std::vector<Triangle> t = p.size() == 4 ? std::vector<Triangle>{{0, 1, 2}, {1, 0, 3}}
-                                                  : std::vector<Triangle>{{0, 1, 2}, {0, 3, 4}};
+    const std::vector<Triangle> t = shared == 2   ? std::vector<Triangle>{{0, 1, 2}, {1, 0, 3}}
+                                    : shared == 1 ? std::vector<Triangle>{{0, 1, 2}, {0, 3, 4}}
+                                                  : std::vector<Triangle>{{0, 1, 2}, {3, 4, 5}};
     if (collinear(p[t[0][0]], p[t[0][1]], p[t[0][2]]) ||
         collinear(p[t[1][0]], p[t[1][1]], p[t[1][2]]))
       continue;
     const TrianglePoints a{p[t[0][0]], p[t[0][1]], p[t[0][2]]},
         b{p[t[1][0]], p[t[1][1]], p[t[1][2]]};
     const SharedCorners c = sharedCorners(t[0], t[1]);
+    ASSERT_EQ(c.count, shared);
     const bool expected = intersectBeyondShared(a, b, c.count, c.ia, c.ib);
     ASSERT_EQ(facesIntersect(p, t, 0, 1), expected) << "trial " << trial;
-    (expected ? meeting : apart) += 1;
+    (expected ? meeting : apart)[shared] += 1;
   }
-  EXPECT_GT(meeting, 100u);  // both answers are exercised
-  EXPECT_GT(apart, 100u);
+  for (int shared = 0; shared < 3; ++shared) {  // both answers are exercised
+    EXPECT_GT(meeting[shared], 100u) << shared << " shared corners";
+    EXPECT_GT(apart[shared], 100u) << shared << " shared corners";
+  }
 }
 
 TEST(Intersections, LargeMeshSelfJoinMatchesBruteForceOnAPushedSphere) {
