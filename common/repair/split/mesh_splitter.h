@@ -297,7 +297,7 @@ class MeshSplitter {
     std::vector<Shared> shared;
     for (auto& [f, w] : work_) {
       const Triangle& t = triangles_[f];
-      auto isProper = [&, &w = w] {  // asked once, if needed
+      auto isProper = [&, &w = w, f = f] {  // asked once, if needed
         if (w.proper < 0) w.proper = !collinear(at(f)[0], at(f)[1], at(f)[2]);
         return w.proper == 1;
       };
