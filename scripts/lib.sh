@@ -3,6 +3,7 @@
 MESHMEND_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${MESHMEND_BUILD_DIR:-$MESHMEND_ROOT/build}"
 PREFIX="$BUILD_DIR/meshlab-prefix"          # private MeshLab with our plugins
+FUZZ_DIR="${MESHMEND_FUZZ_BUILD_DIR:-$BUILD_DIR-fuzz}"  # sanitized build (scripts/fuzz)
 DEPS_DIR="$MESHMEND_ROOT/.deps"              # unpacked MeshLab source (ignored by git)
 SHARED_DIR="$(cd "$MESHMEND_ROOT/.." && pwd)/shared"
 SYSTEM_MESHLAB_LIB=/usr/lib/x86_64-linux-gnu/meshlab

@@ -571,25 +571,26 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 // (it meets that plane only at the corner); sharing none, all three
 // corners of one face strictly on one side. Most neighbours in a curved
 // surface; flat ones, which the filters cannot tell, go to the projection.
-// Each plane's normal is computed once for the corners tested against it.
 bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const TrianglePoints& b) {
-  if (c.count == 2) return orient3dFiltered(a[0], a[1], a[2], b[c.ib]) != 0;
-  if (c.count == 0) {
-    auto allOnOneSide = [](const TrianglePoints& plane, const TrianglePoints& face) {
-      const PlaneFilter filter(plane[0], plane[1], plane[2]);
-      const int side = filter.filteredSide(plane[0], face[0]);
-      return side != 0 && side == filter.filteredSide(plane[0], face[1]) &&
-             side == filter.filteredSide(plane[0], face[2]);
-    };
-    return allOnOneSide(a, b) || allOnOneSide(b, a);
-  }
-  if (c.count != 1) return false;
-  auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int shared) {
-    const PlaneFilter filter(plane[0], plane[1], plane[2]);  // one normal for both corners
-    const int side = filter.filteredSide(plane[0], face[(shared + 1) % 3]);
-    return side != 0 && side == filter.filteredSide(plane[0], face[(shared + 2) % 3]);
+  // The corners `from`, `from` + 1, ... (count of them, modulo 3) of `face`
+  // strictly on one side of `plane`'s plane (its normal computed once).
+  auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int from, int count) {
+    const PlaneFilter filter(plane[0], plane[1], plane[2]);
+    const int side = filter.filteredSide(plane[0], face[std::size_t(from % 3)]);
+    for (int k = 1; k < count && side != 0; ++k)
+      if (filter.filteredSide(plane[0], face[std::size_t((from + k) % 3)]) != side) return false;
+    return side != 0;
   };
-  return oneSide(b, a, c.ia) || oneSide(a, b, c.ib);
+  switch (c.count) {
+    case 2:
+      return oneSide(a, b, c.ib, 1);
+    case 1:
+      return oneSide(b, a, c.ia + 1, 2) || oneSide(a, b, c.ib + 1, 2);
+    case 0:
+      return oneSide(a, b, 0, 3) || oneSide(b, a, 0, 3);
+    default:
+      return false;
+  }
 }
 
 }  // namespace

@@ -82,7 +82,7 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
   return exact::orient2d(ax, ay, bx, by, cx, cy);
 }
 
-int orient3dFiltered(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
   const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
   const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
   const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
@@ -97,11 +97,6 @@ int orient3dFiltered(const Point3& a, const Point3& b, const Point3& c, const Po
     if (det > bound) return 1;
     if (-det > bound) return -1;
   }
-  return 0;
-}
-
-int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
-  if (const int side = orient3dFiltered(a, b, c, d)) return side;
   if (expansion::safe({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2]}))
     return expansion::orient3d(a, b, c, d);
   return exact::orient3d(a, b, c, d);

@@ -22,11 +22,6 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
 // the four points are coplanar.
 int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
 
-// orient3d's floating-point stage alone: the exact sign where its error
-// bound certifies it, 0 where it cannot tell (the points coplanar or nearly
-// so). A cheap first test, for callers with an exact test to fall back on.
-int orient3dFiltered(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
-
 // Exact: are the three points collinear (including coincident points)?
 bool collinear(const Point3& a, const Point3& b, const Point3& c);
 
@@ -62,8 +57,10 @@ class PlaneFilter {
     if (const int s = filteredSide(a, p)) return s;
     return orient3d(a, b, c, p);
   }
-  // The filter alone (a is the first corner): the sign where the rounded
-  // determinant decides it, else 0 (as orient3dFiltered).
+  // The filter alone (a is the first corner): the exact sign where the
+  // rounded determinant's error bound certifies it, else 0 (p on the plane
+  // or nearly so). A cheap first test, for callers with an exact test to
+  // fall back on.
   int filteredSide(const Point3& a, const Point3& p) const {
     const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
     const double det = dx * n_[0] + dy * n_[1] + dz * n_[2];
