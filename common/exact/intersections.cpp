@@ -574,12 +574,15 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const TrianglePoints& b) {
   // The corners `from`, `from` + 1, ... (count of them, modulo 3) of `face`
   // strictly on one side of `plane`'s plane (its normal computed once).
+  // (Every corner is tested, with no branch on a side: those are as good
+  // as random.)
   auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int from, int count) {
     const PlaneFilter filter(plane[0], plane[1], plane[2]);
     const int side = filter.filteredSide(plane[0], face[std::size_t(from % 3)]);
-    for (int k = 1; k < count && side != 0; ++k)
-      if (filter.filteredSide(plane[0], face[std::size_t((from + k) % 3)]) != side) return false;
-    return side != 0;
+    bool same = side != 0;
+    for (int k = 1; k < count; ++k)
+      same &= filter.filteredSide(plane[0], face[std::size_t((from + k) % 3)]) == side;
+    return same;
   };
   switch (c.count) {
     case 2:

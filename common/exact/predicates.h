@@ -68,11 +68,11 @@ class PlaneFilter {
         std::fabs(dx) * nAbs_[0] + std::fabs(dy) * nAbs_[1] + std::fabs(dz) * nAbs_[2];
     const double bound = kOrient3dBound * permanent +
                          kUnderflowSlack * (std::fabs(dx) + std::fabs(dy) + std::fabs(dz) + 1);
-    if (std::isfinite(det) && permanent > kUnderflowGuard) {
-      if (det > bound) return 1;
-      if (-det > bound) return -1;
-    }
-    return 0;
+    // Without branches: which way a candidate pair's point lies is as good
+    // as random, and mispredicted branches cost more than the arithmetic.
+    // (NaN compares false: a non-finite det is never certified.)
+    const bool certified = (std::fabs(det) <= kLargest) & (permanent > kUnderflowGuard);
+    return certified * (int(det > bound) - int(-det > bound));
   }
 
   // Shewchuk's forward error bound for orient3d's rounded determinant, and
@@ -87,6 +87,7 @@ class PlaneFilter {
   // minors next to huge coordinates go to the exact evaluation instead of
   // deciding wrongly; a large permanent alone does not exclude it.
   static constexpr double kUnderflowSlack = 0x1p-1070;
+  static constexpr double kLargest = 0x1.fffffffffffffp1023;  // std::isfinite, as a comparison
 
  private:
   double n_[3] = {0, 0, 0};     // (b-a) x (c-a), as rounded

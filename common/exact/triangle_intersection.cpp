@@ -195,20 +195,6 @@ bool intersectBeyondShared(const TrianglePoints& a, const TrianglePoints& b, int
   }
 }
 
-SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
-  SharedCorners s;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (a[i] == b[j]) ++s.count, s.ia = i, s.ib = j;
-  if (s.count == 2) {
-    for (int i = 0; i < 3; ++i)
-      if (a[i] != b[0] && a[i] != b[1] && a[i] != b[2]) s.ia = i;
-    for (int j = 0; j < 3; ++j)
-      if (b[j] != a[0] && b[j] != a[1] && b[j] != a[2]) s.ib = j;
-  }
-  return s;
-}
-
 const char* toString(ContactKind kind) {
   switch (kind) {
     case ContactKind::kNone:

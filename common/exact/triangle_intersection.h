@@ -49,7 +49,27 @@ struct SharedCorners {
   int count = 0;
   int ia = -1, ib = -1;
 };
-SharedCorners sharedCorners(const Triangle& a, const Triangle& b);
+// Selections, not branches: whether two candidate faces share a corner is
+// as good as random, and the mispredicted branches cost more than the nine
+// comparisons.
+inline SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
+  SharedCorners s;
+  int inB = 0, inA = 0;  // bit i: a[i] is a corner of b; bit j: b[j] is one of a
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const bool same = a[i] == b[j];
+      s.count += same;
+      s.ia = same ? i : s.ia;
+      s.ib = same ? j : s.ib;
+      inB |= int(same) << i;
+      inA |= int(same) << j;
+    }
+  if (s.count == 2) {  // the corners not shared
+    for (int i = 0; i < 3; ++i) s.ia = (inB >> i & 1) ? s.ia : i;
+    for (int j = 0; j < 3; ++j) s.ib = (inA >> j & 1) ? s.ib : j;
+  }
+  return s;
+}
 // Do a and b have the same three vertices (the same face twice)?
 inline bool sameVertices(const Triangle& a, const Triangle& b) {
   return sharedCorners(a, b).count == 3;

@@ -367,5 +367,30 @@ TEST(TriangleIntersection, InsideOtherIsExact) {
   }
 }
 
+// sharedCorners against its definition, on triangles over few vertices
+// (repeated corners included).
+TEST(SharedCorners, MatchesTheDefinition) {
+  std::mt19937 rng(8);
+  std::uniform_int_distribution<int> vertex(0, 4);
+  for (int i = 0; i < 20000; ++i) {
+    const Triangle a{vertex(rng), vertex(rng), vertex(rng)},
+        b{vertex(rng), vertex(rng), vertex(rng)};
+    int count = 0, ia = -1, ib = -1;
+    for (int x = 0; x < 3; ++x)
+      for (int y = 0; y < 3; ++y)
+        if (a[x] == b[y]) ++count, ia = x, ib = y;
+    if (count == 2) {
+      for (int x = 0; x < 3; ++x)
+        if (a[x] != b[0] && a[x] != b[1] && a[x] != b[2]) ia = x;
+      for (int y = 0; y < 3; ++y)
+        if (b[y] != a[0] && b[y] != a[1] && b[y] != a[2]) ib = y;
+    }
+    const SharedCorners c = sharedCorners(a, b);
+    ASSERT_EQ(c.count, count) << i;
+    ASSERT_EQ(c.ia, ia) << i;
+    ASSERT_EQ(c.ib, ib) << i;
+  }
+}
+
 }  // namespace
 }  // namespace meshmend
