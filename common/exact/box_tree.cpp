@@ -3,6 +3,7 @@
 #include "common/base/parallel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -45,6 +46,22 @@ float up(double x) {
   return rounded;
 }
 
+// x moved by `steps` floats (negative: down). Floats' bits ordered as
+// integers: the magnitude's bits with the sign's (both zeros are 0).
+float stepped(float x, std::int64_t steps) {
+  if (!std::isfinite(x)) return x;
+  std::uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const std::int64_t magnitude = bits & 0x7fffffffu;
+  const std::int64_t infinity = 0x7f800000;
+  const std::int64_t key =
+      std::clamp((bits >> 31 ? -magnitude : magnitude) + steps, -infinity, infinity);
+  bits = key < 0 ? 0x80000000u | std::uint32_t(-key) : std::uint32_t(key);
+  float y;
+  std::memcpy(&y, &bits, sizeof y);
+  return y;
+}
+
 void grow(Box& b, const Box& x) {
   for (int k = 0; k < 3; ++k) {
     b.lo[k] = std::min(b.lo[k], x.lo[k]);
@@ -72,6 +89,15 @@ Box boxOf(const Point3& p) {
     box.hi[k] = up(p[k]);
   }
   return box;
+}
+
+Box widened(const Box& b, int steps) {
+  Box w;
+  for (int k = 0; k < 3; ++k) {
+    w.lo[k] = stepped(b.lo[k], -steps);
+    w.hi[k] = stepped(b.hi[k], steps);
+  }
+  return w;
 }
 
 BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kCells, 0) {
@@ -103,11 +129,61 @@ bool BoxGrid::touches(const Box& b) const {
   if (!overlap(b, bounds_)) return false;
   int lo[3], hi[3];
   for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
+  return anyOccupied(lo, hi);
+}
+
+bool BoxGrid::anyOccupied(const int lo[3], const int hi[3]) const {
   for (int x = lo[0]; x <= hi[0]; ++x)
     for (int y = lo[1]; y <= hi[1]; ++y)
       for (int z = lo[2]; z <= hi[2]; ++z)
         if (occupied(x, y, z)) return true;
   return false;
+}
+
+std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
+                                                  const std::vector<Triangle>& T,
+                                                  const std::vector<char>& skip) const {
+  // Per point: the one cell its box lies in, as (x * kCells + y) * kCells
+  // + z, or kSpans when it spans cells or lies outside the grid.
+  constexpr std::uint32_t kSpans = ~0u;
+  std::vector<std::uint32_t> cell(P.size());
+  parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t v = begin; v < end; ++v) {
+      const Box b = boxOf(P[v]);
+      int lo[3], hi[3];
+      bool one = inside(b);
+      for (int k = 0; k < 3; ++k) {
+        cellRange(b, k, lo[k], hi[k]);
+        one &= lo[k] == hi[k];
+      }
+      cell[v] = one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans;
+    }
+  });
+  // A face's box starts at its corners' lowest start and ends at their
+  // highest end, and cellRange() never decreases with the coordinate: the
+  // face's cells are the range of its corners' cells. Corners in one cell
+  // (most faces) ask that cell; a corner outside or across cells, the box.
+  auto touchesFace = [&](const Triangle& t) {
+    const std::uint32_t a = cell[t[0]], b = cell[t[1]], c = cell[t[2]];
+    if (a == kSpans || b == kSpans || c == kSpans) return touches(boxOf(P[t[0]], P[t[1]], P[t[2]]));
+    if (a == b && b == c) return occupied_[a] != 0;
+    int lo[3], hi[3];
+    for (int k = 0, shift = 0; k < 3; ++k, shift += kCellBits) {
+      const int ka = int(a >> shift) & (kCells - 1), kb = int(b >> shift) & (kCells - 1),
+                kc = int(c >> shift) & (kCells - 1);
+      lo[2 - k] = std::min({ka, kb, kc});
+      hi[2 - k] = std::max({ka, kb, kc});
+    }
+    return anyOccupied(lo, hi);
+  };
+  std::vector<std::vector<std::uint32_t>> found(workerCount());
+  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t f = begin; f < end; ++f)
+      if (!skip[f] && touchesFace(T[f])) found[worker].push_back(std::uint32_t(f));
+  });
+  std::vector<std::uint32_t> faces;  // the chunks in order: ascending
+  for (const auto& w : found) faces.insert(faces.end(), w.begin(), w.end());
+  return faces;
 }
 
 bool BoxGrid::covers(const Box& b) const {

@@ -37,6 +37,11 @@ inline Box hull(const Box& a, const Box& b, const Box& c) {
   return h;
 }
 
+// `b` grown by `steps` floats on each side (as many std::nextafter steps,
+// from the ordering of floats' bits: a loop of those was a tenth of a
+// search around changed faces). Infinite and NaN bounds stay as they are.
+Box widened(const Box& b, int steps);
+
 // All six comparisons, then one branch on the result (in a tree descent
 // each comparison's outcome is as good as random: a branch per comparison
 // was mispredicted often).
@@ -58,8 +63,17 @@ class BoxGrid {
   // grid? Then every box that overlaps `b` touches an occupied cell.
   bool covers(const Box& b) const;
 
+  // The faces of (points, triangles) whose boxes touch an occupied cell
+  // (touches(boxOf(corners)), exactly), but those marked in `skip`,
+  // ascending, in parallel. Each point's cell is found once: a point is
+  // shared by about six faces, and a box per face cost more than the test.
+  std::vector<std::uint32_t> facesTouching(const std::vector<Point3>& points,
+                                           const std::vector<Triangle>& triangles,
+                                           const std::vector<char>& skip) const;
+
  private:
-  static constexpr int kCells = 64;
+  static constexpr int kCellBits = 6;
+  static constexpr int kCells = 1 << kCellBits;
   bool inside(const Box& b) const;
   // A multiplication, not a division: any map that never decreases with
   // the coordinate keeps overlapping boxes in overlapping cell ranges, as
@@ -75,6 +89,7 @@ class BoxGrid {
     hi = !(to < kCells - 1) ? kCells - 1 : to > 0 ? int(to) : 0;
   }
   bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
+  bool anyOccupied(const int lo[3], const int hi[3]) const;  // of the cells lo..hi
 
   Box bounds_{{1, 1, 1}, {0, 0, 0}};
   float cellsPerUnit_[3] = {1, 1, 1};

@@ -479,60 +479,6 @@ FindIntersectionsResult findIntersectionsInArrays(const std::vector<const MeshAr
   return r;
 }
 
-std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(const std::vector<Point3>& P,
-                                                                const std::vector<Triangle>& T,
-                                                                const std::vector<char>& changed,
-                                                                int widenSteps) {
-  std::vector<Box> changedBoxes;
-  for (std::size_t f = 0; f < T.size(); ++f) {
-    if (!changed[f]) continue;
-    Box b = boxOf(P[T[f][0]], P[T[f][1]], P[T[f][2]]);  // float bounds
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < widenSteps; ++i) {
-        b.lo[k] = std::nextafter(b.lo[k], -INFINITY);
-        b.hi[k] = std::nextafter(b.hi[k], INFINITY);
-      }
-    changedBoxes.push_back(b);
-  }
-  return pairsWithChangedBoxes(P, T, changed, changedBoxes);
-}
-
-std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
-    const std::vector<Point3>& P, const std::vector<Triangle>& T, const std::vector<char>& changed,
-    const std::vector<Box>& changedBoxes) {
-  std::vector<int> changedIndex(T.size(), -1);
-  std::vector<std::uint32_t> changedFaces;
-  for (std::size_t f = 0; f < T.size(); ++f)
-    if (changed[f]) {
-      changedIndex[f] = int(changedFaces.size());
-      changedFaces.push_back(std::uint32_t(f));
-    }
-  if (changedFaces.empty()) return {};
-  const BoxTree tree(changedBoxes);
-  const BoxGrid nearChanged(changedBoxes);
-  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
-  // Two changed faces: one traversal of the tree against itself (a descent
-  // per changed face cost twice as much).
-  tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned worker) {
-    const std::uint32_t f = changedFaces[i], g = changedFaces[j];
-    found[worker].push_back({std::min(f, g), std::max(f, g)});
-  });
-  // The others: those near a changed face descend the tree.
-  parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-    for (std::size_t g = begin; g < end; ++g) {
-      if (changedIndex[g] >= 0) continue;
-      const Box b = boxOf(P[T[g][0]], P[T[g][1]], P[T[g][2]]);
-      if (!nearChanged.touches(b)) continue;
-      tree.query(b, worker, [&](std::uint32_t i, unsigned) {
-        found[worker].push_back({changedFaces[i], std::uint32_t(g)});
-      });
-    }
-  });
-  std::vector<std::array<std::uint32_t, 2>> pairs;
-  for (const auto& w : found) pairs.insert(pairs.end(), w.begin(), w.end());
-  return pairs;
-}
-
 namespace {
 
 // Exact and sufficient for "faces f and g meet at most in the corners they
@@ -668,6 +614,38 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(
         }
       },
       1024);
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
+  return all;
+}
+
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point3>& P,
+                                                         const std::vector<Triangle>& T,
+                                                         const ChangedFaceSearch& search,
+                                                         const std::vector<char>& degenerate,
+                                                         bool sameVertices) {
+  // The faces' corners side by side in the search's order (each face is in
+  // some ten pairs, and its corners' points lie anywhere in P).
+  const std::vector<std::uint32_t>& faces = search.faces();
+  std::vector<Triangle> corners;
+  std::vector<TrianglePoints> points;
+  std::vector<char> flat;
+  resizeInHugePages(corners, faces.size());
+  resizeInHugePages(points, faces.size());
+  resizeInHugePages(flat, faces.size());
+  parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Triangle& t = corners[i] = T[faces[i]];
+      points[i] = {P[t[0]], P[t[1]], P[t[2]]};
+      flat[i] = degenerate[faces[i]];
+    }
+  });
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
+  search.forEachPair([&](std::uint32_t a, std::uint32_t b, unsigned worker) {
+    if (!flat[a] && !flat[b] &&
+        facesMeet(corners[a], points[a], corners[b], points[b], 0, sameVertices))
+      hits[worker].push_back({faces[a], faces[b]});
+  });
   std::vector<std::array<std::uint32_t, 2>> all;
   for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
   return all;

@@ -12,6 +12,7 @@
 #include "common/base/mesh.h"
 #include "common/base/progress.h"
 #include "common/exact/box_tree.h"
+#include "common/exact/changed_faces.h"
 #include "common/exact/triangle_intersection.h"
 
 namespace meshmend {
@@ -77,21 +78,6 @@ std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat = false, bool s
 // The same with the coordinates rounded to `scalar`.
 std::size_t selfIntersectingPairs(const Mesh& mesh, Scalar scalar, bool sameVertices);
 
-// Candidate pairs (box overlap) of faces of (points, triangles) where at
-// least one face is `changed`: after a local edit only those pairs can
-// intersect anew when every pair of two unchanged faces is known. Boxes of
-// changed faces are widened by `widenSteps` float steps (room for moving
-// their vertices by as many float steps, or by more double steps). Each
-// pair once, changed face first.
-std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(
-    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
-    const std::vector<char>& changed, int widenSteps = 0);
-// The same with the caller's boxes for the changed faces (in face order),
-// e.g. covering every position their vertices may take.
-std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
-    const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
-    const std::vector<char>& changed, const std::vector<Box>& changedBoxes);
-
 // The self-intersection rule for faces f and g of one mesh (never for a
 // degenerate face): they meet beyond what their shared corners explain.
 bool facesIntersect(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
@@ -112,6 +98,12 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(
     const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
     const std::vector<std::array<std::uint32_t, 2>>& pairs, const std::vector<char>& degenerate,
     bool sameVertices);
+// The same for the candidate pairs of `search`, tested as they are found.
+std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point3>& points,
+                                                         const std::vector<Triangle>& triangles,
+                                                         const ChangedFaceSearch& search,
+                                                         const std::vector<char>& degenerate,
+                                                         bool sameVertices);
 
 // The contact segments of every pair (a coplanar overlap contributes its
 // outline, a single touching point nothing), with coinciding end points

@@ -7,10 +7,14 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
+#include <numeric>
 #include <set>
 #include <unordered_map>
 
 #include "common/base/errors.h"
+#include "common/base/huge_pages.h"
+#include "common/base/parallel.h"
 #include "common/exact/intersections.h"
 #include "common/exact/predicates.h"
 #include "common/repair/split/detail.h"
@@ -33,14 +37,17 @@ void requireMergedOutput(const SplitResult& result, const char* operation) {
 
 std::size_t degenerateNewFaces(const SplitResult& result) {
   requireMergedOutput(result, "counting degenerate faces");
-  std::size_t n = 0;
-  for (std::size_t f = 0; f < result.merged.face.size(); ++f) {
-    if (!result.merged_new_face[f]) continue;
-    const Face& face = result.merged.face[f];
-    n += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) || face.cV(2) == face.cV(0) ||
-         collinear(face.cP(0), face.cP(1), face.cP(2));
-  }
-  return n;
+  std::vector<std::size_t> found(workerCount(), 0);
+  parallelChunks(result.merged.face.size(), [&](std::size_t begin, std::size_t end,
+                                                unsigned worker) {
+    for (std::size_t f = begin; f < end; ++f) {
+      if (!result.merged_new_face[f]) continue;
+      const Face& face = result.merged.face[f];
+      found[worker] += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) ||
+                       face.cV(2) == face.cV(0) || collinear(face.cP(0), face.cP(1), face.cP(2));
+    }
+  });
+  return std::accumulate(found.begin(), found.end(), std::size_t(0));
 }
 
 namespace {
@@ -252,12 +259,14 @@ class Rounder {
     for (const Point3& p : reference)
       largest = std::max({largest, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
     floor_ = std::ldexp(largest, -int(kMaxCoordinateBinades));
-    P_ = reference;
-    for (std::size_t v = 0; v < P_.size(); ++v) {
-      P_[v] = storedAs(P_[v], scalar);
-      if (v < movable_.size() && movable_[v])
-        for (int k = 0; k < 3; ++k) P_[v][k] = withinSpan(P_[v][k]);
-    }
+    resizeInHugePages(P_, reference.size());
+    parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t v = begin; v < end; ++v) {
+        P_[v] = storedAs(reference[v], scalar);
+        if (v < movable_.size() && movable_[v])
+          for (int k = 0; k < 3; ++k) P_[v][k] = withinSpan(P_[v][k]);
+      }
+    });
   }
 
   // Re-rounds while defects are left, at most `passes` passes per reach and
@@ -268,13 +277,12 @@ class Rounder {
                   std::size_t& rerounded, bool& bounded) {
     if (!findChanged()) return 0;
     findCandidates();
-    crossing_ = intersectingOf(P_, T_, pairs_, degenerate_, false);
+    crossing_ = intersectingOf(P_, T_, *search_, degenerate_, false);
     budget_ = budget;
     if (crossing_.size() > giveUpAbove) return crossing_.size();
     if (crossing_.empty() && collapsedFaces().empty()) return 0;
     buildAround();                          // only re-rounding needs it
     std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
-    const std::vector<Point3> nearest = P_;
     // Each coordinate goes to one of the `reach` values below its unrounded
     // value or the `reach` above. One each way first (the two nearest);
     // where faces meet at a very small angle, neither may keep them apart,
@@ -310,7 +318,7 @@ class Rounder {
     }
     bounded = tests_ >= budget_ && !crossing_.empty();
     rerounded = 0;
-    for (std::size_t v = 0; v < P_.size(); ++v) rerounded += P_[v] != nearest[v];
+    for (const auto& [v, nearest] : nearest_) rerounded += P_[v] != nearest;
     return crossing_.size();
   }
 
@@ -321,14 +329,19 @@ class Rounder {
   bool findChanged() {
     std::vector<char> moved(P_.size(), 0);
     if (scalar_ != Scalar::kDouble)
-      for (std::size_t v = 0; v < P_.size(); ++v) moved[v] = P_[v] != ref_[v];
-    isChanged_.assign(T_.size(), 0);
-    for (std::size_t f = 0; f < T_.size(); ++f) {
-      const Triangle& t = T_[f];
-      isChanged_[f] =
-          (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
+      parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t v = begin; v < end; ++v) moved[v] = P_[v] != ref_[v];
+      });
+    isChanged_.resize(T_.size());
+    parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const Triangle& t = T_[f];
+        isChanged_[f] =
+            (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
+      }
+    });
+    for (std::size_t f = 0; f < T_.size(); ++f)
       if (isChanged_[f]) changed_.push_back(std::uint32_t(f));
-    }
     return !changed_.empty();
   }
 
@@ -336,14 +349,14 @@ class Rounder {
   // (at most kFarthestRounding from its unrounded position; the boxes are
   // float, so a float step covers double steps too).
   void findCandidates() {
-    pairs_ = pairsWithChangedFaces(P_, T_, isChanged_, kFarthestRounding + 2);
-    // Whether each face of a pair is degenerate as stored, tested once.
+    search_ = std::make_unique<ChangedFaceSearch>(P_, T_, isChanged_, kFarthestRounding + 2);
+    // Whether each face that may be in a pair is degenerate as stored,
+    // tested once.
     degenerate_.assign(T_.size(), 0);
-    std::vector<char>& inPair = degenerate_;  // marks first, then the answer
-    for (const auto& [f, g] : pairs_) inPair[f] = inPair[g] = 1;
-    for (std::uint32_t f : changed_) inPair[f] = 1;
-    for (std::size_t f = 0; f < T_.size(); ++f)
-      if (inPair[f]) degenerate_[f] = isFlat(std::uint32_t(f));
+    const std::vector<std::uint32_t>& faces = search_->faces();
+    parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t i = begin; i < end; ++i) degenerate_[faces[i]] = isFlat(faces[i]);
+    });
   }
 
   // Per vertex, the changed faces around it (compressed rows).
@@ -362,30 +375,28 @@ class Rounder {
       for (int v : T_[f]) around_.items[next[v]++] = f;
   }
 
-  // The candidates of each changed face around `vertices`, both ways, for
-  // the faces that have none yet: one pass over the pairs per pass of
-  // re-rounding, which touches a few vertices (all faces' rows at once cost
-  // more than the rest of re-rounding). Faces with the same three vertices
-  // (a planar overlap kept in each part) coincide however their vertices
-  // are rounded: never a crossing, never a candidate.
+  // The candidates of each changed face around `vertices` that has none
+  // yet (re-rounding touches a few vertices: all faces' rows at once cost
+  // more than the rest of it). Faces with the same three vertices (a planar
+  // overlap kept in each part) coincide however their vertices are
+  // rounded: never a crossing, never a candidate.
   void addRows(const std::set<int>& vertices) {
-    bool any = false;
+    std::vector<std::uint32_t> faces;
     for (int v : vertices)
-      for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
-        char& has = hasRow_[std::size_t(changedIndex_[*f])];
-        if (!has) has = 2, any = true;  // 2: to be filled now
-      }
-    if (!any) return;
-    auto wanted = [&](std::uint32_t f) {
-      return changedIndex_[f] >= 0 && hasRow_[std::size_t(changedIndex_[f])] == 2;
-    };
-    for (const auto& [f, g] : pairs_) {
-      if (!wanted(f) && !wanted(g)) continue;
-      if (sameVertices(T_[f], T_[g])) continue;
-      if (wanted(f)) rows_[std::size_t(changedIndex_[f])].push_back(g);
-      if (wanted(g)) rows_[std::size_t(changedIndex_[g])].push_back(f);
+      for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f)
+        if (!hasRow_[std::size_t(changedIndex_[*f])]) {
+          hasRow_[std::size_t(changedIndex_[*f])] = 1;
+          faces.push_back(*f);
+        }
+    if (faces.empty()) return;
+    std::vector<std::vector<std::uint32_t>> found = search_->candidatesOf(faces);
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      std::vector<std::uint32_t>& row = found[i];
+      row.erase(std::remove_if(row.begin(), row.end(),
+                               [&](std::uint32_t g) { return sameVertices(T_[faces[i]], T_[g]); }),
+                row.end());
+      rows_[std::size_t(changedIndex_[faces[i]])] = std::move(row);
     }
-    for (char& has : hasRow_) has = has != 0;
   }
 
   bool isFlat(std::uint32_t f) const {
@@ -399,9 +410,17 @@ class Rounder {
     auto touches = [&](std::uint32_t f) {
       return moved[T_[f][0]] | moved[T_[f][1]] | moved[T_[f][2]];
     };
+    // Pairs with a moved corner: a changed face's around a vertex the last
+    // pass moved (their rows are there: it asked for them), each once.
     std::vector<std::array<std::uint32_t, 2>> again, still;
-    for (const auto& p : pairs_)
-      if (touches(p[0]) || touches(p[1])) again.push_back(p);
+    for (std::uint32_t f : changed_)
+      if (touches(f))
+        for (std::uint32_t g : rows_[std::size_t(changedIndex_[f])])
+          again.push_back(isChanged_[g]
+                              ? std::array<std::uint32_t, 2>{std::min(f, g), std::max(f, g)}
+                              : std::array<std::uint32_t, 2>{f, g});
+    std::sort(again.begin(), again.end());
+    again.erase(std::unique(again.begin(), again.end()), again.end());
     for (const auto& p : crossing_)
       if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
     for (std::size_t v = 0; v < moved.size(); ++v)
@@ -453,6 +472,7 @@ class Rounder {
   // unrounded position first; true when it moved.
   bool reround(int v, int reach) {
     const Point3 start = P_[v];
+    nearest_.emplace(v, start);  // the first time: the nearest rounding
     std::array<std::vector<double>, 3> choices;
     for (int k = 0; k < 3; ++k) {
       choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
@@ -496,7 +516,9 @@ class Rounder {
   std::vector<char> hasRow_;
   std::vector<int> changedIndex_;
   std::vector<std::uint32_t> changed_;
-  std::vector<std::array<std::uint32_t, 2>> pairs_, crossing_;
+  std::unique_ptr<ChangedFaceSearch> search_;  // candidate pairs (findCandidates)
+  std::vector<std::array<std::uint32_t, 2>> crossing_;
+  std::unordered_map<int, Point3> nearest_;  // re-rounded vertices' nearest rounding
   Rows around_;
   std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
   double floor_ = 0;
@@ -909,25 +931,15 @@ bool keepIfBetter(SplitResult& r, StoredOutput& out, SplitResult& candidate,
   return true;
 }
 
-}  // namespace
-
-StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
-                          const SplitOptions& options, const OutputStageOptions& stage) {
-  requireMergedOutput(r, "storing for the host");
-  const auto start = Clock::now();
-  StoredOutput out;
-  out.scalar = stage.scalar;
-  reportProgress(
-      stage.progress, 95,
-      stage.scalar == Scalar::kFloat ? "Rounding to float" : "Checking the double result");
-  out.crossing = roundForHost(r, stage, &out);
+// Steps 2 to 5, for `r` as step 1 left it with defects.
+void repairStored(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                  const SplitOptions& options, const OutputStageOptions& stage, StoredOutput& out) {
   SplitOptions used = options;
   used.host = stage.scalar;
   // Step 2: where curve points lie a few steps from each other or from an
   // edge, no rounding keeps every face apart (or whole): split again with
   // such points merged as quality snapping merges them.
-  if (stage.resplit_with_snapping && options.snap_host_steps <= 0 &&
-      defectsOf(r, out.crossing) > 0) {
+  if (stage.resplit_with_snapping && options.snap_host_steps <= 0) {
     reportProgress(stage.progress, 96, "Splitting again, merging points a step apart");
     SplitOptions second = used;
     second.snap_host_steps = kHostSnapSteps;
@@ -962,6 +974,21 @@ StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs
     keepIfBetter(r, out, candidate, made);
   }
   out.degenerate_new_faces = degenerateNewFaces(r);
+}
+
+}  // namespace
+
+StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs,
+                          const SplitOptions& options, const OutputStageOptions& stage) {
+  requireMergedOutput(r, "storing for the host");
+  const auto start = Clock::now();
+  StoredOutput out;
+  out.scalar = stage.scalar;
+  reportProgress(
+      stage.progress, 95,
+      stage.scalar == Scalar::kFloat ? "Rounding to float" : "Checking the double result");
+  out.crossing = roundForHost(r, stage, &out);
+  if (defectsOf(r, out.crossing) > 0) repairStored(r, inputs, options, stage, out);
   out.time_ms = msSince(start);
   return out;
 }

@@ -1,0 +1,109 @@
+#include "common/exact/changed_faces.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace meshmend {
+
+namespace {
+
+std::vector<Box> widenedBoxes(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                              const std::vector<char>& changed, int widenSteps) {
+  std::vector<std::uint32_t> faces;
+  for (std::size_t f = 0; f < T.size(); ++f)
+    if (changed[f]) faces.push_back(std::uint32_t(f));
+  std::vector<Box> boxes(faces.size());
+  parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Triangle& t = T[faces[i]];
+      boxes[i] = widened(boxOf(P[t[0]], P[t[1]], P[t[2]]), widenSteps);
+    }
+  });
+  return boxes;
+}
+
+}  // namespace
+
+ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
+                                     const std::vector<Triangle>& triangles,
+                                     const std::vector<char>& changed, int widenSteps)
+    : ChangedFaceSearch(points, triangles, changed,
+                        widenedBoxes(points, triangles, changed, widenSteps)) {}
+
+ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
+                                     const std::vector<Triangle>& triangles,
+                                     const std::vector<char>& changed,
+                                     std::vector<Box> changedBoxes)
+    : boxes_(std::move(changedBoxes)) {
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    if (changed[f]) faces_.push_back(std::uint32_t(f));
+  changedCount_ = faces_.size();
+  if (changedCount_ == 0) return;
+  changedTree_ = std::make_unique<BoxTree>(boxes_);
+  findNearFaces(points, triangles, changed);
+}
+
+// The unchanged faces whose boxes touch the grid cells of the changed
+// boxes, with their boxes: the rest of a large mesh is turned away without
+// a box.
+void ChangedFaceSearch::findNearFaces(const std::vector<Point3>& P, const std::vector<Triangle>& T,
+                                      const std::vector<char>& changed) {
+  const std::vector<std::uint32_t> near = BoxGrid(boxes_).facesTouching(P, T, changed);
+  faces_.insert(faces_.end(), near.begin(), near.end());
+  boxes_.resize(faces_.size());
+  parallelChunks(faces_.size() - changedCount_, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t k = changedCount_ + begin; k < changedCount_ + end; ++k) {
+      const Triangle& t = T[faces_[k]];
+      boxes_[k] = boxOf(P[t[0]], P[t[1]], P[t[2]]);
+    }
+  });
+}
+
+std::vector<std::array<std::uint32_t, 2>> ChangedFaceSearch::pairs() const {
+  std::vector<std::vector<std::array<std::uint32_t, 2>>> found(workerCount());
+  forEachPair([&](std::uint32_t a, std::uint32_t b, unsigned worker) {
+    found[worker].push_back({faces_[a], faces_[b]});
+  });
+  std::vector<std::array<std::uint32_t, 2>> all;
+  for (const auto& w : found) all.insert(all.end(), w.begin(), w.end());
+  return all;
+}
+
+std::vector<std::vector<std::uint32_t>> ChangedFaceSearch::candidatesOf(
+    const std::vector<std::uint32_t>& faces) const {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  std::vector<std::vector<std::uint32_t>> rows(faces.size());
+  std::vector<Box> boxes(faces.size(),
+                         Box{{inf, inf, inf}, {-inf, -inf, -inf}});  // overlap nothing
+  const auto changedEnd = faces_.begin() + std::ptrdiff_t(changedCount_);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const auto at = std::lower_bound(faces_.begin(), changedEnd, faces[i]);
+    if (at == changedEnd || *at != faces[i]) continue;  // unchanged: no pairs of its own
+    boxes[i] = boxes_[std::size_t(at - faces_.begin())];
+    changedTree_->query(boxes[i], 0, [&](std::uint32_t j, unsigned) {
+      if (faces_[j] != faces[i]) rows[i].push_back(faces_[j]);
+    });
+  }
+  // The near faces: one pass over them serves every face asked for (asked
+  // for a few at a time, as re-rounding does, that costs less than a
+  // hierarchy of them).
+  const BoxTree asked(boxes);
+  for (std::size_t k = changedCount_; k < faces_.size(); ++k)
+    asked.query(boxes_[k], 0, [&](std::uint32_t i, unsigned) { rows[i].push_back(faces_[k]); });
+  return rows;
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedFaces(const std::vector<Point3>& P,
+                                                                const std::vector<Triangle>& T,
+                                                                const std::vector<char>& changed,
+                                                                int widenSteps) {
+  return ChangedFaceSearch(P, T, changed, widenSteps).pairs();
+}
+
+std::vector<std::array<std::uint32_t, 2>> pairsWithChangedBoxes(
+    const std::vector<Point3>& P, const std::vector<Triangle>& T, const std::vector<char>& changed,
+    const std::vector<Box>& changedBoxes) {
+  return ChangedFaceSearch(P, T, changed, changedBoxes).pairs();
+}
+
+}  // namespace meshmend
