@@ -28,6 +28,7 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 
@@ -78,13 +79,15 @@ int main(int argc, char** argv) {
   };
   // The output stage (output_stage.h) after the sample's split, for each
   // host scalar, and with the check of the stored result the filter makes
-  // (storedIntersectingPairs). The result of the stage's methods is its
-  // own time in microseconds (-1 where it left defects), of the checked one
-  // the intersecting pairs the check counts.
+  // (storedIntersectingPairs). The result of the stage's methods is the
+  // median of its own times over the runs so far, in microseconds (-1
+  // where it left defects), of the checked one the intersecting pairs the
+  // check counts.
   auto stored = [&](const char* name, std::optional<Scalar> scalar, bool check) {
     methods.push_back({name, "ours", [=] {
                          auto ma = std::make_shared<Mesh>(readMesh(a));
                          auto mb = std::make_shared<Mesh>(readMesh(b));
+                         auto times = std::make_shared<std::vector<long>>();
                          return std::function<long()>([=] {
                            SplitOptions o;
                            o.self = o.weld_duplicates = o.remove_duplicate_faces = true;
@@ -97,7 +100,10 @@ int main(int argc, char** argv) {
                              if (check) return long(storedIntersectingPairs(r.merged, *scalar));
                              // The stage's own time, in microseconds (-1: defects left).
                              if (s.crossing + s.degenerate_new_faces > 0) return -1L;
-                             return long(s.time_ms * 1000);
+                             times->push_back(long(s.time_ms * 1000));
+                             std::vector<long> sorted = *times;
+                             std::sort(sorted.begin(), sorted.end());
+                             return sorted[sorted.size() / 2];
                            }
                            return long(r.faces_split);
                          });
