@@ -1,7 +1,6 @@
 #include "common/exact/changed_faces.h"
 
 #include <algorithm>
-#include <limits>
 
 namespace meshmend {
 
@@ -44,8 +43,8 @@ ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
 }
 
 // The unchanged faces whose boxes touch the grid cells of the changed
-// boxes, with their boxes: the rest of a large mesh is turned away without
-// a box.
+// boxes, with their boxes: most of the rest of a large mesh is turned away
+// by its corners' cells.
 void ChangedFaceSearch::findNearFaces(const std::vector<Point3>& P, const std::vector<Triangle>& T,
                                       const std::vector<char>& changed) {
   const std::vector<std::uint32_t> near = BoxGrid(boxes_).facesTouching(P, T, changed);
@@ -71,25 +70,27 @@ std::vector<std::array<std::uint32_t, 2>> ChangedFaceSearch::pairs() const {
 
 std::vector<std::vector<std::uint32_t>> ChangedFaceSearch::candidatesOf(
     const std::vector<std::uint32_t>& faces) const {
-  constexpr float inf = std::numeric_limits<float>::infinity();
   std::vector<std::vector<std::uint32_t>> rows(faces.size());
-  std::vector<Box> boxes(faces.size(),
-                         Box{{inf, inf, inf}, {-inf, -inf, -inf}});  // overlap nothing
+  std::vector<Box> boxes;          // of the changed faces asked for
+  std::vector<std::size_t> rowOf;  // their rows
   const auto changedEnd = faces_.begin() + std::ptrdiff_t(changedCount_);
   for (std::size_t i = 0; i < faces.size(); ++i) {
     const auto at = std::lower_bound(faces_.begin(), changedEnd, faces[i]);
     if (at == changedEnd || *at != faces[i]) continue;  // unchanged: no pairs of its own
-    boxes[i] = boxes_[std::size_t(at - faces_.begin())];
-    changedTree_->query(boxes[i], 0, [&](std::uint32_t j, unsigned) {
+    const Box& box = boxes_[std::size_t(at - faces_.begin())];
+    changedTree_->query(box, 0, [&](std::uint32_t j, unsigned) {
       if (faces_[j] != faces[i]) rows[i].push_back(faces_[j]);
     });
+    boxes.push_back(box);
+    rowOf.push_back(i);
   }
   // The near faces: one pass over them serves every face asked for (asked
   // for a few at a time, as re-rounding does, that costs less than a
   // hierarchy of them).
   const BoxTree asked(boxes);
   for (std::size_t k = changedCount_; k < faces_.size(); ++k)
-    asked.query(boxes_[k], 0, [&](std::uint32_t i, unsigned) { rows[i].push_back(faces_[k]); });
+    asked.query(boxes_[k], 0,
+                [&](std::uint32_t j, unsigned) { rows[rowOf[j]].push_back(faces_[k]); });
   return rows;
 }
 

@@ -16,13 +16,14 @@ namespace meshmend {
 
 // The candidate pairs (box overlap) of faces of (points, triangles) with at
 // least one face `changed`, found once and then visited all at once in
-// parallel (forEachPair) or per changed face (candidatesOf), each pair
-// once.
+// parallel (forEachPair, each pair once) or per changed face
+// (candidatesOf).
 //
 // The boxes of the changed faces may be widened (room for moving their
 // vertices, as re-rounding does): the pairs are those of the boxes, and
 // stay a superset of the overlapping faces' pairs while every vertex of a
-// changed face stays inside the boxes it was given.
+// changed face stays inside the boxes it was given and no vertex of an
+// unchanged face moves (a face with a moved corner is a changed one).
 class ChangedFaceSearch {
  public:
   // The changed faces' boxes are theirs widened by `widenSteps` float steps

@@ -38,15 +38,17 @@ void requireMergedOutput(const SplitResult& result, const char* operation) {
 std::size_t degenerateNewFaces(const SplitResult& result) {
   requireMergedOutput(result, "counting degenerate faces");
   std::vector<std::size_t> found(workerCount(), 0);
-  parallelChunks(result.merged.face.size(), [&](std::size_t begin, std::size_t end,
-                                                unsigned worker) {
-    for (std::size_t f = begin; f < end; ++f) {
-      if (!result.merged_new_face[f]) continue;
-      const Face& face = result.merged.face[f];
-      found[worker] += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) ||
-                       face.cV(2) == face.cV(0) || collinear(face.cP(0), face.cP(1), face.cP(2));
-    }
-  });
+  parallelChunks(result.merged.face.size(),
+                 [&](std::size_t begin, std::size_t end, unsigned worker) {
+                   std::size_t n = 0;
+                   for (std::size_t f = begin; f < end; ++f) {
+                     if (!result.merged_new_face[f]) continue;
+                     const Face& face = result.merged.face[f];
+                     n += face.cV(0) == face.cV(1) || face.cV(1) == face.cV(2) ||
+                          face.cV(2) == face.cV(0) || collinear(face.cP(0), face.cP(1), face.cP(2));
+                   }
+                   found[worker] = n;
+                 });
   return std::accumulate(found.begin(), found.end(), std::size_t(0));
 }
 
