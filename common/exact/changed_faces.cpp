@@ -6,19 +6,11 @@ namespace meshmend {
 
 namespace {
 
-std::vector<Box> widenedBoxes(const std::vector<Point3>& P, const std::vector<Triangle>& T,
-                              const std::vector<char>& changed, int widenSteps) {
+std::vector<std::uint32_t> marked(const std::vector<char>& changed) {
   std::vector<std::uint32_t> faces;
-  for (std::size_t f = 0; f < T.size(); ++f)
+  for (std::size_t f = 0; f < changed.size(); ++f)
     if (changed[f]) faces.push_back(std::uint32_t(f));
-  std::vector<Box> boxes(faces.size());
-  parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const Triangle& t = T[faces[i]];
-      boxes[i] = widened(boxOf(P[t[0]], P[t[1]], P[t[2]]), widenSteps);
-    }
-  });
-  return boxes;
+  return faces;
 }
 
 }  // namespace
@@ -26,16 +18,29 @@ std::vector<Box> widenedBoxes(const std::vector<Point3>& P, const std::vector<Tr
 ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
                                      const std::vector<Triangle>& triangles,
                                      const std::vector<char>& changed, int widenSteps)
-    : ChangedFaceSearch(points, triangles, changed,
-                        widenedBoxes(points, triangles, changed, widenSteps)) {}
+    : faces_(marked(changed)), boxes_(faces_.size()) {
+  parallelChunks(faces_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Triangle& t = triangles[faces_[i]];
+      boxes_[i] = widened(boxOf(points[t[0]], points[t[1]], points[t[2]]), widenSteps);
+    }
+  });
+  search(points, triangles, changed);
+}
 
 ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
                                      const std::vector<Triangle>& triangles,
                                      const std::vector<char>& changed,
                                      std::vector<Box> changedBoxes)
-    : boxes_(std::move(changedBoxes)) {
-  for (std::size_t f = 0; f < triangles.size(); ++f)
-    if (changed[f]) faces_.push_back(std::uint32_t(f));
+    : faces_(marked(changed)), boxes_(std::move(changedBoxes)) {
+  search(points, triangles, changed);
+}
+
+// With faces_ and boxes_ holding the changed faces: their tree, and the
+// unchanged faces near them.
+void ChangedFaceSearch::search(const std::vector<Point3>& points,
+                               const std::vector<Triangle>& triangles,
+                               const std::vector<char>& changed) {
   changedCount_ = faces_.size();
   if (changedCount_ == 0) return;
   changedTree_ = std::make_unique<BoxTree>(boxes_);

@@ -57,6 +57,8 @@ class ChangedFaceSearch {
       const std::vector<std::uint32_t>& faces) const;
 
  private:
+  void search(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
+              const std::vector<char>& changed);
   void findNearFaces(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
                      const std::vector<char>& changed);
 
