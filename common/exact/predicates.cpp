@@ -20,9 +20,8 @@ constexpr double kOrient3dBound = PlaneFilter::kOrient3dBound;
 // Below this magnitude products may underflow and the bounds no longer hold.
 constexpr double kUnderflowGuard = PlaneFilter::kUnderflowGuard;
 // orient3d's minors multiplied by a coordinate may have underflowed
-// (PlaneFilter::kUnderflowSlack). orient2d's two products are off by at
+// (PlaneFilter::underflowSlack). orient2d's two products are off by at
 // most 2^-1074 then, which the guard's 1e-250 keeps far below its bound.
-constexpr double kUnderflowSlack = PlaneFilter::kUnderflowSlack;
 
 int sign(const mpq_class& q) {
   return sgn(q);
@@ -92,7 +91,7 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
                            (std::fabs(cx * dz) + std::fabs(cz * dx)) * std::fabs(by) +
                            (std::fabs(cx * dy) + std::fabs(cy * dx)) * std::fabs(bz);
   const double bound = kOrient3dBound * permanent +
-                       kUnderflowSlack * (std::fabs(bx) + std::fabs(by) + std::fabs(bz) + 1);
+                       PlaneFilter::underflowSlack(std::fabs(bx) + std::fabs(by) + std::fabs(bz));
   if (std::isfinite(det) && permanent > kUnderflowGuard) {
     if (det > bound) return 1;
     if (-det > bound) return -1;

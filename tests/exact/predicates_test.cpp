@@ -5,6 +5,7 @@
 #include <cfloat>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,25 @@ TEST(Predicates, HandlesHugeAndTinyCoordinates) {
   EXPECT_EQ(orient2d(0, 0, tiny, 0, 0, tiny), 1);
   EXPECT_EQ(orient3d(Point3(0, 0, 0), Point3(tiny, 0, 0), Point3(0, tiny, 0), Point3(0, 0, tiny)),
             1);
+}
+
+// The filters' allowance for underflowed minors: at least 2^-1070 per unit
+// of the third row's magnitude plus one (the bound the filters rely on), and
+// a normal number (no arithmetic on subnormals) from a subnormal sum to
+// DBL_MAX.
+TEST(Predicates, UnderflowSlackBoundsInNormalNumbers) {
+  std::vector<double> sums{0, 0x1p-1074, 1e-300, 0.5, 1, 3, 0x1p59, 0x1p60, 0x1p61, 1e200, DBL_MAX};
+  std::mt19937_64 rng(99);
+  std::uniform_int_distribution<int> exponent(-1074, 1023);
+  std::uniform_real_distribution<double> mantissa(1, 2);
+  for (int i = 0; i < 10000; ++i) sums.push_back(std::ldexp(mantissa(rng), exponent(rng)));
+  for (double sum : sums) {
+    const double slack = PlaneFilter::underflowSlack(sum);
+    EXPECT_EQ(std::fpclassify(slack), FP_NORMAL) << sum;
+    // 2^-1070 (sum + 1) scaled by 2^1070 into the range of long double, exactly.
+    EXPECT_GE(std::ldexp(static_cast<long double>(slack), 1070), static_cast<long double>(sum) + 1)
+        << sum;
+  }
 }
 
 // Randomized comparison with the pure-GMP evaluation on near-degenerate input:
