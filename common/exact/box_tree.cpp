@@ -144,28 +144,37 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
                                                   const std::vector<Triangle>& T,
                                                   const std::vector<char>& skip) const {
   // Per point: the one cell its box lies in, as (x * kCells + y) * kCells
-  // + z, or kSpans when it spans cells or lies outside the grid.
-  constexpr std::uint32_t kSpans = ~0u;
+  // + z; or, with kSpans set, that it spans cells or lies outside the grid,
+  // and bit 2k (2k + 1) when its box ends below the grid (starts above it)
+  // along axis k.
+  constexpr std::uint32_t kSpans = 0x80000000u;
   std::vector<std::uint32_t> cell(P.size());
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t v = begin; v < end; ++v) {
       const Box b = boxOf(P[v]);
       int lo[3], hi[3];
       bool one = inside(b);
+      std::uint32_t beyond = 0;
       for (int k = 0; k < 3; ++k) {
         cellRange(b, k, lo[k], hi[k]);
         one &= lo[k] == hi[k];
+        beyond |= std::uint32_t(b.hi[k] < bounds_.lo[k]) << 2 * k |
+                  std::uint32_t(b.lo[k] > bounds_.hi[k]) << (2 * k + 1);
       }
-      cell[v] = one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans;
+      cell[v] = one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans | beyond;
     }
   });
   // A face's box starts at its corners' lowest start and ends at their
   // highest end, and cellRange() never decreases with the coordinate: the
   // face's cells are the range of its corners' cells. Corners in one cell
-  // (most faces) ask that cell; a corner outside or across cells, the box.
+  // (most faces) ask that cell; corners all beyond one side of the grid
+  // (most of the rest of a large mesh) ask nothing; others, the box.
   auto touchesFace = [&](const Triangle& t) {
     const std::uint32_t a = cell[t[0]], b = cell[t[1]], c = cell[t[2]];
-    if (a == kSpans || b == kSpans || c == kSpans) return touches(boxOf(P[t[0]], P[t[1]], P[t[2]]));
+    if ((a | b | c) & kSpans) {
+      const std::uint32_t all = a & b & c;  // with kSpans: beyond the same side, all three
+      return !((all & kSpans) && (all & ~kSpans)) && touches(boxOf(P[t[0]], P[t[1]], P[t[2]]));
+    }
     if (a == b && b == c) return occupied_[a] != 0;
     int lo[3], hi[3];
     for (int k = 0, shift = 0; k < 3; ++k, shift += kCellBits) {

@@ -495,10 +495,12 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
     const TrianglePoints& p = pass == 0 ? a : b;
     const Triangle& other = pass == 0 ? tb : ta;
     const TrianglePoints& q = pass == 0 ? b : a;
-    if (orient2dDropping(p[0], p[1], p[2], axis) == 0) continue;
+    // The side of each edge's line the face is on: the same for all three
+    // (a cyclic turn of the corners keeps the sign).
+    const int inside = orient2dDropping(p[0], p[1], p[2], axis);
+    if (inside == 0) continue;
     for (int e = 0; e < 3; ++e) {
-      const int u = e, w = (e + 1) % 3, o = (e + 2) % 3;
-      const int inside = orient2dDropping(p[u], p[w], p[o], axis);
+      const int u = e, w = (e + 1) % 3;
       bool separated = true;
       for (int k = 0; k < 3 && separated; ++k) {
         if (other[k] == t[u] || other[k] == t[w]) continue;
@@ -511,32 +513,34 @@ bool separatedInProjection(const Triangle& ta, const TrianglePoints& a, const Tr
 }
 
 // Exact and sufficient for the same, by the planes' floating-point filters
-// alone: sharing an edge, the fourth corner off the other face's plane (a
-// face crosses that plane only along the edge); sharing one corner, the
-// other two corners of one face strictly on one side of the other's plane
-// (it meets that plane only at the corner); sharing none, all three
-// corners of one face strictly on one side. Most neighbours in a curved
-// surface; flat ones, which the filters cannot tell, go to the projection.
-bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const TrianglePoints& b) {
+// alone (`pa`, `pb`: those of a and b): sharing an edge, the fourth corner
+// off the other face's plane (a face crosses that plane only along the
+// edge); sharing one corner, the other two corners of one face strictly on
+// one side of the other's plane (it meets that plane only at the corner);
+// sharing none, all three corners of one face strictly on one side. Most
+// neighbours in a curved surface; flat ones, which the filters cannot tell,
+// go to the projection.
+bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const PlaneFilter& pa,
+                   const TrianglePoints& b, const PlaneFilter& pb) {
   // The corners `from`, `from` + 1, ... (count of them, modulo 3) of `face`
-  // strictly on one side of `plane`'s plane (its normal computed once).
-  // (Every corner is tested, with no branch on a side: those are as good
-  // as random.)
-  auto oneSide = [](const TrianglePoints& plane, const TrianglePoints& face, int from, int count) {
-    const PlaneFilter filter(plane[0], plane[1], plane[2]);
-    const int side = filter.filteredSide(plane[0], face[std::size_t(from % 3)]);
+  // strictly on one side of the plane of `filter` through `origin`. (Every
+  // corner is tested, with no branch on a side: those are as good as
+  // random.)
+  auto oneSide = [](const PlaneFilter& filter, const Point3& origin, const TrianglePoints& face,
+                    int from, int count) {
+    const int side = filter.filteredSide(origin, face[std::size_t(from % 3)]);
     bool same = side != 0;
     for (int k = 1; k < count; ++k)
-      same &= filter.filteredSide(plane[0], face[std::size_t((from + k) % 3)]) == side;
+      same &= filter.filteredSide(origin, face[std::size_t((from + k) % 3)]) == side;
     return same;
   };
   switch (c.count) {
     case 2:
-      return oneSide(a, b, c.ib, 1);
+      return oneSide(pa, a[0], b, c.ib, 1);
     case 1:
-      return oneSide(b, a, c.ia + 1, 2) || oneSide(a, b, c.ib + 1, 2);
+      return oneSide(pb, b[0], a, c.ia + 1, 2) || oneSide(pa, a[0], b, c.ib + 1, 2);
     case 0:
-      return oneSide(a, b, 0, 3) || oneSide(b, a, 0, 3);
+      return oneSide(pa, a[0], b, 0, 3) || oneSide(pb, b[0], a, 0, 3);
     default:
       return false;
   }
@@ -546,21 +550,38 @@ bool apartByPlanes(const SharedCorners& c, const TrianglePoints& a, const Triang
 
 namespace {
 
+// Exact: some axis along which the faces' corners do not overlap (boxes
+// that overlap only through their outward rounding or widening).
+bool apartAlongAnAxis(const TrianglePoints& a, const TrianglePoints& b) {
+  for (int k = 0; k < 3; ++k)
+    if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
+        std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
+      return true;
+  return false;
+}
+
+// facesMeet after its test along the axes, with the faces' plane filters.
+// The pairs of a search around changed faces come here directly: the axis
+// test turned away one in two thousand of them.
+bool meetBeyondAxes(const Triangle& ta, const TrianglePoints& a, const PlaneFilter& pa,
+                    const Triangle& tb, const TrianglePoints& b, const PlaneFilter& pb,
+                    int knownFlat, bool sameVertices) {
+  if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
+  const SharedCorners c = sharedCorners(ta, tb);
+  if (c.count == 3 && !sameVertices) return false;
+  if (c.count < 3 && (apartByPlanes(c, a, pa, b, pb) || separatedInProjection(ta, a, tb, b)))
+    return false;
+  return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+}
+
 // facesIntersect with the degeneracy of the two faces known (`knownFlat`:
 // -1 not known, 0 neither is degenerate); faces with the same three
 // vertices meet unless `sameVertices` is false.
 bool facesMeet(const Triangle& ta, const TrianglePoints& a, const Triangle& tb,
                const TrianglePoints& b, int knownFlat, bool sameVertices = true) {
-  // Apart along an axis (exact): most candidates of a widened box search.
-  for (int k = 0; k < 3; ++k)
-    if (std::max({a[0][k], a[1][k], a[2][k]}) < std::min({b[0][k], b[1][k], b[2][k]}) ||
-        std::max({b[0][k], b[1][k], b[2][k]}) < std::min({a[0][k], a[1][k], a[2][k]}))
-      return false;
-  if (knownFlat < 0 && (collinear(a[0], a[1], a[2]) || collinear(b[0], b[1], b[2]))) return false;
-  const SharedCorners c = sharedCorners(ta, tb);
-  if (c.count == 3 && !sameVertices) return false;
-  if (c.count < 3 && (apartByPlanes(c, a, b) || separatedInProjection(ta, a, tb, b))) return false;
-  return intersectBeyondShared(a, b, c.count, c.ia, c.ib);
+  if (apartAlongAnAxis(a, b)) return false;
+  return meetBeyondAxes(ta, a, PlaneFilter(a[0], a[1], a[2]), tb, b, PlaneFilter(b[0], b[1], b[2]),
+                        knownFlat, sameVertices);
 }
 
 // The same for faces f and g of a mesh.
@@ -626,24 +647,29 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point
                                                          bool sameVertices) {
   // The faces' corners side by side in the search's order (each face is in
   // some ten pairs, and its corners' points lie anywhere in P).
+  // Their plane filters too: each made once, not once or twice per pair.
   const std::vector<std::uint32_t>& faces = search.faces();
   std::vector<Triangle> corners;
   std::vector<TrianglePoints> points;
+  std::vector<PlaneFilter> planes;
   std::vector<char> flat;
   resizeInHugePages(corners, faces.size());
   resizeInHugePages(points, faces.size());
+  resizeInHugePages(planes, faces.size());
   resizeInHugePages(flat, faces.size());
   parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t i = begin; i < end; ++i) {
       const Triangle& t = corners[i] = T[faces[i]];
       points[i] = {P[t[0]], P[t[1]], P[t[2]]};
+      planes[i] = PlaneFilter(points[i][0], points[i][1], points[i][2]);
       flat[i] = degenerate[faces[i]];
     }
   });
   std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
   search.forEachPair([&](std::uint32_t a, std::uint32_t b, unsigned worker) {
     if (!flat[a] && !flat[b] &&
-        facesMeet(corners[a], points[a], corners[b], points[b], 0, sameVertices))
+        meetBeyondAxes(corners[a], points[a], planes[a], corners[b], points[b], planes[b], 0,
+                       sameVertices))
       hits[worker].push_back({faces[a], faces[b]});
   });
   std::vector<std::array<std::uint32_t, 2>> all;

@@ -101,17 +101,6 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
   return exact::orient3d(a, b, c, d);
 }
 
-PlaneFilter::PlaneFilter(const Point3& a, const Point3& b, const Point3& c) {
-  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
-  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
-  n_[0] = by * cz - bz * cy;
-  n_[1] = bz * cx - bx * cz;
-  n_[2] = bx * cy - by * cx;
-  nAbs_[0] = std::fabs(by * cz) + std::fabs(bz * cy);
-  nAbs_[1] = std::fabs(bz * cx) + std::fabs(bx * cz);
-  nAbs_[2] = std::fabs(bx * cy) + std::fabs(by * cx);
-}
-
 int projectionAxis(const Point3& a, const Point3& b, const Point3& c) {
   const Point3 normal = (b - a) ^ (c - a);  // component k = orientation dropping axis k
   // The axes by decreasing |normal| component (three compares, no sort).

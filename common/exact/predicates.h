@@ -49,7 +49,17 @@ inline int orient2dDropping(const Point3& a, const Point3& b, const Point3& c, i
 class PlaneFilter {
  public:
   PlaneFilter() = default;
-  PlaneFilter(const Point3& a, const Point3& b, const Point3& c);
+  // Inline: made per candidate pair where no per-face filters are kept.
+  PlaneFilter(const Point3& a, const Point3& b, const Point3& c) {
+    const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+    const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+    n_[0] = by * cz - bz * cy;
+    n_[1] = bz * cx - bx * cz;
+    n_[2] = bx * cy - by * cx;
+    nAbs_[0] = std::fabs(by * cz) + std::fabs(bz * cy);
+    nAbs_[1] = std::fabs(bz * cx) + std::fabs(bx * cz);
+    nAbs_[2] = std::fabs(bx * cy) + std::fabs(by * cx);
+  }
   // orient3d(a, b, c, p) for the corners this filter was made from. Inline:
   // the search between meshes asks it some ten times per candidate pair,
   // and a call cost as much as the filter (orient3d only when it cannot

@@ -49,24 +49,30 @@ struct SharedCorners {
   int count = 0;
   int ia = -1, ib = -1;
 };
-// Selections, not branches: whether two candidate faces share a corner is
-// as good as random, and the mispredicted branches cost more than the nine
-// comparisons.
+// One bit per pair of corners, then bit arithmetic: no branch on whether
+// two candidate faces share a corner (as good as random, and a mispredicted
+// branch costs more than the nine comparisons). The last match in the
+// order (a[0], b[0]), (a[0], b[1]), ... gives ia and ib.
 inline SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
   SharedCorners s;
-  int inB = 0, inA = 0;  // bit i: a[i] is a corner of b; bit j: b[j] is one of a
+  unsigned m = 0;  // bit 3i + j: a[i] == b[j]
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const bool same = a[i] == b[j];
       s.count += same;
-      s.ia = same ? i : s.ia;
-      s.ib = same ? j : s.ib;
-      inB |= int(same) << i;
-      inA |= int(same) << j;
+      m |= unsigned(same) << (3 * i + j);
     }
-  if (s.count == 2) {  // the corners not shared
-    for (int i = 0; i < 3; ++i) s.ia = (inB >> i & 1) ? s.ia : i;
-    for (int j = 0; j < 3; ++j) s.ib = (inA >> j & 1) ? s.ib : j;
+  static constexpr int kRow[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2},
+                       kColumn[9] = {0, 1, 2, 0, 1, 2, 0, 1, 2};
+  const int last = 31 - __builtin_clz(m | 1);  // the last match (0 when none)
+  s.ia = m ? kRow[last] : -1;
+  s.ib = m ? kColumn[last] : -1;
+  if (s.count == 2) {  // the corners not shared, where there are such
+    const unsigned inB = unsigned((m & 7) != 0) | unsigned((m & 070) != 0) << 1 |
+                         unsigned((m & 0700) != 0) << 2;  // bit i: a[i] is a corner of b
+    const unsigned inA = (m | m >> 3 | m >> 6) & 7;       // bit j: b[j] is one of a
+    s.ia = inB != 7 ? 31 - __builtin_clz(~inB & 7) : s.ia;
+    s.ib = inA != 7 ? 31 - __builtin_clz(~inA & 7) : s.ib;
   }
   return s;
 }
