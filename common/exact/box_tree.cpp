@@ -146,22 +146,40 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
   // Per point: the one cell its box lies in, as (x * kCells + y) * kCells
   // + z; or, with kSpans set, that it spans cells or lies outside the grid,
   // and bit 2k (2k + 1) when its box ends below the grid (starts above it)
-  // along axis k.
+  // along axis k. A point stored as float (every point of a float host's
+  // mesh, most of a double host's) is its own box: one cell where it is
+  // inside, found once per axis (a box of each point was most of the work).
   constexpr std::uint32_t kSpans = 0x80000000u;
+  auto code = [&](const Box& b) {
+    int lo[3], hi[3];
+    bool one = inside(b);
+    std::uint32_t beyond = 0;
+    for (int k = 0; k < 3; ++k) {
+      cellRange(b, k, lo[k], hi[k]);
+      one &= lo[k] == hi[k];
+      beyond |= std::uint32_t(b.hi[k] < bounds_.lo[k]) << 2 * k |
+                std::uint32_t(b.lo[k] > bounds_.hi[k]) << (2 * k + 1);
+    }
+    return one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans | beyond;
+  };
+  auto storedCode = [&](const float x[3]) {
+    int at[3];
+    bool in = true;
+    for (int k = 0; k < 3; ++k) {
+      in &= x[k] >= bounds_.lo[k] && x[k] <= bounds_.hi[k];
+      const double from = (x[k] - bounds_.lo[k]) * cellsPerUnit_[k];  // as cellRange()
+      at[k] = !(from > 0) ? 0 : from < kCells - 1 ? int(from) : kCells - 1;
+    }
+    return in ? std::uint32_t((at[0] * kCells + at[1]) * kCells + at[2])
+              : code({{x[0], x[1], x[2]}, {x[0], x[1], x[2]}});
+  };
   std::vector<std::uint32_t> cell(P.size());
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t v = begin; v < end; ++v) {
-      const Box b = boxOf(P[v]);
-      int lo[3], hi[3];
-      bool one = inside(b);
-      std::uint32_t beyond = 0;
-      for (int k = 0; k < 3; ++k) {
-        cellRange(b, k, lo[k], hi[k]);
-        one &= lo[k] == hi[k];
-        beyond |= std::uint32_t(b.hi[k] < bounds_.lo[k]) << 2 * k |
-                  std::uint32_t(b.lo[k] > bounds_.hi[k]) << (2 * k + 1);
-      }
-      cell[v] = one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans | beyond;
+      const Point3& p = P[v];
+      const float x[3] = {float(p[0]), float(p[1]), float(p[2])};
+      const bool stored = double(x[0]) == p[0] && double(x[1]) == p[1] && double(x[2]) == p[2];
+      cell[v] = stored ? storedCode(x) : code(boxOf(p));
     }
   });
   // A face's box starts at its corners' lowest start and ends at their

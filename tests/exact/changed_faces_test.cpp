@@ -126,7 +126,8 @@ TEST(ChangedFaceSearch, NoChangedFaceNoPairs) {
 }
 
 // The grid's faces touching it are those whose boxes touch it, for faces
-// inside, across and outside the grid.
+// inside, across and outside the grid, with corners in double and stored as
+// float (a point box of its own), some on the grid's bounds.
 TEST(BoxGrid, FacesTouchingAreThoseWhoseBoxesTouch) {
   std::mt19937 rng(6);
   std::uniform_real_distribution<double> inside(0, 10), around(-4, 14), size(-1.5, 1.5);
@@ -146,17 +147,35 @@ TEST(BoxGrid, FacesTouchingAreThoseWhoseBoxesTouch) {
     points.push_back(i % 3 ? a + Point3(size(rng), size(rng), size(rng)) : Point3(-30, 40, 5));
     triangles.push_back({first, first + 1, first + 2});
   }
+  Box bounds = boxes[0];  // the grid's
+  for (const Box& b : boxes)
+    for (int k = 0; k < 3; ++k) {
+      bounds.lo[k] = std::min(bounds.lo[k], b.lo[k]);
+      bounds.hi[k] = std::max(bounds.hi[k], b.hi[k]);
+    }
+  for (const Box& b : {bounds, boxes[0]}) {  // corners on the grid's bounds and a box's
+    const int first = int(points.size());
+    points.push_back(Point3(b.lo[0], b.lo[1], b.lo[2]));
+    points.push_back(Point3(b.hi[0], b.hi[1], b.hi[2]));
+    points.push_back(Point3(b.lo[0], b.hi[1], b.lo[2]));
+    triangles.push_back({first, first, first + 1});
+    triangles.push_back({first + 2, first + 2, first + 2});
+  }
   std::vector<char> skip(triangles.size(), 0);
   for (std::size_t f = 0; f < skip.size(); f += 7) skip[f] = 1;
-  std::vector<std::uint32_t> expected;
-  for (std::uint32_t f = 0; f < triangles.size(); ++f) {
-    const Triangle& t = triangles[f];
-    if (!skip[f] && grid.touches(boxOf(points[t[0]], points[t[1]], points[t[2]])))
-      expected.push_back(f);
+  for (const bool stored : {false, true}) {
+    if (stored)
+      for (Point3& p : points) p = storedAs(p, Scalar::kFloat);
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t f = 0; f < triangles.size(); ++f) {
+      const Triangle& t = triangles[f];
+      if (!skip[f] && grid.touches(boxOf(points[t[0]], points[t[1]], points[t[2]])))
+        expected.push_back(f);
+    }
+    EXPECT_GT(expected.size(), 1000u);
+    EXPECT_LT(expected.size(), 15000u);
+    EXPECT_EQ(grid.facesTouching(points, triangles, skip), expected) << "stored " << stored;
   }
-  EXPECT_GT(expected.size(), 1000u);
-  EXPECT_LT(expected.size(), 15000u);
-  EXPECT_EQ(grid.facesTouching(points, triangles, skip), expected);
 }
 
 TEST(Box, WidenedIsThatManyNextafterSteps) {
