@@ -6,10 +6,15 @@ namespace meshmend {
 
 namespace {
 
+// The faces marked, ascending (per chunk, then the chunks in order).
 std::vector<std::uint32_t> marked(const std::vector<char>& changed) {
+  std::vector<std::vector<std::uint32_t>> found(workerCount());
+  parallelChunks(changed.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    for (std::size_t f = begin; f < end; ++f)
+      if (changed[f]) found[worker].push_back(std::uint32_t(f));
+  });
   std::vector<std::uint32_t> faces;
-  for (std::size_t f = 0; f < changed.size(); ++f)
-    if (changed[f]) faces.push_back(std::uint32_t(f));
+  for (const auto& w : found) faces.insert(faces.end(), w.begin(), w.end());
   return faces;
 }
 

@@ -325,9 +325,9 @@ class Rounder {
   }
 
  private:
-  // Faces that are new or that rounding moved: only those can cross
-  // anything they did not cross before (every other face is an input face,
-  // exactly as it was).
+  // Marks the faces that are new or that rounding moved: only those can
+  // cross anything they did not cross before (every other face is an input
+  // face, exactly as it was). True when there are any.
   bool findChanged() {
     std::vector<char> moved(P_.size(), 0);
     if (scalar_ != Scalar::kDouble)
@@ -335,16 +335,17 @@ class Rounder {
         for (std::size_t v = begin; v < end; ++v) moved[v] = P_[v] != ref_[v];
       });
     isChanged_.resize(T_.size());
-    parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    std::vector<char> any(workerCount(), 0);
+    parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+      char some = 0;
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = T_[f];
-        isChanged_[f] =
+        some |= isChanged_[f] =
             (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
       }
+      any[worker] = some;
     });
-    for (std::size_t f = 0; f < T_.size(); ++f)
-      if (isChanged_[f]) changed_.push_back(std::uint32_t(f));
-    return !changed_.empty();
+    return std::find(any.begin(), any.end(), 1) != any.end();
   }
 
   // Candidates: boxes widened by more steps than re-rounding moves a vertex
@@ -352,6 +353,8 @@ class Rounder {
   // float, so a float step covers double steps too).
   void findCandidates() {
     search_ = std::make_unique<ChangedFaceSearch>(P_, T_, isChanged_, kFarthestRounding + 2);
+    changed_.assign(search_->faces().begin(),
+                    search_->faces().begin() + std::ptrdiff_t(search_->changedCount()));
     // Whether each face that may be in a pair is degenerate as stored,
     // tested once.
     degenerate_.assign(T_.size(), 0);
@@ -517,7 +520,7 @@ class Rounder {
   std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
   std::vector<char> hasRow_;
   std::vector<int> changedIndex_;
-  std::vector<std::uint32_t> changed_;
+  std::vector<std::uint32_t> changed_;         // the changed faces, ascending (findCandidates)
   std::unique_ptr<ChangedFaceSearch> search_;  // candidate pairs (findCandidates)
   std::vector<std::array<std::uint32_t, 2>> crossing_;
   std::unordered_map<int, Point3> nearest_;  // re-rounded vertices' nearest rounding
@@ -540,7 +543,9 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
   const std::vector<Triangle> T = trianglesOf(merged);
   VertexOriginHandle vo = vertexOrigins(merged);
   std::vector<char> movable(reference.size(), 0);  // new vertices: inputs stay as they are
-  for (std::size_t v = 0; v < reference.size(); ++v) movable[v] = vo[v].vertex < 0;
+  parallelChunks(reference.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t v = begin; v < end; ++v) movable[v] = vo[v].vertex < 0;
+  });
   std::vector<Point3> P;
   std::size_t moved = 0;
   bool bounded = false;
@@ -555,7 +560,9 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
     out->rounding_tests += rounder.tests();
   }
   // The stored positions, to the merged output and to each mesh.
-  for (std::size_t v = 0; v < P.size(); ++v) merged.vert[v].P() = P[v];
+  parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t v = begin; v < end; ++v) merged.vert[v].P() = P[v];
+  });
   for (std::size_t m = 0; m < r.meshes.size(); ++m)
     for (std::size_t v = 0; v < r.merged_vertex[m].size(); ++v)
       r.meshes[m].vert[v].P() = P[r.merged_vertex[m][v]];
