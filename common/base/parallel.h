@@ -109,6 +109,18 @@ void parallelChunks(std::size_t n, Body&& body, std::size_t minimumPerWorker = 4
     if (e) std::rethrow_exception(e);
 }
 
+// Per-chunk results of parallelChunks (indexed by `worker`) as one list,
+// in chunk order: a chunk's items in [0, n) order stay in that order.
+template <class T>
+std::vector<T> joined(const std::vector<std::vector<T>>& parts) {
+  std::size_t n = 0;
+  for (const auto& part : parts) n += part.size();
+  std::vector<T> all;
+  all.reserve(n);
+  for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
+  return all;
+}
+
 // Runs a task on a helper thread while the caller works on, or, when no
 // helper takes it first, on the calling thread once it is waited for: the
 // task runs exactly once either way (if waited for), and wait() rethrows

@@ -208,9 +208,7 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
     for (std::size_t f = begin; f < end; ++f)
       if (!skip[f] && touchesFace(T[f])) found[worker].push_back(std::uint32_t(f));
   });
-  std::vector<std::uint32_t> faces;  // the chunks in order: ascending
-  for (const auto& w : found) faces.insert(faces.end(), w.begin(), w.end());
-  return faces;
+  return joined(found);  // ascending
 }
 
 bool BoxGrid::covers(const Box& b) const {

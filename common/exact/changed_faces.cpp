@@ -6,16 +6,14 @@ namespace meshmend {
 
 namespace {
 
-// The faces marked, ascending (per chunk, then the chunks in order).
+// The faces marked, ascending.
 std::vector<std::uint32_t> marked(const std::vector<char>& changed) {
   std::vector<std::vector<std::uint32_t>> found(workerCount());
   parallelChunks(changed.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
     for (std::size_t f = begin; f < end; ++f)
       if (changed[f]) found[worker].push_back(std::uint32_t(f));
   });
-  std::vector<std::uint32_t> faces;
-  for (const auto& w : found) faces.insert(faces.end(), w.begin(), w.end());
-  return faces;
+  return joined(found);
 }
 
 }  // namespace
@@ -73,9 +71,7 @@ std::vector<std::array<std::uint32_t, 2>> ChangedFaceSearch::pairs() const {
   forEachPair([&](std::uint32_t a, std::uint32_t b, unsigned worker) {
     found[worker].push_back({faces_[a], faces_[b]});
   });
-  std::vector<std::array<std::uint32_t, 2>> all;
-  for (const auto& w : found) all.insert(all.end(), w.begin(), w.end());
-  return all;
+  return joined(found);
 }
 
 std::vector<std::vector<std::uint32_t>> ChangedFaceSearch::candidatesOf(

@@ -615,9 +615,7 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(
           if (facesIntersect(P, T, pairs[i][0], pairs[i][1])) hits[worker].push_back(pairs[i]);
       },
       1024);
-  std::vector<std::array<std::uint32_t, 2>> all;
-  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
-  return all;
+  return joined(hits);
 }
 
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(
@@ -635,9 +633,7 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(
         }
       },
       1024);
-  std::vector<std::array<std::uint32_t, 2>> all;
-  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
-  return all;
+  return joined(hits);
 }
 
 std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point3>& P,
@@ -672,9 +668,7 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point
                        sameVertices))
       hits[worker].push_back({faces[a], faces[b]});
   });
-  std::vector<std::array<std::uint32_t, 2>> all;
-  for (const auto& h : hits) all.insert(all.end(), h.begin(), h.end());
-  return all;
+  return joined(hits);
 }
 
 SegmentSoup contactSegments(const FindIntersectionsResult& result) {

@@ -277,8 +277,9 @@ class Rounder {
   // than `giveUpAbove` defects.
   std::size_t run(int passes, std::size_t budget, std::size_t giveUpAbove, const Progress& progress,
                   std::size_t& rerounded, bool& bounded) {
-    if (!findChanged()) return 0;
+    markChanged();
     findCandidates();
+    if (changed_.empty()) return 0;
     crossing_ = intersectingOf(P_, T_, *search_, degenerate_, false);
     budget_ = budget;
     if (crossing_.size() > giveUpAbove) return crossing_.size();
@@ -327,25 +328,21 @@ class Rounder {
  private:
   // Marks the faces that are new or that rounding moved: only those can
   // cross anything they did not cross before (every other face is an input
-  // face, exactly as it was). True when there are any.
-  bool findChanged() {
+  // face, exactly as it was).
+  void markChanged() {
     std::vector<char> moved(P_.size(), 0);
     if (scalar_ != Scalar::kDouble)
       parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t v = begin; v < end; ++v) moved[v] = P_[v] != ref_[v];
       });
     isChanged_.resize(T_.size());
-    std::vector<char> any(workerCount(), 0);
-    parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
-      char some = 0;
+    parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = T_[f];
-        some |= isChanged_[f] =
+        isChanged_[f] =
             (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
       }
-      any[worker] = some;
     });
-    return std::find(any.begin(), any.end(), 1) != any.end();
   }
 
   // Candidates: boxes widened by more steps than re-rounding moves a vertex

@@ -1,11 +1,14 @@
 #include "common/exact/intersections.h"
 
+#include <algorithm>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
 #include "common/base/errors.h"
 #include "common/exact/box_tree.h"
+#include "common/exact/changed_faces.h"
 #include "common/exact/predicates.h"
 #include "tests/mesh_builders.h"
 
@@ -158,6 +161,65 @@ TEST(Intersections, FacesIntersectAgreesWithTheRulesOnNearbyFaces) {
     EXPECT_GT(meeting[shared], 100u) << shared << " shared corners";
     EXPECT_GT(apart[shared], 100u) << shared << " shared corners";
   }
+}
+
+// The pairs of a search around changed faces that intersect, tested with
+// each face's plane filter made once, are those the exact rule finds on
+// every pair: nearly coplanar neighbours (a tilted grid stored as float,
+// which the filters cannot tell and the projection or the exact test
+// must), faces sharing an edge or a corner, a second grid crossing the
+// first, faces with the same three vertices (not counted) and flat ones.
+TEST(Intersections, SearchAroundChangedFacesMatchesTheRuleOnEveryPair) {
+  std::vector<Point3> P;
+  std::vector<Triangle> T;
+  std::vector<char> changed;
+  auto grid = [&](int n, auto at, auto isChanged) {
+    const int first = int(P.size());
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) P.push_back(storedAs(at(i, j), Scalar::kFloat));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int v = first + i * (n + 1) + j;
+        T.push_back({v, v + 1, v + n + 2});
+        T.push_back({v, v + n + 2, v + n + 1});
+        changed.push_back(isChanged(T.size()));
+        changed.push_back(isChanged(T.size() + 1));
+      }
+  };
+  grid(
+      24, [](int i, int j) { return Point3(0.1 * i, 0.1 * j, 0.031 * i + 0.017 * j); },
+      [](std::size_t f) { return f % 3 == 0; });
+  grid(
+      8, [](int i, int j) { return Point3(0.3 * i - 0.1, 1.2, 0.3 * j - 0.5); },
+      [](std::size_t) { return true; });
+  for (std::size_t f = 0; f < 40; f += 7) {  // the same face again, and a flat one
+    T.push_back(T[f]);
+    changed.push_back(1);
+  }
+  T.push_back({0, 1, 2});  // 0, 1, 2 lie on the grid's first row
+  changed.push_back(1);
+  std::vector<char> degenerate(T.size());
+  for (std::size_t f = 0; f < T.size(); ++f)
+    degenerate[f] = collinear(P[T[f][0]], P[T[f][1]], P[T[f][2]]);
+  ASSERT_EQ(degenerate.back(), 1);
+
+  std::set<std::array<std::uint32_t, 2>> expected;
+  for (std::uint32_t f = 0; f < T.size(); ++f)
+    for (std::uint32_t g = f + 1; g < T.size(); ++g) {
+      if (!(changed[f] || changed[g]) || degenerate[f] || degenerate[g]) continue;
+      const SharedCorners c = sharedCorners(T[f], T[g]);
+      if (c.count == 3) continue;
+      const TrianglePoints a{P[T[f][0]], P[T[f][1]], P[T[f][2]]},
+          b{P[T[g][0]], P[T[g][1]], P[T[g][2]]};
+      if (intersectBeyondShared(a, b, c.count, c.ia, c.ib)) expected.insert({f, g});
+    }
+  ASSERT_GT(expected.size(), 20u);  // the grids cross
+
+  const ChangedFaceSearch search(P, T, changed, 4);
+  std::set<std::array<std::uint32_t, 2>> found;
+  for (auto [f, g] : intersectingOf(P, T, search, degenerate, false))
+    found.insert({std::min(f, g), std::max(f, g)});
+  EXPECT_EQ(found, expected);
 }
 
 TEST(Intersections, LargeMeshSelfJoinMatchesBruteForceOnAPushedSphere) {
