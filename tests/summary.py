@@ -46,8 +46,11 @@ def cases(xml_path):
             yield name, "failed", (message or "").strip()
         elif skipped is not None or status in ("notrun", "disabled"):
             message = skipped.get("message", "") if skipped is not None else status
+            output = case.findtext("system-out") or ""
             if message == "SKIP_REGULAR_EXPRESSION_MATCHED":  # a GTEST_SKIP: its own words
-                message = gtest_skip_reason(case.findtext("system-out") or "") or message
+                message = gtest_skip_reason(output) or message
+            elif message.startswith("SKIP_RETURN_CODE"):  # a check that said why on its way out
+                message = next((line for line in output.splitlines() if line.startswith("missing")), message)
             yield name, "skipped", (message or "").strip()
         else:
             yield name, "passed", ""

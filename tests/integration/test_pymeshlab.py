@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import cad_cases
-from conftest import (BUILD, DATA, ROOT, PLUGIN_DIR, VENDOR, Host, filters, float_exact, meshcheck, mlx, need, read_ply,
+from conftest import (BUILD, DATA, ROOT, PLUGIN_DIR, Host, filters, float_exact, meshcheck, mlx, need, read_ply,
                       require_shared_data, run_server, write_off, write_ply)
 from test_clearance import nested_spheres
 from test_stitch import indices, joined, sphere, two_sheets
@@ -35,10 +35,6 @@ PYTHON_NAMES = {
     "MeshMend: Prepare Shader View": "meshmend_prepare_shader_view",
 }
 NAMES = {python: name for name, python in PYTHON_NAMES.items()}
-
-if not VENDOR.is_dir():
-    need(False, f"{VENDOR}: pymeshlab is built from its sources there, so these tests cannot run")
-
 
 @pytest.fixture(scope="module", params=["2025.07d", "2022.02d"])
 def host(request):
