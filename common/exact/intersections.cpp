@@ -1,5 +1,4 @@
 #include "common/exact/intersections.h"
-#include "common/base/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +11,7 @@
 #include "common/base/errors.h"
 #include "common/base/huge_pages.h"
 #include "common/base/parallel.h"
+#include "common/base/timing.h"
 #include "common/exact/box_tree.h"
 #include "common/exact/predicates.h"
 
