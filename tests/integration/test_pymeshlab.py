@@ -36,6 +36,7 @@ PYTHON_NAMES = {
 }
 NAMES = {python: name for name, python in PYTHON_NAMES.items()}
 
+
 @pytest.fixture(scope="module", params=["2025.07d", "2022.02d"])
 def host(request):
     h = Host(request.param)
