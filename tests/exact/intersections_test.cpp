@@ -180,10 +180,11 @@ TEST(Intersections, SearchAroundChangedFacesMatchesTheRuleOnEveryPair) {
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
         const int v = first + i * (n + 1) + j;
-        T.push_back({v, v + 1, v + n + 2});
-        T.push_back({v, v + n + 2, v + n + 1});
-        changed.push_back(isChanged(T.size()));
-        changed.push_back(isChanged(T.size() + 1));
+        for (const Triangle& t :
+             {Triangle{v, v + 1, v + n + 2}, Triangle{v, v + n + 2, v + n + 1}}) {
+          changed.push_back(isChanged(T.size()));  // by the face's index
+          T.push_back(t);
+        }
       }
   };
   grid(
