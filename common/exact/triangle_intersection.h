@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "common/base/mesh.h"
@@ -49,32 +50,43 @@ struct SharedCorners {
   int count = 0;
   int ia = -1, ib = -1;
 };
-// One bit per pair of corners, then bit arithmetic: no branch on whether
-// two candidate faces share a corner (as good as random, and a mispredicted
+// One bit per pair of corners, then a table: no branch on whether two
+// candidate faces share a corner (as good as random, and a mispredicted
 // branch costs more than the nine comparisons). The last match in the
 // order (a[0], b[0]), (a[0], b[1]), ... gives ia and ib.
-inline SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
-  SharedCorners s;
-  unsigned m = 0;  // bit 3i + j: a[i] == b[j]
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const bool same = a[i] == b[j];
-      s.count += same;
-      m |= unsigned(same) << (3 * i + j);
+namespace shared_corners_detail {
+struct Entry {
+  std::int8_t count, ia, ib;
+};
+// The SharedCorners of each match mask (bit 3i + j: a[i] == b[j]).
+constexpr std::array<Entry, 512> table() {
+  std::array<Entry, 512> t{};
+  for (unsigned m = 0; m < 512; ++m) {
+    int count = 0, last = -1;
+    for (int bit = 0; bit < 9; ++bit)
+      if (m >> bit & 1) ++count, last = bit;
+    int ia = last < 0 ? -1 : last / 3, ib = last < 0 ? -1 : last % 3;
+    if (count == 2) {  // the corners not shared, where there are such
+      for (int i = 0; i < 3; ++i)
+        if (!(m >> (3 * i) & 7)) ia = i;  // a[i] is no corner of b (the last such)
+      for (int j = 0; j < 3; ++j)
+        if (!((m | m >> 3 | m >> 6) >> j & 1)) ib = j;
     }
-  static constexpr int kRow[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2},
-                       kColumn[9] = {0, 1, 2, 0, 1, 2, 0, 1, 2};
-  const int last = 31 - __builtin_clz(m | 1);  // the last match (0 when none)
-  s.ia = m ? kRow[last] : -1;
-  s.ib = m ? kColumn[last] : -1;
-  if (s.count == 2) {  // the corners not shared, where there are such
-    const unsigned inB = unsigned((m & 7) != 0) | unsigned((m & 070) != 0) << 1 |
-                         unsigned((m & 0700) != 0) << 2;  // bit i: a[i] is a corner of b
-    const unsigned inA = (m | m >> 3 | m >> 6) & 7;       // bit j: b[j] is one of a
-    s.ia = inB != 7 ? 31 - __builtin_clz(~inB & 7) : s.ia;
-    s.ib = inA != 7 ? 31 - __builtin_clz(~inA & 7) : s.ib;
+    t[m] = {std::int8_t(count), std::int8_t(ia), std::int8_t(ib)};
   }
-  return s;
+  return t;
+}
+inline constexpr std::array<Entry, 512> kTable = table();
+}  // namespace shared_corners_detail
+inline SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
+  // The nine comparisons written out: as a loop they took twice the
+  // instructions.
+  const int a0 = a[0], a1 = a[1], a2 = a[2], b0 = b[0], b1 = b[1], b2 = b[2];
+  const unsigned m = unsigned(a0 == b0) | unsigned(a0 == b1) << 1 | unsigned(a0 == b2) << 2 |
+                     unsigned(a1 == b0) << 3 | unsigned(a1 == b1) << 4 | unsigned(a1 == b2) << 5 |
+                     unsigned(a2 == b0) << 6 | unsigned(a2 == b1) << 7 | unsigned(a2 == b2) << 8;
+  const shared_corners_detail::Entry e = shared_corners_detail::kTable[m];
+  return {e.count, e.ia, e.ib};
 }
 // Do a and b have the same three vertices (the same face twice)?
 inline bool sameVertices(const Triangle& a, const Triangle& b) {
