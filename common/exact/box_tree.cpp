@@ -115,8 +115,22 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kC
     for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
     for (int x = lo[0]; x <= hi[0]; ++x)
       for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z) occupied_[(x * kCells + y) * kCells + z] = 1;
+        for (int z = lo[2]; z <= hi[2]; ++z) occupied_[index(x, y, z)] = 1;
   }
+  // Each occupied cell c - d (d in {0, 1}^3) sets the bits m that contain d.
+  blocks_.assign(occupied_.size(), 0);
+  for (int x = 0; x < kCells; ++x)
+    for (int y = 0; y < kCells; ++y)
+      for (int z = 0; z < kCells; ++z) {
+        if (!occupied(x, y, z)) continue;
+        for (int d = 0; d < 8; ++d) {
+          const int bx = x - (d & 1), by = y - (d >> 1 & 1), bz = z - (d >> 2 & 1);
+          if (bx < 0 || by < 0 || bz < 0) continue;
+          std::uint8_t containing = 0;
+          for (int m = 0; m < 8; ++m) containing |= std::uint8_t(((m & d) == d) << m);
+          blocks_[index(bx, by, bz)] |= containing;
+        }
+      }
 }
 
 bool BoxGrid::inside(const Box& b) const {
@@ -132,7 +146,7 @@ bool BoxGrid::touches(const Box& b) const {
   return anyOccupied(lo, hi);
 }
 
-bool BoxGrid::anyOccupied(const int lo[3], const int hi[3]) const {
+bool BoxGrid::anyOccupiedIn(const int lo[3], const int hi[3]) const {
   for (int x = lo[0]; x <= hi[0]; ++x)
     for (int y = lo[1]; y <= hi[1]; ++y)
       for (int z = lo[2]; z <= hi[2]; ++z)
@@ -162,24 +176,24 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
     }
     return one ? std::uint32_t((lo[0] * kCells + lo[1]) * kCells + lo[2]) : kSpans | beyond;
   };
-  auto storedCode = [&](const float x[3]) {
-    int at[3];
-    bool in = true;
-    for (int k = 0; k < 3; ++k) {
-      in &= x[k] >= bounds_.lo[k] && x[k] <= bounds_.hi[k];
-      const double from = (x[k] - bounds_.lo[k]) * cellsPerUnit_[k];  // as cellRange()
-      at[k] = !(from > 0) ? 0 : from < kCells - 1 ? int(from) : kCells - 1;
-    }
-    return in ? std::uint32_t((at[0] * kCells + at[1]) * kCells + at[2])
-              : code({{x[0], x[1], x[2]}, {x[0], x[1], x[2]}});
+  // A point stored as float inside the grid (most): its cell along each
+  // axis as cellRange() finds it (the same float arithmetic), the clamp at
+  // the low end needless inside.
+  auto axisCell = [&](float x, int k) {
+    return int(std::min((x - bounds_.lo[k]) * cellsPerUnit_[k], float(kCells - 1)));
   };
   std::vector<std::uint32_t> cell(P.size());
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t v = begin; v < end; ++v) {
       const Point3& p = P[v];
-      const float x[3] = {float(p[0]), float(p[1]), float(p[2])};
-      const bool stored = double(x[0]) == p[0] && double(x[1]) == p[1] && double(x[2]) == p[2];
-      cell[v] = stored ? storedCode(x) : code(boxOf(p));
+      const float x = float(p[0]), y = float(p[1]), z = float(p[2]);
+      const bool stored = (double(x) == p[0]) & (double(y) == p[1]) & (double(z) == p[2]);
+      const bool in = (x >= bounds_.lo[0]) & (x <= bounds_.hi[0]) & (y >= bounds_.lo[1]) &
+                      (y <= bounds_.hi[1]) & (z >= bounds_.lo[2]) & (z <= bounds_.hi[2]);
+      if (stored & in)
+        cell[v] = std::uint32_t(index(axisCell(x, 0), axisCell(y, 1), axisCell(z, 2)));
+      else
+        cell[v] = code(stored ? Box{{x, y, z}, {x, y, z}} : boxOf(p));
     }
   });
   // A face's box starts at its corners' lowest start and ends at their

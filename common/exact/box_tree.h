@@ -88,12 +88,23 @@ class BoxGrid {
     lo = !(from > 0) ? 0 : from < kCells - 1 ? int(from) : kCells - 1;
     hi = !(to < kCells - 1) ? kCells - 1 : to > 0 ? int(to) : 0;
   }
-  bool occupied(int x, int y, int z) const { return occupied_[(x * kCells + y) * kCells + z]; }
-  bool anyOccupied(const int lo[3], const int hi[3]) const;  // of the cells lo..hi
+  static int index(int x, int y, int z) { return (x * kCells + y) * kCells + z; }
+  bool occupied(int x, int y, int z) const { return occupied_[index(x, y, z)]; }
+  // Of the cells lo..hi: a box that spans at most two cells along each axis
+  // (most faces' boxes) is one look-up in blocks_.
+  bool anyOccupied(const int lo[3], const int hi[3]) const {
+    const int dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+    if ((dx | dy | dz) > 1) return anyOccupiedIn(lo, hi);
+    return blocks_[index(lo[0], lo[1], lo[2])] >> (dx | dy << 1 | dz << 2) & 1;
+  }
+  bool anyOccupiedIn(const int lo[3], const int hi[3]) const;  // cell by cell
 
   Box bounds_{{1, 1, 1}, {0, 0, 0}};
   float cellsPerUnit_[3] = {1, 1, 1};
   std::vector<char> occupied_;
+  // Per cell, bit m (bit 0: x, 1: y, 2: z) set where a cell of the block
+  // from this one to the next along each axis in m is occupied.
+  std::vector<std::uint8_t> blocks_;
 };
 
 // A uniform grid over boxes whose non-empty cells are found by hashing:

@@ -178,6 +178,46 @@ TEST(BoxGrid, FacesTouchingAreThoseWhoseBoxesTouch) {
   }
 }
 
+// Boxes spanning one or two cells along each axis (most faces' boxes): a
+// box overlapping one of the grid's touches it, along whichever axes it
+// spans two cells, and a box more than two cells from all of them does not.
+TEST(BoxGrid, SmallBoxesTouchWhereTheGridsBoxesAre) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> inside(0, 10), around(-1, 11), size(0, 0.15);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 500; ++i) {
+    const Point3 a(inside(rng), inside(rng), inside(rng));
+    boxes.push_back(boxOf(a, a + Point3(0.1, 0.1, 0.1), a + Point3(0.1, 0, 0.05)));
+  }
+  const BoxGrid grid(boxes);
+  const double cell = 10.0 / 64, far = 2.5 * cell;  // the grid spans about 10 in 64 cells
+  int overlapping = 0, distant = 0;
+  for (int i = 0; i < 40000; ++i) {
+    // Every other one beside a box of the grid, where it may reach into the
+    // cell next to that box's.
+    const Box& b = boxes[std::size_t(i) % boxes.size()];
+    const Point3 a = i % 2 ? Point3(around(rng), around(rng), around(rng))
+                           : Point3(b.lo[0] - size(rng), b.lo[1] - size(rng), b.lo[2] - size(rng));
+    const Box q = boxOf(a, a + Point3(size(rng), size(rng), size(rng)), a);
+    bool overlaps = false, nearAny = false;
+    for (const Box& b : boxes) {
+      overlaps |= overlap(b, q);
+      bool near = true;
+      for (int k = 0; k < 3; ++k) near &= b.lo[k] - q.hi[k] < far && q.lo[k] - b.hi[k] < far;
+      nearAny |= near;
+    }
+    if (overlaps) {
+      ++overlapping;
+      EXPECT_TRUE(grid.touches(q)) << i;
+    } else if (!nearAny) {
+      ++distant;
+      EXPECT_FALSE(grid.touches(q)) << i;
+    }
+  }
+  EXPECT_GT(overlapping, 1000);
+  EXPECT_GT(distant, 5000);
+}
+
 TEST(Box, WidenedIsThatManyNextafterSteps) {
   std::vector<float> values = {0.0f,
                                -0.0f,
