@@ -262,13 +262,27 @@ class Rounder {
       largest = std::max({largest, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
     floor_ = std::ldexp(largest, -int(kMaxCoordinateBinades));
     resizeInHugePages(P_, reference.size());
+    moved_.resize(reference.size());
     parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t v = begin; v < end; ++v) {
-        P_[v] = storedAs(reference[v], scalar);
+        const Point3& r = reference[v];
+        Point3 p = storedAs(r, scalar);
         if (v < movable_.size() && movable_[v])
-          for (int k = 0; k < 3; ++k) P_[v][k] = withinSpan(P_[v][k]);
+          for (int k = 0; k < 3; ++k) p[k] = withinSpan(p[k]);
+        P_[v] = p;
+        moved_[v] = char((p[0] != r[0]) | (p[1] != r[1]) | (p[2] != r[2]));
       }
     });
+  }
+
+  // Whether vertex v may be stored off its reference position: only those
+  // need writing back.
+  bool moved(std::size_t v) const { return moved_[v]; }
+  // New faces whose corners, as stored, are collinear (degenerateNewFaces).
+  std::size_t degenerateNewFaces() const {
+    std::size_t n = 0;
+    for (std::uint32_t f : changed_) n += degenerate_[f] && f < newFace_.size() && newFace_[f];
+    return n;
   }
 
   // Re-rounds while defects are left, at most `passes` passes per reach and
@@ -330,17 +344,12 @@ class Rounder {
   // cross anything they did not cross before (every other face is an input
   // face, exactly as it was).
   void markChanged() {
-    std::vector<char> moved(P_.size(), 0);
-    if (scalar_ != Scalar::kDouble)
-      parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-        for (std::size_t v = begin; v < end; ++v) moved[v] = P_[v] != ref_[v];
-      });
     isChanged_.resize(T_.size());
     parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = T_[f];
         isChanged_[f] =
-            (f < newFace_.size() && newFace_[f]) | moved[t[0]] | moved[t[1]] | moved[t[2]];
+            (f < newFace_.size() && newFace_[f]) | moved_[t[0]] | moved_[t[1]] | moved_[t[2]];
       }
     });
   }
@@ -475,6 +484,7 @@ class Rounder {
   bool reround(int v, int reach) {
     const Point3 start = P_[v];
     nearest_.emplace(v, start);  // the first time: the nearest rounding
+    moved_[std::size_t(v)] = 1;
     std::array<std::vector<double>, 3> choices;
     for (int k = 0; k < 3; ++k) {
       choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
@@ -513,6 +523,7 @@ class Rounder {
   const std::vector<char>& movable_;
   const Scalar scalar_;
   std::vector<Point3>& P_;
+  std::vector<char> moved_;  // rounded off the reference position, or re-rounded
   std::vector<char> isChanged_, degenerate_;
   std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
   std::vector<char> hasRow_;
@@ -555,10 +566,13 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
     out->vertices_rerounded += moved;
     out->bounded |= bounded;
     out->rounding_tests += rounder.tests();
+    out->degenerate_new_faces = rounder.degenerateNewFaces();
   }
-  // The stored positions, to the merged output and to each mesh.
+  // The stored positions, to the merged output (where they moved) and to
+  // each mesh.
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t v = begin; v < end; ++v) merged.vert[v].P() = P[v];
+    for (std::size_t v = begin; v < end; ++v)
+      if (rounder.moved(v)) merged.vert[v].P() = P[v];
   });
   for (std::size_t m = 0; m < r.meshes.size(); ++m)
     for (std::size_t v = 0; v < r.merged_vertex[m].size(); ++v)
@@ -994,7 +1008,7 @@ StoredOutput storeForHost(SplitResult& r, const std::vector<const Mesh*>& inputs
       stage.progress, 95,
       stage.scalar == Scalar::kFloat ? "Rounding to float" : "Checking the double result");
   out.crossing = roundForHost(r, stage, &out);
-  if (defectsOf(r, out.crossing) > 0) repairStored(r, inputs, options, stage, out);
+  if (out.crossing + out.degenerate_new_faces > 0) repairStored(r, inputs, options, stage, out);
   out.time_ms = msSince(start);
   return out;
 }
