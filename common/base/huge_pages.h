@@ -15,6 +15,8 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
+#include <utility>
 #include <vector>
 
 namespace meshmend {
@@ -27,17 +29,40 @@ inline constexpr std::size_t kLargeArrayBytes = std::size_t(4) << 20;
 // begin + bytes) (none under 4 MiB). Pages written already keep theirs.
 void adviseHugePages(const void* begin, std::size_t bytes);
 
-// v.reserve(n), the room beyond v's elements advised before it is written.
+// An allocator that default-initializes new elements where std::allocator
+// value-initializes them (zeroes them first): for large arrays of records
+// each of which is written whole before it is read, a pass over the memory
+// less.
 template <class T>
-void reserveInHugePages(std::vector<T>& v, std::size_t n) {
+struct DefaultInitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <class U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// v.reserve(n), the room beyond v's elements advised before it is written.
+template <class T, class A>
+void reserveInHugePages(std::vector<T, A>& v, std::size_t n) {
   if (n <= v.capacity()) return;
   v.reserve(n);
   adviseHugePages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
 }
 
 // v.resize(n) (value-initialized new elements), the new memory advised first.
-template <class T>
-void resizeInHugePages(std::vector<T>& v, std::size_t n) {
+template <class T, class A>
+void resizeInHugePages(std::vector<T, A>& v, std::size_t n) {
   reserveInHugePages(v, n);
   v.resize(n);
 }

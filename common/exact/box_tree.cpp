@@ -100,7 +100,7 @@ Box widened(const Box& b, int steps) {
   return w;
 }
 
-BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kCells, 0) {
+BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCells, kEmpty) {
   if (boxes.empty()) return;
   bounds_ = boxes[0];
   for (const Box& b : boxes)
@@ -115,10 +115,18 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : occupied_(kCells * kCells * kC
     for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
     for (int x = lo[0]; x <= hi[0]; ++x)
       for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z) occupied_[index(x, y, z)] = 1;
+        for (int z = lo[2]; z <= hi[2]; ++z) {
+          std::uint32_t& at = cellBox_[index(x, y, z)];
+          if (at == kEmpty) {
+            at = std::uint32_t(cellBoxes_.size());
+            cellBoxes_.push_back(b);
+          } else {
+            grow(cellBoxes_[at], b);
+          }
+        }
   }
   // Each occupied cell c - d (d in {0, 1}^3) sets the bits m that contain d.
-  blocks_.assign(occupied_.size(), 0);
+  blocks_.assign(cellBox_.size(), 0);
   for (int x = 0; x < kCells; ++x)
     for (int y = 0; y < kCells; ++y)
       for (int z = 0; z < kCells; ++z) {
@@ -143,7 +151,15 @@ bool BoxGrid::touches(const Box& b) const {
   if (!overlap(b, bounds_)) return false;
   int lo[3], hi[3];
   for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
-  return anyOccupied(lo, hi);
+  return anyOccupied(lo, hi) && overlapsCellBoxes(b, lo, hi);
+}
+
+bool BoxGrid::overlapsCellBoxes(const Box& b, const int lo[3], const int hi[3]) const {
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        if (overlapsCellBoxes(b, index(x, y, z))) return true;
+  return false;
 }
 
 bool BoxGrid::anyOccupiedIn(const int lo[3], const int hi[3]) const {
@@ -200,27 +216,43 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
   // highest end, and cellRange() never decreases with the coordinate: the
   // face's cells are the range of its corners' cells. Corners in one cell
   // (most faces) ask that cell; corners all beyond one side of the grid
-  // (most of the rest of a large mesh) ask nothing; others, the box.
-  auto touchesFace = [&](const Triangle& t) {
-    const std::uint32_t a = cell[t[0]], b = cell[t[1]], c = cell[t[2]];
-    if ((a | b | c) & kSpans) {
-      const std::uint32_t all = a & b & c;  // with kSpans: beyond the same side, all three
-      return !((all & kSpans) && (all & ~kSpans)) && touches(boxOf(P[t[0]], P[t[1]], P[t[2]]));
-    }
-    if (a == b && b == c) return occupied_[a] != 0;
-    int lo[3], hi[3];
+  // (most of the rest of a large mesh) ask nothing; others, the box. The
+  // face's box and the cells' boxes only where a cell it touches is
+  // occupied (few faces: a call of its own, so that the loop over all of
+  // them stays small).
+  auto cellsOf = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, int lo[3], int hi[3]) {
     for (int k = 0, shift = 0; k < 3; ++k, shift += kCellBits) {
       const int ka = int(a >> shift) & (kCells - 1), kb = int(b >> shift) & (kCells - 1),
                 kc = int(c >> shift) & (kCells - 1);
       lo[2 - k] = std::min({ka, kb, kc});
       hi[2 - k] = std::max({ka, kb, kc});
     }
+  };
+  auto mayTouch = [&](const Triangle& t) {
+    const std::uint32_t a = cell[t[0]], b = cell[t[1]], c = cell[t[2]];
+    if ((a | b | c) & kSpans) {
+      const std::uint32_t all = a & b & c;  // with kSpans: beyond the same side, all three
+      return !((all & kSpans) && (all & ~kSpans));
+    }
+    if (a == b && b == c) return cellBox_[a] != kEmpty;
+    int lo[3], hi[3];
+    cellsOf(a, b, c, lo, hi);
     return anyOccupied(lo, hi);
+  };
+  auto touchesFace = [&](const Triangle& t) {
+    const Box box = boxOf(P[t[0]], P[t[1]], P[t[2]]);
+    const std::uint32_t a = cell[t[0]], b = cell[t[1]], c = cell[t[2]];
+    if ((a | b | c) & kSpans) return touches(box);
+    if (a == b && b == c) return overlapsCellBoxes(box, int(a));
+    int lo[3], hi[3];
+    cellsOf(a, b, c, lo, hi);
+    return overlapsCellBoxes(box, lo, hi);
   };
   std::vector<std::vector<std::uint32_t>> found(workerCount());
   parallelChunks(T.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
     for (std::size_t f = begin; f < end; ++f)
-      if (!skip[f] && touchesFace(T[f])) found[worker].push_back(std::uint32_t(f));
+      if (!skip[f] && mayTouch(T[f]) && touchesFace(T[f]))
+        found[worker].push_back(std::uint32_t(f));
   });
   return joined(found);  // ascending
 }

@@ -52,18 +52,22 @@ inline bool overlap(const Box& x, const Box& y) {
 
 // A coarse occupancy grid over the cells that some boxes touch: it turns
 // away, cheaply, the boxes far from all of them (most of a large mesh), so
-// that only the rest go into a tree or a search.
+// that only the rest go into a tree or a search. Each occupied cell keeps
+// the bounding box of the boxes that touch it: where they run through a
+// cell as a thin band (faces along a curve), a box beside the band in the
+// same cell is turned away too (half the faces a cell alone let through).
 class BoxGrid {
  public:
   explicit BoxGrid(const std::vector<Box>& boxes);
-  // Does `b` touch a cell that one of the boxes touches? (Never false for a
-  // box that overlaps one of them.)
+  // Does `b` touch a cell that one of the boxes touches, and overlap the
+  // bounding box of those that touch it? (Never false for a box that
+  // overlaps one of them: their overlap lies in a cell both touch.)
   bool touches(const Box& b) const;
   // Does every cell that `b` touches hold one of the boxes, b inside the
   // grid? Then every box that overlaps `b` touches an occupied cell.
   bool covers(const Box& b) const;
 
-  // The faces of (points, triangles) whose boxes touch an occupied cell
+  // The faces of (points, triangles) whose boxes touch the grid's boxes
   // (touches(boxOf(corners)), exactly), but those marked in `skip`,
   // ascending, in parallel. Each point's cell is found once: a point is
   // shared by about six faces, and a box per face cost more than the test.
@@ -89,7 +93,12 @@ class BoxGrid {
     hi = !(to < kCells - 1) ? kCells - 1 : to > 0 ? int(to) : 0;
   }
   static int index(int x, int y, int z) { return (x * kCells + y) * kCells + z; }
-  bool occupied(int x, int y, int z) const { return occupied_[index(x, y, z)]; }
+  bool occupied(int x, int y, int z) const { return cellBox_[index(x, y, z)] != kEmpty; }
+  // Does `b` overlap the bounding box of a cell c of lo..hi (c's boxes)?
+  bool overlapsCellBoxes(const Box& b, const int lo[3], const int hi[3]) const;
+  bool overlapsCellBoxes(const Box& b, int cell) const {
+    return cellBox_[cell] != kEmpty && overlap(b, cellBoxes_[cellBox_[cell]]);
+  }
   // Of the cells lo..hi: a box that spans at most two cells along each axis
   // (most faces' boxes) is one look-up in blocks_.
   bool anyOccupied(const int lo[3], const int hi[3]) const {
@@ -101,7 +110,10 @@ class BoxGrid {
 
   Box bounds_{{1, 1, 1}, {0, 0, 0}};
   float cellsPerUnit_[3] = {1, 1, 1};
-  std::vector<char> occupied_;
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  std::vector<std::uint32_t>
+      cellBox_;  // per cell: its boxes' bounding box in cellBoxes_, or kEmpty
+  std::vector<Box> cellBoxes_;
   // Per cell, bit m (bit 0: x, 1: y, 2: z) set where a cell of the block
   // from this one to the next along each axis in m is occupied.
   std::vector<std::uint8_t> blocks_;

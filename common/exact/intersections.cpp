@@ -641,30 +641,33 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point
                                                          const ChangedFaceSearch& search,
                                                          const std::vector<char>& degenerate,
                                                          bool sameVertices) {
-  // The faces' corners side by side in the search's order (each face is in
-  // some ten pairs, and its corners' points lie anywhere in P).
-  // Their plane filters too: each made once, not once or twice per pair.
+  // What the tests read of each face, side by side in the search's order
+  // and in one record (each face is in some ten pairs, its corners' points
+  // lie anywhere in P, and a pair's two records are two misses, not six).
+  // The plane filters too: each made once, not once or twice per pair.
+  struct FaceRecord {
+    TrianglePoints points;
+    PlaneFilter plane;
+    Triangle corners;
+    bool flat;
+  };
   const std::vector<std::uint32_t>& faces = search.faces();
-  std::vector<Triangle> corners;
-  std::vector<TrianglePoints> points;
-  std::vector<PlaneFilter> planes;
-  std::vector<char> flat;
-  resizeInHugePages(corners, faces.size());
-  resizeInHugePages(points, faces.size());
-  resizeInHugePages(planes, faces.size());
-  resizeInHugePages(flat, faces.size());
+  std::vector<FaceRecord, DefaultInitAllocator<FaceRecord>> records;  // each written below
+  resizeInHugePages(records, faces.size());
   parallelChunks(faces.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t i = begin; i < end; ++i) {
-      const Triangle& t = corners[i] = T[faces[i]];
-      points[i] = {P[t[0]], P[t[1]], P[t[2]]};
-      planes[i] = PlaneFilter(points[i][0], points[i][1], points[i][2]);
-      flat[i] = degenerate[faces[i]];
+      FaceRecord& r = records[i];
+      const Triangle& t = r.corners = T[faces[i]];
+      r.points = {P[t[0]], P[t[1]], P[t[2]]};
+      r.plane = PlaneFilter(r.points[0], r.points[1], r.points[2]);
+      r.flat = degenerate[faces[i]];
     }
   });
   std::vector<std::vector<std::array<std::uint32_t, 2>>> hits(workerCount());
   search.forEachPair([&](std::uint32_t a, std::uint32_t b, unsigned worker) {
-    if (!flat[a] && !flat[b] &&
-        meetBeyondAxes(corners[a], points[a], planes[a], corners[b], points[b], planes[b], 0,
+    const FaceRecord &ra = records[a], &rb = records[b];
+    if (!ra.flat && !rb.flat &&
+        meetBeyondAxes(ra.corners, ra.points, ra.plane, rb.corners, rb.points, rb.plane, 0,
                        sameVertices))
       hits[worker].push_back({faces[a], faces[b]});
   });

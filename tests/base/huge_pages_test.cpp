@@ -108,3 +108,23 @@ TEST(HugePages, LargeArraysAreInHugePagesWhereTheKernelGivesThem) {
     EXPECT_LE(kb, 0) << "huge pages without the kernel offering them";
   }
 }
+
+// Default-initialized elements: records with a constructor get it, and
+// constructor arguments reach it, as with std::allocator.
+TEST(HugePages, DefaultInitAllocatorConstructsAsAsked) {
+  struct Record {
+    int set = 7;
+    int given;
+    Record() : given(-1) {}
+    explicit Record(int g) : given(g) {}
+  };
+  std::vector<Record, DefaultInitAllocator<Record>> records;
+  resizeInHugePages(records, std::size_t(1) << 20);
+  ASSERT_EQ(records.size(), std::size_t(1) << 20);
+  EXPECT_EQ(records[777].set, 7);
+  EXPECT_EQ(records.back().given, -1);
+  records.emplace_back(5);
+  EXPECT_EQ(records.back().given, 5);
+  std::vector<int, DefaultInitAllocator<int>> copy(3, 4);  // a value given is still copied
+  EXPECT_EQ(copy[2], 4);
+}
