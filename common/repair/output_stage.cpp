@@ -247,32 +247,38 @@ struct Rows {
   }
 };
 
-// Step 1 on arrays: `reference` (the unrounded positions: input vertices
-// exactly, curve points within their error), `newFace` and `movable`
-// (vertices that may be re-rounded: the new ones) given; `P` receives the
-// stored positions. Returns the crossing pairs left.
+// Step 1 on arrays: `P` (the unrounded positions: input vertices exactly,
+// curve points within their error; the stored ones on return), `newFace`
+// and `movable` (vertices that may be re-rounded: the new ones) given.
+// Rounds in place: the unrounded position is kept only for the vertices
+// that may leave it (a copy of every position was a tenth of the stage).
+// Returns the crossing pairs left.
 class Rounder {
  public:
-  Rounder(const std::vector<Point3>& reference, const std::vector<Triangle>& T,
-          const std::vector<char>& newFace, const std::vector<char>& movable, Scalar scalar,
-          std::vector<Point3>& P)
-      : ref_(reference), T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
+  Rounder(std::vector<Point3>& P, const std::vector<Triangle>& T, const std::vector<char>& newFace,
+          const std::vector<char>& movable, Scalar scalar)
+      : T_(T), newFace_(newFace), movable_(movable), scalar_(scalar), P_(P) {
     double largest = 0;
-    for (const Point3& p : reference)
+    for (const Point3& p : P)
       largest = std::max({largest, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
     floor_ = std::ldexp(largest, -int(kMaxCoordinateBinades));
-    resizeInHugePages(P_, reference.size());
-    moved_.resize(reference.size());
-    parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    resizeInHugePages(moved_, P.size());
+    std::vector<std::vector<std::pair<int, Point3>>> kept(workerCount());
+    parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
       for (std::size_t v = begin; v < end; ++v) {
-        const Point3& r = reference[v];
+        const Point3 r = P_[v];
         Point3 p = storedAs(r, scalar);
-        if (v < movable_.size() && movable_[v])
+        const bool isMovable = movable_.size() > v && movable_[v];
+        if (isMovable)
           for (int k = 0; k < 3; ++k) p[k] = withinSpan(p[k]);
-        P_[v] = p;
         moved_[v] = char((p[0] != r[0]) | (p[1] != r[1]) | (p[2] != r[2]));
+        if (moved_[v] || isMovable) kept[worker].emplace_back(int(v), r);
+        P_[v] = p;
       }
     });
+    reference_ = joined(kept);
+    std::sort(reference_.begin(), reference_.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
   }
 
   // Whether vertex v may be stored off its reference position: only those
@@ -449,7 +455,7 @@ class Rounder {
   bool collapsed(std::uint32_t f) const {
     const Triangle& t = T_[f];
     return isFlat(f) &&
-           ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]]));
+           ((f < newFace_.size() && newFace_[f]) || !collinear(ref(t[0]), ref(t[1]), ref(t[2])));
   }
   // The same from the degeneracy kept per face (degenerate_).
   std::vector<std::uint32_t> collapsedFaces() const {
@@ -457,7 +463,7 @@ class Rounder {
     for (std::uint32_t f : changed_) {
       const Triangle& t = T_[f];
       if (degenerate_[f] &&
-          ((f < newFace_.size() && newFace_[f]) || !collinear(ref_[t[0]], ref_[t[1]], ref_[t[2]])))
+          ((f < newFace_.size() && newFace_[f]) || !collinear(ref(t[0]), ref(t[1]), ref(t[2]))))
         flat.push_back(f);
     }
     return flat;
@@ -487,7 +493,7 @@ class Rounder {
     moved_[std::size_t(v)] = 1;
     std::array<std::vector<double>, 3> choices;
     for (int k = 0; k < 3; ++k) {
-      choices[k] = roundingChoices(ref_[v][k], reach, scalar_);
+      choices[k] = roundingChoices(ref(v)[k], reach, scalar_);
       for (double& c : choices[k]) c = withinSpan(c);
     }
     std::vector<std::array<std::uint8_t, 3>> order;
@@ -517,12 +523,20 @@ class Rounder {
   // mesh must stay within the span that exact operations take (mesh.h).
   double withinSpan(double x) const { return std::fabs(x) < floor_ ? 0.0 : x; }
 
-  const std::vector<Point3>& ref_;
+  // Vertex v's unrounded position: kept where rounding or re-rounding may
+  // have moved it, else where it is stored.
+  Point3 ref(int v) const {
+    const auto at = std::lower_bound(reference_.begin(), reference_.end(), v,
+                                     [](const auto& kept, int u) { return kept.first < u; });
+    return at != reference_.end() && at->first == v ? at->second : P_[std::size_t(v)];
+  }
+
   const std::vector<Triangle>& T_;
   const std::vector<char>& newFace_;
   const std::vector<char>& movable_;
   const Scalar scalar_;
   std::vector<Point3>& P_;
+  std::vector<std::pair<int, Point3>> reference_;  // ascending: see ref()
   std::vector<char> moved_;  // rounded off the reference position, or re-rounded
   std::vector<char> isChanged_, degenerate_;
   std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
@@ -547,18 +561,17 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
   requireMergedOutput(r, "rounding for the host");
   Mesh& merged = r.merged;
   if (merged.fn == 0) return 0;
-  const std::vector<Point3> reference = positionsOf(merged);
+  std::vector<Point3> P = positionsOf(merged);
   const std::vector<Triangle> T = trianglesOf(merged);
   VertexOriginHandle vo = vertexOrigins(merged);
-  std::vector<char> movable(reference.size(), 0);  // new vertices: inputs stay as they are
-  parallelChunks(reference.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+  std::vector<char> movable(P.size(), 0);  // new vertices: inputs stay as they are
+  parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t v = begin; v < end; ++v) movable[v] = vo[v].vertex < 0;
   });
-  std::vector<Point3> P;
   std::size_t moved = 0;
   bool bounded = false;
   const std::size_t used = out ? out->rounding_tests : 0;
-  Rounder rounder(reference, T, r.merged_new_face, movable, stage.scalar, P);
+  Rounder rounder(P, T, r.merged_new_face, movable, stage.scalar);
   const std::size_t remaining = rounder.run(
       stage.rounding_passes, stage.max_rounding_tests > used ? stage.max_rounding_tests - used : 0,
       giveUpAbove, stage.progress, moved, bounded);
@@ -586,8 +599,7 @@ StoredOutput storeNewPoints(std::vector<Point3>& points, const std::vector<Trian
   const auto start = Clock::now();
   StoredOutput out;
   out.scalar = stage.scalar;
-  const std::vector<Point3> reference = points;
-  Rounder rounder(reference, triangles, changed, movable, stage.scalar, points);
+  Rounder rounder(points, triangles, changed, movable, stage.scalar);
   out.crossing = rounder.run(stage.rounding_passes, stage.max_rounding_tests, kNoLimit,
                              stage.progress, out.vertices_rerounded, out.bounded);
   out.rounding_tests = rounder.tests();
