@@ -125,7 +125,11 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCe
           }
         }
   }
-  // Each occupied cell c - d (d in {0, 1}^3) sets the bits m that contain d.
+  // Each occupied cell c sets, in the block of c - d (d in {0, 1}^3), the
+  // bits m that contain d.
+  std::uint8_t containing[8] = {};
+  for (int d = 0; d < 8; ++d)
+    for (int m = 0; m < 8; ++m) containing[d] |= std::uint8_t(((m & d) == d) << m);
   blocks_.assign(cellBox_.size(), 0);
   for (int x = 0; x < kCells; ++x)
     for (int y = 0; y < kCells; ++y)
@@ -133,10 +137,7 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCe
         if (!occupied(x, y, z)) continue;
         for (int d = 0; d < 8; ++d) {
           const int bx = x - (d & 1), by = y - (d >> 1 & 1), bz = z - (d >> 2 & 1);
-          if (bx < 0 || by < 0 || bz < 0) continue;
-          std::uint8_t containing = 0;
-          for (int m = 0; m < 8; ++m) containing |= std::uint8_t(((m & d) == d) << m);
-          blocks_[index(bx, by, bz)] |= containing;
+          if (bx >= 0 && by >= 0 && bz >= 0) blocks_[index(bx, by, bz)] |= containing[d];
         }
       }
 }

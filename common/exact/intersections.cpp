@@ -641,10 +641,10 @@ std::vector<std::array<std::uint32_t, 2>> intersectingOf(const std::vector<Point
                                                          const ChangedFaceSearch& search,
                                                          const std::vector<char>& degenerate,
                                                          bool sameVertices) {
-  // What the tests read of each face, side by side in the search's order
-  // and in one record (each face is in some ten pairs, its corners' points
-  // lie anywhere in P, and a pair's two records are two misses, not six).
-  // The plane filters too: each made once, not once or twice per pair.
+  // What the tests read of each face, in one record, side by side in the
+  // search's order (each face is in some ten pairs, and its corners' points
+  // lie anywhere in P). The plane filters too: each made once, not once or
+  // twice per pair.
   struct FaceRecord {
     TrianglePoints points;
     PlaneFilter plane;

@@ -251,7 +251,7 @@ struct Rows {
 // curve points within their error; the stored ones on return), `newFace`
 // and `movable` (vertices that may be re-rounded: the new ones) given.
 // Rounds in place: the unrounded position is kept only for the vertices
-// that may leave it (a copy of every position was a tenth of the stage).
+// that may leave it (one array of every position less).
 // Returns the crossing pairs left.
 class Rounder {
  public:
