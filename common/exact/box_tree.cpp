@@ -356,7 +356,7 @@ void BoxTree::buildParallel(bool splitByMedian) {
     else
       buildInOrder(b, e, out);
   };
-  // Leaves hold two to four boxes, so a tree over m boxes has fewer than m
+  // Leaves hold four to eight boxes, so a tree over m boxes has fewer than m
   // nodes: each part's room is made once.
   if (n < 20000) {
     reserveInHugePages(nodes_, n);

@@ -212,7 +212,11 @@ class BoxTree {
     std::uint32_t b;  // internal: right child; leaf: count | kLeaf
   };
   static constexpr std::uint32_t kLeaf = 0x80000000u;
-  static constexpr std::uint32_t kLeafSize = 4;
+  // At most this many boxes per leaf. Eight: on bunny + dragon the split
+  // did 2.4 % fewer instructions than with four (its searches descend less
+  // deep; the leaves' extra box tests cost less), with six 1 % fewer and
+  // with twelve as many, while the output stage's search did more.
+  static constexpr std::uint32_t kLeafSize = 8;
 
   bool leaf(const Node& n) const { return n.b & kLeaf; }
   std::uint32_t count(const Node& n) const { return n.b & ~kLeaf; }
