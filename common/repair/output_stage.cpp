@@ -59,6 +59,8 @@ void separateFromMerged(SplitResult& r);
 std::size_t mendCollinearNewFaces(SplitResult& r) {
   requireMergedOutput(r, "mending collinear faces");
   Mesh& m = r.merged;
+  r.merged_points.clear();  // they no longer describe `merged`
+  r.merged_triangles.clear();
   FaceOriginHandle origin = faceOrigins(m);
   std::vector<Triangle> T = trianglesOf(m);
   auto isFlat = [&](std::size_t f) {
@@ -250,6 +252,8 @@ struct Rows {
 // Step 1 on arrays: `P` (the unrounded positions: input vertices exactly,
 // curve points within their error; the stored ones on return), `newFace`
 // and `movable` (vertices that may be re-rounded: the new ones) given.
+// Every face with a movable corner is a new face (the split's new vertices
+// lie only on faces it made; storeNewPoints' callers mark them so).
 // Rounds in place: the unrounded position is kept only for the vertices
 // that may leave it (one array of every position less).
 // Returns the crossing pairs left.
@@ -264,18 +268,28 @@ class Rounder {
     floor_ = std::ldexp(largest, -int(kMaxCoordinateBinades));
     resizeInHugePages(moved_, P.size());
     std::vector<std::vector<std::pair<int, Point3>>> kept(workerCount());
+    std::vector<std::size_t> movedCount(workerCount(), 0);
     parallelChunks(P_.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
       for (std::size_t v = begin; v < end; ++v) {
+        const bool isMovable = v < movable_.size() && movable_[v];
+        moved_[v] = 0;
+        if (scalar == Scalar::kDouble && !isMovable) continue;  // stored as it is
         const Point3 r = P_[v];
-        Point3 p = storedAs(r, scalar);
-        const bool isMovable = movable_.size() > v && movable_[v];
-        if (isMovable)
-          for (int k = 0; k < 3; ++k) p[k] = withinSpan(p[k]);
+        const Point3 p = storedAs(r, scalar);
         moved_[v] = char((p[0] != r[0]) | (p[1] != r[1]) | (p[2] != r[2]));
-        if (moved_[v] || isMovable) kept[worker].emplace_back(int(v), r);
-        P_[v] = p;
+        if (isMovable) {
+          const Point3 q(withinSpan(p[0]), withinSpan(p[1]), withinSpan(p[2]));
+          moved_[v] = char((q[0] != r[0]) | (q[1] != r[1]) | (q[2] != r[2]));
+          kept[worker].emplace_back(int(v), r);
+          P_[v] = q;
+        } else if (moved_[v]) {  // (most are stored as they are: nothing to write)
+          ++movedCount[worker];
+          kept[worker].emplace_back(int(v), r);
+          P_[v] = p;
+        }
       }
     });
+    fixedMoved_ = std::accumulate(movedCount.begin(), movedCount.end(), std::size_t(0)) > 0;
     reference_ = joined(kept);
     std::sort(reference_.begin(), reference_.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -350,6 +364,11 @@ class Rounder {
   // cross anything they did not cross before (every other face is an input
   // face, exactly as it was).
   void markChanged() {
+    if (!fixedMoved_) {  // the new faces hold every movable vertex
+      isChanged_.assign(T_.size(), 0);
+      std::copy_n(newFace_.begin(), std::min(newFace_.size(), T_.size()), isChanged_.begin());
+      return;
+    }
     isChanged_.resize(T_.size());
     parallelChunks(T_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
@@ -538,6 +557,7 @@ class Rounder {
   std::vector<Point3>& P_;
   std::vector<std::pair<int, Point3>> reference_;  // ascending: see ref()
   std::vector<char> moved_;  // rounded off the reference position, or re-rounded
+  bool fixedMoved_ = false;  // a vertex that is not movable moved (rounded to a float host)
   std::vector<char> isChanged_, degenerate_;
   std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
   std::vector<char> hasRow_;
@@ -554,6 +574,15 @@ class Rounder {
   std::size_t tests() const { return tests_; }
 };
 
+// The split's arrays of the merged output (`kept`, emptied) when they
+// hold its `count` elements, else made from it.
+template <class T, class Make>
+std::vector<T> takeOr(std::vector<T>& kept, std::size_t count, Make make, const Mesh& merged) {
+  std::vector<T> taken = std::move(kept);
+  kept.clear();
+  return taken.size() == count ? taken : make(merged);
+}
+
 }  // namespace
 
 std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, StoredOutput* out,
@@ -561,8 +590,9 @@ std::size_t roundForHost(SplitResult& r, const OutputStageOptions& stage, Stored
   requireMergedOutput(r, "rounding for the host");
   Mesh& merged = r.merged;
   if (merged.fn == 0) return 0;
-  std::vector<Point3> P = positionsOf(merged);
-  const std::vector<Triangle> T = trianglesOf(merged);
+  std::vector<Point3> P = takeOr(r.merged_points, merged.vert.size(), positionsOf, merged);
+  const std::vector<Triangle> T =
+      takeOr(r.merged_triangles, merged.face.size(), trianglesOf, merged);
   VertexOriginHandle vo = vertexOrigins(merged);
   std::vector<char> movable(P.size(), 0);  // new vertices: inputs stay as they are
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {

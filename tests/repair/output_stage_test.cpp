@@ -92,6 +92,39 @@ TEST(OutputStage, FloatResultHoldsFloatsAndCrossesNothing) {
   EXPECT_EQ(check(r.merged, Scalar::kFloat).degenerate_faces, 0u);
 }
 
+TEST(OutputStage, TakesTheSplitsArraysAndRepairsTheSameWithoutThem) {
+  // The tubes as a float host holds them: only the new vertices move when
+  // stored in float.
+  Tubes t;
+  for (Mesh* m : {&t.a, &t.b})
+    for (Vertex& v : m->vert) v.P() = storedAs(v.cP(), Scalar::kFloat);
+  SplitOptions o;
+  o.self = true;
+  SplitResult given = splitAlongIntersections(t.inputs(), o);
+  EXPECT_EQ(given.merged_points, positionsOf(given.merged));
+  EXPECT_EQ(given.merged_triangles, trianglesOf(given.merged));
+  SplitResult copied = given;
+  copied.merged_points.clear();
+  copied.merged_triangles.clear();
+  const StoredOutput sa = storeForHost(given, t.inputs(), o, host(Scalar::kFloat));
+  const StoredOutput sb = storeForHost(copied, t.inputs(), o, host(Scalar::kFloat));
+  EXPECT_TRUE(given.merged_points.empty());
+  EXPECT_EQ(sa.crossing, 0u);
+  EXPECT_EQ(sa.degenerate_new_faces, 0u);
+  EXPECT_EQ(sa.crossing, sb.crossing);
+  EXPECT_EQ(sa.vertices_rerounded, sb.vertices_rerounded);
+  EXPECT_EQ(positionsOf(given.merged), positionsOf(copied.merged));
+  EXPECT_EQ(trianglesOf(given.merged), trianglesOf(copied.merged));
+  EXPECT_EQ(storedIntersectingPairs(given.merged, Scalar::kFloat), 0u);
+  // Arrays that no longer match `merged` are not used.
+  SplitResult stale = splitAlongIntersections(t.inputs(), o);
+  stale.merged_points.pop_back();
+  stale.merged_triangles.pop_back();
+  const StoredOutput s = storeForHost(stale, t.inputs(), o, host(Scalar::kDouble));
+  EXPECT_EQ(s.crossing, 0u);
+  EXPECT_EQ(storedIntersectingPairs(stale.merged, Scalar::kDouble), 0u);
+}
+
 TEST(OutputStage, TheCheckersCountIncludesFacesWithTheSameThreeVertices) {
   // A box and its copy moved by half its width keep, each, their faces where
   // they overlap in a plane (overlaps_once off): no crossing for the stage,

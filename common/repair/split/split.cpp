@@ -520,9 +520,12 @@ void mergeAndSnap(const CurveWelding& w, SplitMeshes& split,
     snapCurves(merged, curves, split.outputs, options, r);
     r.new_faces_below_1deg = newSlivers(merged, r.merged_new_face);
   }
-  if (options.merged_output) merged.toMesh(r.merged);
   r.curve_edges_welded = curves.size();
   countCurves(merged.positions.size(), curves, r.curve_loops, r.open_curves);
+  if (!options.merged_output) return;
+  merged.toMesh(r.merged);
+  r.merged_points = std::move(merged.positions);
+  r.merged_triangles = std::move(merged.triangles);
 }
 
 }  // namespace

@@ -93,6 +93,11 @@ struct SplitResult {
   // Per face of `merged` (empty without snapping): 1 when quality snapping
   // reshaped or made it, so that it may lie off its birth face's plane.
   std::vector<char> merged_snapped_face;
+  // `merged` as arrays, as the split made it: the output stage takes them
+  // (and leaves them empty) instead of copying `merged` into arrays again.
+  // Code that changes `merged` before the stage empties them.
+  std::vector<Point3> merged_points;
+  std::vector<Triangle> merged_triangles;
   // Every intersecting pair of the inputs was searched for (and split): each
   // mesh's own and those between meshes. Faces left as they were then cross
   // nothing, so the intersections left are among pairs with a new face.
