@@ -7,6 +7,9 @@
 // the exact rational value, so that later steps can keep deciding exactly.
 #pragma once
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -79,12 +82,25 @@ constexpr std::array<Entry, 512> table() {
 inline constexpr std::array<Entry, 512> kTable = table();
 }  // namespace shared_corners_detail
 inline SharedCorners sharedCorners(const Triangle& a, const Triangle& b) {
+  // Bit 3i + k of m: a's corner i is b's corner k.
+#if defined(__SSE2__)
+  // Each corner of a against b's three at once (a third of the
+  // instructions of nine scalar comparisons; every candidate pair asks).
+  const __m128i corners = _mm_setr_epi32(b[0], b[1], b[2], b[2]);
+  auto row = [&](int v) {
+    return unsigned(
+               _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(corners, _mm_set1_epi32(v))))) &
+           7u;
+  };
+  const unsigned m = row(a[0]) | row(a[1]) << 3 | row(a[2]) << 6;
+#else
   // The nine comparisons written out: as a loop they took twice the
   // instructions.
   const int a0 = a[0], a1 = a[1], a2 = a[2], b0 = b[0], b1 = b[1], b2 = b[2];
   const unsigned m = unsigned(a0 == b0) | unsigned(a0 == b1) << 1 | unsigned(a0 == b2) << 2 |
                      unsigned(a1 == b0) << 3 | unsigned(a1 == b1) << 4 | unsigned(a1 == b2) << 5 |
                      unsigned(a2 == b0) << 6 | unsigned(a2 == b1) << 7 | unsigned(a2 == b2) << 8;
+#endif
   const shared_corners_detail::Entry e = shared_corners_detail::kTable[m];
   return {e.count, e.ia, e.ib};
 }
