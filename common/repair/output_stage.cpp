@@ -241,14 +241,6 @@ std::vector<double> roundingChoices(double x, int reach, Scalar scalar) {
   return out;
 }
 
-// Items per index, in compressed rows (the changed faces around each vertex).
-struct Rows {
-  std::vector<std::uint32_t> offsets, items;
-  std::pair<const std::uint32_t*, const std::uint32_t*> row(std::size_t i) const {
-    return {items.data() + offsets[i], items.data() + offsets[i + 1]};
-  }
-};
-
 // Step 1 on arrays: `P` (the unrounded positions: input vertices exactly,
 // curve points within their error; the stored ones on return), `newFace`
 // and `movable` (vertices that may be re-rounded: the new ones) given.
@@ -318,7 +310,8 @@ class Rounder {
     budget_ = budget;
     if (crossing_.size() > giveUpAbove) return crossing_.size();
     if (crossing_.empty() && collapsedFaces().empty()) return 0;
-    buildAround();                          // only re-rounding needs it
+    rows_.assign(changed_.size(), {});  // only re-rounding needs these
+    hasRow_.assign(changed_.size(), 0);
     std::vector<char> moved(P_.size(), 0);  // re-rounded in the last pass
     // Each coordinate goes to one of the `reach` values below its unrounded
     // value or the `reach` above. One each way first (the two nearest);
@@ -347,6 +340,7 @@ class Rounder {
       for (const auto& p : crossing_)
         for (std::uint32_t f : p) addCorners(f);
       for (std::uint32_t f : flat) addCorners(f);
+      gatherAround(candidates);
       addRows(candidates);
       for (int v : candidates) {
         if (tests_ >= budget_) break;  // the bound holds within a pass too
@@ -395,21 +389,25 @@ class Rounder {
     });
   }
 
-  // Per vertex, the changed faces around it (compressed rows).
-  void buildAround() {
-    changedIndex_.assign(T_.size(), -1);
-    for (std::size_t i = 0; i < changed_.size(); ++i) changedIndex_[changed_[i]] = int(i);
-    rows_.assign(changed_.size(), {});
-    hasRow_.assign(changed_.size(), 0);
-    around_.offsets.assign(P_.size() + 1, 0);
-    for (std::uint32_t f : changed_)
-      for (int v : T_[f]) ++around_.offsets[v + 1];
-    for (std::size_t v = 0; v < P_.size(); ++v) around_.offsets[v + 1] += around_.offsets[v];
-    around_.items.resize(around_.offsets.back());
-    std::vector<std::uint32_t> next(around_.offsets.begin(), around_.offsets.end() - 1);
-    for (std::uint32_t f : changed_)
-      for (int v : T_[f]) around_.items[next[v]++] = f;
+  // The changed faces around each of `vertices` that has none yet, as
+  // positions in changed_: one pass over the changed faces per pass of
+  // re-rounding, which asks for a few vertices (the rows of every vertex
+  // cost more than the rest of it).
+  void gatherAround(const std::set<int>& vertices) {
+    if (wanted_.empty()) wanted_.assign(P_.size(), 0);
+    bool any = false;
+    for (int v : vertices)
+      if (around_.emplace(v, std::vector<std::uint32_t>()).second) {
+        wanted_[std::size_t(v)] = 1;
+        any = true;
+      }
+    if (!any) return;
+    for (std::size_t i = 0; i < changed_.size(); ++i)
+      for (int v : T_[changed_[i]])
+        if (wanted_[std::size_t(v)]) around_[v].push_back(std::uint32_t(i));
+    for (int v : vertices) wanted_[std::size_t(v)] = 0;
   }
+  const std::vector<std::uint32_t>& around(int v) const { return around_.at(v); }
 
   // The candidates of each changed face around `vertices` that has none
   // yet (re-rounding touches a few vertices: all faces' rows at once cost
@@ -417,12 +415,13 @@ class Rounder {
   // overlap kept in each part) coincide however their vertices are
   // rounded: never a crossing, never a candidate.
   void addRows(const std::set<int>& vertices) {
-    std::vector<std::uint32_t> faces;
+    std::vector<std::uint32_t> faces, at;  // faces without rows, and their positions
     for (int v : vertices)
-      for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f)
-        if (!hasRow_[std::size_t(changedIndex_[*f])]) {
-          hasRow_[std::size_t(changedIndex_[*f])] = 1;
-          faces.push_back(*f);
+      for (std::uint32_t i : around(v))
+        if (!hasRow_[i]) {
+          hasRow_[i] = 1;
+          faces.push_back(changed_[i]);
+          at.push_back(i);
         }
     if (faces.empty()) return;
     std::vector<std::vector<std::uint32_t>> found = search_->candidatesOf(faces);
@@ -431,7 +430,7 @@ class Rounder {
       row.erase(std::remove_if(row.begin(), row.end(),
                                [&](std::uint32_t g) { return sameVertices(T_[faces[i]], T_[g]); }),
                 row.end());
-      rows_[std::size_t(changedIndex_[faces[i]])] = std::move(row);
+      rows_[at[i]] = std::move(row);
     }
   }
 
@@ -449,19 +448,21 @@ class Rounder {
     // Pairs with a moved corner: a changed face's around a vertex the last
     // pass moved (their rows are there: it asked for them), each once.
     std::vector<std::array<std::uint32_t, 2>> again, still;
-    for (std::uint32_t f : changed_)
+    for (std::size_t i = 0; i < changed_.size(); ++i) {
+      const std::uint32_t f = changed_[i];
       if (touches(f))
-        for (std::uint32_t g : rows_[std::size_t(changedIndex_[f])])
+        for (std::uint32_t g : rows_[i])
           again.push_back(isChanged_[g]
                               ? std::array<std::uint32_t, 2>{std::min(f, g), std::max(f, g)}
                               : std::array<std::uint32_t, 2>{f, g});
+    }
     std::sort(again.begin(), again.end());
     again.erase(std::unique(again.begin(), again.end()), again.end());
     for (const auto& p : crossing_)
       if (!touches(p[0]) && !touches(p[1])) still.push_back(p);
-    for (std::size_t v = 0; v < moved.size(); ++v)
-      if (moved[v])
-        for (auto [f, end] = around_.row(v); f != end; ++f) degenerate_[*f] = isFlat(*f);
+    for (const auto& [v, faces] : around_)  // every vertex a pass moved was asked for
+      if (moved[std::size_t(v)])
+        for (std::uint32_t i : faces) degenerate_[changed_[i]] = isFlat(changed_[i]);
     crossing_ = intersectingOf(P_, T_, again, degenerate_, false);
     crossing_.insert(crossing_.end(), still.begin(), still.end());
     std::fill(moved.begin(), moved.end(), 0);
@@ -493,11 +494,12 @@ class Rounder {
   // knowing while it beats the best).
   std::size_t localCrossings(int v, std::size_t enough) {
     std::size_t n = 0;
-    for (auto [f, end] = around_.row(std::size_t(v)); f != end; ++f) {
-      if ((n += 2 * collapsed(*f)) >= enough) return n;
-      for (std::uint32_t g : rows_[std::size_t(changedIndex_[*f])]) {
+    for (std::uint32_t i : around(v)) {
+      const std::uint32_t f = changed_[i];
+      if ((n += 2 * collapsed(f)) >= enough) return n;
+      for (std::uint32_t g : rows_[i]) {
         ++tests_;
-        if ((n += facesIntersect(P_, T_, *f, g)) >= enough) return n;
+        if ((n += facesIntersect(P_, T_, f, g)) >= enough) return n;
       }
     }
     return n;
@@ -561,12 +563,14 @@ class Rounder {
   std::vector<char> isChanged_, degenerate_;
   std::vector<std::vector<std::uint32_t>> rows_;  // per changed face: its candidates (addRows)
   std::vector<char> hasRow_;
-  std::vector<int> changedIndex_;
   std::vector<std::uint32_t> changed_;         // the changed faces, ascending (findCandidates)
   std::unique_ptr<ChangedFaceSearch> search_;  // candidate pairs (findCandidates)
   std::vector<std::array<std::uint32_t, 2>> crossing_;
   std::unordered_map<int, Point3> nearest_;  // re-rounded vertices' nearest rounding
-  Rows around_;
+  // Per vertex asked for: the changed faces around it, as positions in
+  // changed_ (gatherAround); wanted_ marks those a pass gathers.
+  std::unordered_map<int, std::vector<std::uint32_t>> around_;
+  std::vector<char> wanted_;
   std::size_t tests_ = 0, budget_ = 0;  // exact pair tests made, and the most allowed
   double floor_ = 0;
 

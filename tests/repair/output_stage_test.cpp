@@ -113,6 +113,7 @@ TEST(OutputStage, TakesTheSplitsArraysAndRepairsTheSameWithoutThem) {
   EXPECT_EQ(sa.degenerate_new_faces, 0u);
   EXPECT_EQ(sa.crossing, sb.crossing);
   EXPECT_EQ(sa.vertices_rerounded, sb.vertices_rerounded);
+  EXPECT_GT(sa.vertices_rerounded, 0u);  // rounding to nearest left crossings here
   EXPECT_EQ(positionsOf(given.merged), positionsOf(copied.merged));
   EXPECT_EQ(trianglesOf(given.merged), trianglesOf(copied.merged));
   EXPECT_EQ(storedIntersectingPairs(given.merged, Scalar::kFloat), 0u);
