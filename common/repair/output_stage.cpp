@@ -391,8 +391,8 @@ class Rounder {
 
   // The changed faces around each of `vertices` that has none yet, as
   // positions in changed_: one pass over the changed faces per pass of
-  // re-rounding, which asks for a few vertices (the rows of every vertex
-  // cost more than the rest of it).
+  // re-rounding, which asks for a few vertices (rows for every vertex of a
+  // large mesh cost about as much as the re-rounding they served).
   void gatherAround(const std::set<int>& vertices) {
     if (wanted_.empty()) wanted_.assign(P_.size(), 0);
     bool any = false;
