@@ -267,18 +267,13 @@ class Rounder {
         moved_[v] = 0;
         if (scalar == Scalar::kDouble && !isMovable) continue;  // stored as it is
         const Point3 r = P_[v];
-        const Point3 p = storedAs(r, scalar);
+        Point3 p = storedAs(r, scalar);
+        if (isMovable) p = Point3(withinSpan(p[0]), withinSpan(p[1]), withinSpan(p[2]));
         moved_[v] = char((p[0] != r[0]) | (p[1] != r[1]) | (p[2] != r[2]));
-        if (isMovable) {
-          const Point3 q(withinSpan(p[0]), withinSpan(p[1]), withinSpan(p[2]));
-          moved_[v] = char((q[0] != r[0]) | (q[1] != r[1]) | (q[2] != r[2]));
-          kept[worker].emplace_back(int(v), r);
-          P_[v] = q;
-        } else if (moved_[v]) {  // (most are stored as they are: nothing to write)
-          ++movedCount[worker];
-          kept[worker].emplace_back(int(v), r);
-          P_[v] = p;
-        }
+        if (!moved_[v] && !isMovable) continue;  // (most: stored as they are, nothing to write)
+        movedCount[worker] += std::size_t(!isMovable);
+        kept[worker].emplace_back(int(v), r);
+        P_[v] = p;
       }
     });
     fixedMoved_ = std::accumulate(movedCount.begin(), movedCount.end(), std::size_t(0)) > 0;
