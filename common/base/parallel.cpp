@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <deque>
 #include <mutex>
-#include <system_error>
 #include <thread>
 
 namespace meshmend {
@@ -51,11 +50,14 @@ class HelperPool {
     // poster takes; a task alongside has one chunk, for a helper).
     const std::size_t need = job.count - (job.count > 1);
     while (idle_ < need && helpers_ < workerCount() - 1) {
-      try {
-        std::thread(&HelperPool::serve, this).detach();
-      } catch (const std::system_error&) {
+      // A detached POSIX thread, not a std::thread: a std::thread's state is
+      // freed by the helper after its last signal, so a process could exit
+      // (release() returned) with it still allocated, which LeakSanitizer
+      // reported now and then as a leak.
+      pthread_t helper;
+      if (pthread_create(&helper, nullptr, &HelperPool::start, this) != 0)
         break;  // no thread to spare (the process is at its limit): the chunks run here
-      }
+      pthread_detach(helper);
       ++helpers_;
       ++idle_;  // counted as waiting until it takes a chunk
     }
@@ -106,6 +108,11 @@ class HelperPool {
   struct Release {
     ~Release() { current()->release(); }
   };
+
+  static void* start(void* pool) {
+    static_cast<HelperPool*>(pool)->serve();
+    return nullptr;
+  }
 
   static HelperPool*& current() {
     static HelperPool* pool = nullptr;
