@@ -62,13 +62,6 @@ float stepped(float x, std::int64_t steps) {
   return y;
 }
 
-void grow(Box& b, const Box& x) {
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = std::min(b.lo[k], x.lo[k]);
-    b.hi[k] = std::max(b.hi[k], x.hi[k]);
-  }
-}
-
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 }  // namespace
@@ -456,6 +449,32 @@ void BoxTree::sortByMorton() {
 }
 
 // A balanced hierarchy over the current order: split every range at its middle.
+void BoxTree::groups(std::uint32_t most, std::vector<Leaf>& leaves,
+                     std::vector<Group>& groups) const {
+  leaves.clear();
+  groups.clear();
+  if (!nodes_.empty()) this->groups(0, most, leaves, groups);
+}
+
+std::uint32_t BoxTree::groups(std::uint32_t n, std::uint32_t most, std::vector<Leaf>& leaves,
+                              std::vector<Group>& groups) const {
+  const Node& node = nodes_[n];
+  if (leaf(node)) {
+    groups.push_back({node.box, std::uint32_t(leaves.size()), 1});
+    leaves.push_back({node.box, order_.data() + node.a, count(node)});
+    return count(node);
+  }
+  const std::size_t mark = groups.size();
+  const std::uint32_t firstLeaf = std::uint32_t(leaves.size());
+  const std::uint32_t size =
+      this->groups(node.a, most, leaves, groups) + this->groups(node.b, most, leaves, groups);
+  if (size <= most) {  // one group for both children's
+    groups.resize(mark);
+    groups.push_back({node.box, firstLeaf, std::uint32_t(leaves.size()) - firstLeaf});
+  }
+  return size;
+}
+
 void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const {
   const std::uint32_t self = std::uint32_t(out.size());
   out.push_back({});

@@ -37,6 +37,14 @@ inline Box hull(const Box& a, const Box& b, const Box& c) {
   return h;
 }
 
+// `b` grown to contain `x`.
+inline void grow(Box& b, const Box& x) {
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = std::min(b.lo[k], x.lo[k]);
+    b.hi[k] = std::max(b.hi[k], x.hi[k]);
+  }
+}
+
 // `b` grown by `steps` floats on each side (as many std::nextafter steps,
 // from the ordering of floats' bits: a loop of those was a tenth of a
 // search around changed faces). Infinite and NaN bounds stay as they are.
@@ -194,6 +202,7 @@ class BoxTree {
   explicit BoxTree(std::vector<Box> boxes, Layout layout = Layout::kMedianSplit);
 
   std::size_t size() const { return boxes_.size(); }
+  const std::vector<Box>& boxes() const { return boxes_; }  // as given
   const Box& bounds() const { return nodes_.empty() ? empty_ : nodes_[0].box; }
 
   // Calls visit(i, j, worker) once for every pair i < j of overlapping boxes,
@@ -204,6 +213,21 @@ class BoxTree {
   // Calls visit(i, worker) for every box of this tree that overlaps `query`.
   template <class Visit>
   void query(const Box& query, unsigned worker, Visit&& visit) const;
+
+  // The leaves, in the tree's order, in groups of at most `most` boxes near
+  // each other (whole subtrees, of at least one leaf each): a leaf's boxes
+  // are first[0..count), a group's leaves leaves[firstLeaf..+leafCount);
+  // each with its hull.
+  struct Leaf {
+    Box box;
+    const std::uint32_t* first;
+    std::uint32_t count;
+  };
+  struct Group {
+    Box box;
+    std::uint32_t firstLeaf, leafCount;
+  };
+  void groups(std::uint32_t most, std::vector<Leaf>& leaves, std::vector<Group>& groups) const;
 
  private:
   struct Node {
@@ -230,6 +254,10 @@ class BoxTree {
   void within(std::uint32_t n, unsigned worker, Visit& visit) const;
   template <class Visit>
   void between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& visit) const;
+  // Appends the leaves and groups of subtree n (groups()); returns its
+  // number of boxes.
+  std::uint32_t groups(std::uint32_t n, std::uint32_t most, std::vector<Leaf>& leaves,
+                       std::vector<Group>& groups) const;
   void tasks(std::uint32_t n, int depth,
              std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
   void pairTasks(std::uint32_t x, std::uint32_t y, int depth,

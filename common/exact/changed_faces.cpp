@@ -30,7 +30,8 @@ std::vector<std::uint32_t> marked(const std::vector<char>& changed) {
 
 ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
                                      const std::vector<Triangle>& triangles,
-                                     const std::vector<char>& changed, int widenSteps)
+                                     const std::vector<char>& changed, int widenSteps,
+                                     const NearFaceFinder& near)
     : faces_(marked(changed)), boxes_(faces_.size()) {
   parallelChunks(faces_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t i = begin; i < end; ++i) {
@@ -38,7 +39,7 @@ ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
       boxes_[i] = widened(boxOf(points[t[0]], points[t[1]], points[t[2]]), widenSteps);
     }
   });
-  search(points, triangles, changed);
+  search(points, triangles, changed, near);
 }
 
 ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
@@ -53,20 +54,22 @@ ChangedFaceSearch::ChangedFaceSearch(const std::vector<Point3>& points,
 // unchanged faces near them.
 void ChangedFaceSearch::search(const std::vector<Point3>& points,
                                const std::vector<Triangle>& triangles,
-                               const std::vector<char>& changed) {
+                               const std::vector<char>& changed, const NearFaceFinder& near) {
   changedCount_ = faces_.size();
   if (changedCount_ == 0) return;
   changedTree_ = std::make_unique<BoxTree>(boxes_);
-  findNearFaces(points, triangles, changed);
+  findNearFaces(points, triangles, changed, near);
 }
 
-// The unchanged faces whose boxes touch the grid cells of the changed
-// boxes, with their boxes: most of the rest of a large mesh is turned away
-// by its corners' cells.
+// The unchanged faces near the changed boxes, with their boxes: from `near`
+// or else those that touch the boxes' grid cells (most of the rest of a
+// large mesh is turned away by its corners' cells).
 void ChangedFaceSearch::findNearFaces(const std::vector<Point3>& P, const std::vector<Triangle>& T,
-                                      const std::vector<char>& changed) {
-  const std::vector<std::uint32_t> near = BoxGrid(boxes_).facesTouching(P, T, changed);
-  faces_.insert(faces_.end(), near.begin(), near.end());
+                                      const std::vector<char>& changed,
+                                      const NearFaceFinder& near) {
+  const std::vector<std::uint32_t> found =
+      near ? near(*changedTree_, changed) : BoxGrid(boxes_).facesTouching(P, T, changed);
+  faces_.insert(faces_.end(), found.begin(), found.end());
   boxes_.resize(faces_.size());
   parallelChunks(faces_.size() - changedCount_, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t k = changedCount_ + begin; k < changedCount_ + end; ++k) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -13,6 +14,12 @@
 #include "common/exact/box_tree.h"
 
 namespace meshmend {
+
+// The unchanged faces (not marked in `changed`) whose boxes overlap a box
+// of `boxes`, ascending, each once (a superset will do): for a caller who
+// knows where the faces lie, instead of a pass over all of them.
+using NearFaceFinder = std::function<std::vector<std::uint32_t>(const BoxTree& boxes,
+                                                                const std::vector<char>& changed)>;
 
 // The candidate pairs (box overlap) of faces of (points, triangles) with at
 // least one face `changed`, found once and then visited all at once in
@@ -29,8 +36,10 @@ class ChangedFaceSearch {
   // The changed faces' boxes are theirs widened by `widenSteps` float steps
   // on each side (room for moving a vertex by as many float steps, or by
   // more double steps).
+  // The unchanged faces near them from `near` when given.
   ChangedFaceSearch(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
-                    const std::vector<char>& changed, int widenSteps = 0);
+                    const std::vector<char>& changed, int widenSteps = 0,
+                    const NearFaceFinder& near = {});
   // The same with the caller's boxes for the changed faces (in face order),
   // e.g. covering every position their vertices may take.
   ChangedFaceSearch(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
@@ -58,9 +67,9 @@ class ChangedFaceSearch {
 
  private:
   void search(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
-              const std::vector<char>& changed);
+              const std::vector<char>& changed, const NearFaceFinder& near = {});
   void findNearFaces(const std::vector<Point3>& points, const std::vector<Triangle>& triangles,
-                     const std::vector<char>& changed);
+                     const std::vector<char>& changed, const NearFaceFinder& near);
 
   std::vector<std::uint32_t> faces_;
   std::size_t changedCount_ = 0;

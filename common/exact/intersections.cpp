@@ -250,17 +250,17 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
                   std::vector<WorkerFindings>& found, FindIntersectionsResult& r) {
   const std::size_t n = soups.size();
   const auto buildStart = Clock::now();
-  std::vector<BoxTree> trees;
+  std::vector<std::shared_ptr<const BoxTree>> trees;
   trees.reserve(n);
   for (std::size_t m = 0; m < n; ++m)
-    trees.emplace_back(std::move(soups[m].boxes), options.layout == 1
-                                                      ? BoxTree::Layout::kMorton
-                                                      : BoxTree::Layout::kMedianSplit);
+    trees.push_back(std::make_shared<const BoxTree>(
+        std::move(soups[m].boxes),
+        options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit));
   r.build_ms = msSince(buildStart);
   for (std::size_t m = 0; m < n; ++m) {
     reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
     const Soup& s = soups[m];
-    trees[m].selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
+    trees[m]->selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
       if (s.degenerate[f] || s.degenerate[g]) return;
       ++found[worker].candidates;
       if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
@@ -269,6 +269,7 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
             {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
     });
   }
+  if (options.keep_trees) r.face_trees = std::move(trees);
   return r.build_ms;
 }
 

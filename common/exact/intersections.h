@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,10 @@ struct FindIntersectionsOptions {
   // nothing in them and no rounding moves them apart: the split and its
   // checks of the float result leave them out.
   bool same_vertices = true;
-  int layout = 0;     // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
+  int layout = 0;  // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
+  // Hand each mesh's tree of its faces' boxes (built for `self`) to the
+  // result's face_trees, for later searches near a few faces.
+  bool keep_trees = false;
   Progress progress;  // called between stages
 };
 
@@ -57,6 +61,9 @@ struct FindIntersectionsResult {
   // of the mesh's; between meshes only, those within another mesh's bounds.
   std::vector<std::size_t> degenerate_faces;
   std::size_t candidate_pairs = 0;  // box pairs tested exactly
+  // Per mesh (with `self` and keep_trees): the tree of its faces' boxes,
+  // box i that of face i.
+  std::vector<std::shared_ptr<const BoxTree>> face_trees;
   double build_ms = 0, search_ms = 0, time_ms = 0;
 };
 

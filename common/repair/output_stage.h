@@ -115,6 +115,15 @@ std::size_t roundForHost(SplitResult& result, const OutputStageOptions& stage,
                          StoredOutput* out = nullptr,
                          std::size_t giveUpAbove = std::numeric_limits<std::size_t>::max());
 
+// The faces of `result.merged` the split left as they were (not
+// merged_new_face) whose boxes overlap given boxes (NearFaceFinder), from
+// the split's trees of the input faces, which it takes with
+// merged_face_origin (emptied): a few descents where the search around the
+// changed faces otherwise passes over the whole mesh. Empty where the trees
+// are missing (the split searched no self-intersections) or the origins do
+// not describe the `faces` faces stored (the merged output was changed).
+NearFaceFinder keptFacesNear(SplitResult& result, std::size_t faces);
+
 // Step 1 for any operation that computes new points in double (hole
 // patches, stitches, vertices moved for clearance): `points` rounded to
 // stage.scalar, and where that makes a face marked `changed` (new, or

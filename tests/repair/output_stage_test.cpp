@@ -126,6 +126,53 @@ TEST(OutputStage, TakesTheSplitsArraysAndRepairsTheSameWithoutThem) {
   EXPECT_EQ(storedIntersectingPairs(stale.merged, Scalar::kDouble), 0u);
 }
 
+TEST(OutputStage, FindsTheFacesNearTheNewOnesInTheSplitsTrees) {
+  // The first tube with every third face twice (removed before the split,
+  // so that the trees' faces are not numbered as the input's).
+  Tubes t;
+  std::vector<Triangle> twice;
+  for (const Triangle& f : trianglesOf(t.a)) {
+    twice.push_back(f);
+    if (twice.size() % 3 == 0) twice.push_back(f);
+  }
+  t.a = makeMesh(positionsOf(t.a), twice);
+  SplitOptions o;
+  o.self = true;
+  o.remove_duplicate_faces = true;
+  SplitResult r = splitAlongIntersections(t.inputs(), o);
+  ASSERT_GT(r.duplicate_faces_removed, 0u);
+  ASSERT_EQ(r.input_face_trees.size(), 2u);
+  const std::vector<Point3> P = positionsOf(r.merged);
+  const std::vector<Triangle> T = trianglesOf(r.merged);
+  const std::vector<char> changed = r.merged_new_face;
+  SplitResult copy = r;
+  const NearFaceFinder near = keptFacesNear(copy, T.size());
+  ASSERT_TRUE(near);
+  EXPECT_TRUE(copy.input_face_trees.empty() && copy.merged_face_origin.empty());
+  // The same candidate pairs as a search over every face, some of them
+  // with a face left as it was.
+  const ChangedFaceSearch fromTrees(P, T, changed, 4, near), overAll(P, T, changed, 4);
+  auto pairs = fromTrees.pairs(), all = overAll.pairs();
+  std::sort(pairs.begin(), pairs.end());
+  std::sort(all.begin(), all.end());
+  EXPECT_EQ(pairs, all);
+  std::size_t withKept = 0;
+  for (const auto& p : pairs) withKept += !changed[p[0]] || !changed[p[1]];
+  EXPECT_GT(withKept, 0u);
+  for (std::size_t i = fromTrees.changedCount(); i < fromTrees.faces().size(); ++i)
+    EXPECT_FALSE(changed[fromTrees.faces()[i]]);
+  // Not without the trees (no self-intersections searched), nor when the
+  // origins do not describe the faces.
+  SplitOptions between;
+  SplitResult noTrees = splitAlongIntersections(t.inputs(), between);
+  EXPECT_TRUE(noTrees.input_face_trees.empty());
+  EXPECT_FALSE(keptFacesNear(noTrees, noTrees.merged_triangles.size()));
+  SplitResult changedAfter = r;
+  changedAfter.merged_face_origin.pop_back();
+  EXPECT_FALSE(keptFacesNear(changedAfter, T.size()));
+  EXPECT_TRUE(changedAfter.input_face_trees.empty());
+}
+
 TEST(OutputStage, TheCheckersCountIncludesFacesWithTheSameThreeVertices) {
   // A box and its copy moved by half its width keep, each, their faces where
   // they overlap in a plane (overlaps_once off): no crossing for the stage,

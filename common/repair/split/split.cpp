@@ -129,6 +129,7 @@ FindIntersectionsResult findCrossings(const std::vector<WeldedArrays>& inputs,
   find.cross = options.between_meshes;
   find.contacts = true;
   find.same_vertices = false;
+  find.keep_trees = options.self && options.merged_output;
   find.progress = [&](int percent, const char* stage) {
     return !options.progress || options.progress(percent * 4 / 10, stage);
   };
@@ -526,6 +527,7 @@ void mergeAndSnap(const CurveWelding& w, SplitMeshes& split,
   merged.toMesh(r.merged);
   r.merged_points = std::move(merged.positions);
   r.merged_triangles = std::move(merged.triangles);
+  r.merged_face_origin = std::move(merged.face_origin);
 }
 
 }  // namespace
@@ -540,6 +542,9 @@ SplitResult splitAlongIntersections(const std::vector<const Mesh*>& meshes,
   std::vector<WeldedArrays> inputs = prepareInputs(meshes, options, r);
   FindIntersectionsResult found = findCrossings(inputs, options, r);
   r.complete = options.self && (options.between_meshes || meshes.size() == 1);
+  r.input_face_trees = std::move(found.face_trees);
+  if (!r.input_face_trees.empty())
+    for (const WeldedArrays& in : inputs) r.input_face_of_box.push_back(in.face_origin);
 
   reportProgress(options.progress, 40, "Collecting curve points");
   std::vector<MeshSplitter> splitters;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "common/base/json.h"
@@ -98,6 +99,13 @@ struct SplitResult {
   // Code that changes `merged` before the stage empties them.
   std::vector<Point3> merged_points;
   std::vector<Triangle> merged_triangles;
+  std::vector<FaceOrigin> merged_face_origin;  // as merged's provenance
+  // Where each input mesh's faces lie (with options.self and merged_output):
+  // the search's tree of its faces' boxes, and the input face of each tree
+  // box (FaceOrigin::face). With merged_face_origin they find the faces of
+  // `merged` left as they were near a few boxes, without a pass over all.
+  std::vector<std::shared_ptr<const BoxTree>> input_face_trees;
+  std::vector<std::vector<int>> input_face_of_box;
   // Every intersecting pair of the inputs was searched for (and split): each
   // mesh's own and those between meshes. Faces left as they were then cross
   // nothing, so the intersections left are among pairs with a new face.
