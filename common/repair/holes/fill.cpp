@@ -28,9 +28,14 @@ constexpr double kRoundPatchQuality = 0.85;
 // A disk whose flat patch covers less than this fraction of its area in
 // space is triangulated again with triangles that grow inwards by
 // kDiskGrowth per layer, up to kMostDiskScale times the border's size.
+// The dense disk (the last fallback, the border's spacing as split) grows
+// so too, up to kMostDenseDiskScale: with the border's spacing throughout,
+// the patch over spot's large round hole had 3.6 times the faces cut out
+// (2,043 unknowns against the disk's 522) and most of the fill's time.
 constexpr double kDenseDisk = 0.75;
 constexpr double kDiskGrowth = 1.2;
 constexpr double kMostDiskScale = 4;
+constexpr double kMostDenseDiskScale = 2;
 constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
 const char* where(const Domain& d) {
@@ -45,8 +50,8 @@ bool smoothWithTangents(HoleFairing mode) {
 // fairing of the patch as it stands (its systems made on first use).
 struct Candidate {
   Domain domain;
-  bool uniform = false;  // a disk whose triangles keep the border's spacing throughout
-  bool graded = false;   // a disk whose triangles were made larger inside
+  bool uniform = false;  // a disk whose triangles start at the border's spacing (the dense disk)
+  bool graded = false;   // a disk (not the dense one) whose triangles were made larger inside
   bool tried = false;
   std::string problem;  // why there is no patch over this domain (empty: there is)
   Patch patch;
@@ -92,9 +97,9 @@ class HoleFiller {
       }
     }
     if (std::find(order.begin(), order.end(), disk) == order.end()) order.push_back(disk);
-    // Last, a disk with triangles of the border's spacing throughout (as
-    // split), where the disk's are larger: more vertices for the patch to
-    // bend around what it met.
+    // Last, a disk with triangles of the border's spacing (as split),
+    // growing inwards to at most twice it, where the disk's are larger:
+    // more vertices for the patch to bend around what it met.
     candidates.emplace_back();
     Candidate* dense = &candidates.back();
     dense->domain = disk->domain;
@@ -338,7 +343,7 @@ class HoleFiller {
     // A disk holds more area than the surface its border bounds (all of it
     // where the border is round and flat): measured on the flat placement,
     // the triangles inside grow towards the size that makes up for it.
-    if (!d.planar && !c.uniform && uniformFaces <= double(options_.uniform_face_limit)) {
+    if (!d.planar && uniformFaces <= double(options_.uniform_face_limit)) {
       double inSpace = 0;
       for (const Triangle& t : c.patch.triangles)
         inSpace += ((c.flat[std::size_t(t[1])] - c.flat[std::size_t(t[0])]) ^
@@ -348,8 +353,9 @@ class HoleFiller {
       const double ratio = inSpace / std::abs(signedArea(d.uv));  // both in units of size^2
       if (ratio < kDenseDisk) {
         settings.growth = kDiskGrowth;
-        settings.maxSize = meanSize * std::min(kMostDiskScale, 1 / std::sqrt(ratio));
-        c.graded = true;
+        const double most = c.uniform ? kMostDenseDiskScale : kMostDiskScale;
+        settings.maxSize = meanSize * std::min(most, 1 / std::sqrt(ratio));
+        c.graded = !c.uniform;
         if (!cover(c, sizes, settings) || !placeFlat(c)) {
           context_.times.triangulate += msSince(clock);
           return;

@@ -101,8 +101,8 @@ struct HoleFillOptions {
   // intersects is replaced by a flatter one (LaplacianRegression ->
   // Biharmonic -> Harmonic -> Flat; from Biharmonic, LaplacianRegression
   // last), or left out. Each shape is tried over every domain (the hole's
-  // plane, a disk, a disk with triangles of the border's spacing
-  // throughout) before the next shape. Its counts make
+  // plane, a disk, a disk with smaller triangles: the border's spacing,
+  // growing inwards to at most twice it) before the next shape. Its counts make
   // new_intersecting_pairs exact.
   bool check_intersections = true;
   // Count every intersecting pair of the finished mesh as stored, by the
