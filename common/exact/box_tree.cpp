@@ -448,7 +448,6 @@ void BoxTree::sortByMorton() {
   }
 }
 
-// A balanced hierarchy over the current order: split every range at its middle.
 void BoxTree::groups(std::uint32_t most, std::vector<Leaf>& leaves,
                      std::vector<Group>& groups) const {
   leaves.clear();
@@ -475,6 +474,7 @@ std::uint32_t BoxTree::groups(std::uint32_t n, std::uint32_t most, std::vector<L
   return size;
 }
 
+// A balanced hierarchy over the current order: split every range at its middle.
 void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const {
   const std::uint32_t self = std::uint32_t(out.size());
   out.push_back({});

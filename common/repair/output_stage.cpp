@@ -591,10 +591,6 @@ std::vector<T> takeOr(std::vector<T>& kept, std::size_t count, Make make, const 
   return taken.size() == count ? taken : make(merged);
 }
 
-}  // namespace
-
-namespace {
-
 // At most this many boxes of changed faces per query of markNear: on
 // bunny + dragon the stage took 654 M instructions with 32, 677 M with a
 // leaf each (8) and 657 M with 64.
@@ -855,10 +851,6 @@ void carryCurveEdge(int a, int b, const Mesh& mesh, Scalar scalar,
   for (int v = b; from.at(v) >= 0; v = from.at(v))
     curves.push_back({std::min(v, from.at(v)), std::max(v, from.at(v))});
 }
-
-}  // namespace
-
-namespace {
 
 // Each input's own output again from the merged output (after
 // splitRoundedAgain changed it): its vertices in their order, each at its
