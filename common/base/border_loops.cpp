@@ -47,19 +47,20 @@ std::vector<std::uint64_t> cornerSums(std::size_t faceCount, std::size_t vertexC
 }
 
 // Collects, in one pass over the faces, the faces at the vertices whose
-// mark (marks[2 v], nonzero) says so; each face once per vertex, grouped
-// by vertex in `out` (vertices ascending).
+// slot (slots[v], nonzero: the index in `vertices`, plus one) says so; each
+// face once per vertex, grouped by vertex in `out` (vertices ascending).
+// Most faces have no such corner: one test of the three slots skips them.
 template <class Corners>
 void gatherFaces(std::size_t faceCount, const Corners& corners, const std::vector<int>& vertices,
-                 const std::uint64_t* marks, BorderEdges& out) {
+                 const int* slots, BorderEdges& out) {
   std::vector<std::pair<int, int>> found;  // (slot, face)
   for (std::size_t f = 0; f < faceCount; ++f) {
     const Triangle t = corners(f);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t mark = marks[2 * std::size_t(t[k])];
-      if (mark == 0 || (k > 0 && t[k] == t[0]) || (k == 2 && t[2] == t[1])) continue;
-      found.push_back({int(mark - 1), int(f)});
-    }
+    const int s0 = slots[t[0]], s1 = slots[t[1]], s2 = slots[t[2]];
+    if ((s0 | s1 | s2) == 0) continue;
+    if (s0 != 0) found.push_back({s0 - 1, int(f)});
+    if (s1 != 0 && t[1] != t[0]) found.push_back({s1 - 1, int(f)});
+    if (s2 != 0 && t[2] != t[0] && t[2] != t[1]) found.push_back({s2 - 1, int(f)});
   }
   out.vertices = vertices;
   out.start.assign(vertices.size() + 1, 0);
@@ -99,30 +100,32 @@ void bordersLeaving(int v, const int* faces, const Triangle* corners, std::size_
 template <class Corners>
 BorderEdges borderEdges(std::size_t faceCount, std::size_t vertexCount, const Corners& corners) {
   BorderEdges out;
-  std::vector<std::uint64_t> marks = cornerSums(faceCount, vertexCount, corners);
-  std::vector<int> vertices;
-  for (std::size_t v = 0; v < vertexCount; ++v) {
-    const bool unpaired = (marks[2 * v] | marks[2 * v + 1]) != 0;
-    marks[2 * v] = unpaired ? vertices.size() + 1 : 0;  // the slot, plus one
-    if (unpaired) vertices.push_back(int(v));
+  std::vector<int> vertices, slots(vertexCount, 0);
+  {
+    const std::vector<std::uint64_t> sums = cornerSums(faceCount, vertexCount, corners);
+    for (std::size_t v = 0; v < vertexCount; ++v)
+      if ((sums[2 * v] | sums[2 * v + 1]) != 0) {
+        vertices.push_back(int(v));
+        slots[v] = int(vertices.size());
+      }
   }
   if (vertices.empty()) return out;
-  gatherFaces(faceCount, corners, vertices, marks.data(), out);
+  gatherFaces(faceCount, corners, vertices, slots.data(), out);
   std::vector<int> missed;  // ends of border edges whose sums cancelled (see the header)
   for (std::size_t i = 0; i < out.vertices.size(); ++i)
     bordersLeaving(out.vertices[i], out.faces.data() + out.start[i],
                    out.corners.data() + out.start[i], std::size_t(out.start[i + 1] - out.start[i]),
                    out.edges);
   for (const BorderEdge& e : out.edges)
-    if (marks[2 * std::size_t(e.to)] == 0) missed.push_back(e.to);
+    if (slots[std::size_t(e.to)] == 0) missed.push_back(e.to);
   while (!missed.empty()) {
     std::sort(missed.begin(), missed.end());
     missed.erase(std::unique(missed.begin(), missed.end()), missed.end());
     for (int v : missed) vertices.push_back(v);
     std::sort(vertices.begin(), vertices.end());
-    for (std::size_t i = 0; i < vertices.size(); ++i) marks[2 * std::size_t(vertices[i])] = i + 1;
+    for (std::size_t i = 0; i < vertices.size(); ++i) slots[std::size_t(vertices[i])] = int(i + 1);
     BorderEdges again;
-    gatherFaces(faceCount, corners, vertices, marks.data(), again);
+    gatherFaces(faceCount, corners, vertices, slots.data(), again);
     std::vector<BorderEdge> more;
     for (int v : missed) {
       const std::size_t i =
@@ -135,7 +138,7 @@ BorderEdges borderEdges(std::size_t faceCount, std::size_t vertexCount, const Co
     missed.clear();
     for (const BorderEdge& e : more) {
       out.edges.push_back(e);
-      if (marks[2 * std::size_t(e.to)] == 0) missed.push_back(e.to);
+      if (slots[std::size_t(e.to)] == 0) missed.push_back(e.to);
     }
   }
   return out;

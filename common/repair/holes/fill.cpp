@@ -26,8 +26,9 @@ constexpr double kMaxStretch = 2;
 // triangles) over the hole's plane is used without making the disk's.
 constexpr double kRoundPatchQuality = 0.85;
 // A disk whose flat patch covers less than this fraction of its area in
-// space is triangulated again with triangles that grow inwards by
-// kDiskGrowth per layer, up to kMostDiskScale times the border's size.
+// space (measured on a coarse patch of kCoarse times the sizes) is
+// triangulated with triangles that grow inwards by kDiskGrowth per layer,
+// up to kMostDiskScale times the border's size.
 // The dense disk (the last fallback, the border's spacing as split) grows
 // so too, up to kMostDenseDiskScale: with the border's spacing throughout,
 // the patch over spot's large round hole had 3.6 times the faces cut out
@@ -36,6 +37,7 @@ constexpr double kDenseDisk = 0.75;
 constexpr double kDiskGrowth = 1.2;
 constexpr double kMostDiskScale = 4;
 constexpr double kMostDenseDiskScale = 2;
+constexpr double kCoarse = 3;
 constexpr const char* kNoMembrane = "the membrane over the disk could not be solved";
 
 const char* where(const Domain& d) {
@@ -335,34 +337,41 @@ class HoleFiller {
     } else {
       settings.growth = 1;
       settings.maxSize = meanSize * 4;
-    }
-    if (!cover(c, sizes, settings) || !placeFlat(c)) {
-      context_.times.triangulate += msSince(clock);
-      return;
-    }
-    // A disk holds more area than the surface its border bounds (all of it
-    // where the border is round and flat): measured on the flat placement,
-    // the triangles inside grow towards the size that makes up for it.
-    if (!d.planar && uniformFaces <= double(options_.uniform_face_limit)) {
-      double inSpace = 0;
-      for (const Triangle& t : c.patch.triangles)
-        inSpace += ((c.flat[std::size_t(t[1])] - c.flat[std::size_t(t[0])]) ^
-                    (c.flat[std::size_t(t[2])] - c.flat[std::size_t(t[0])]))
-                       .Norm() /
-                   2;
-      const double ratio = inSpace / std::abs(signedArea(d.uv));  // both in units of size^2
+      // A disk holds more area than the surface its border bounds (all of
+      // it where the border is round and flat): its triangles inside grow
+      // towards the size that makes up for it.
+      const double ratio = d.planar ? 1 : flatAreaRatio(c, sizes, settings);
       if (ratio < kDenseDisk) {
         settings.growth = kDiskGrowth;
         const double most = c.uniform ? kMostDenseDiskScale : kMostDiskScale;
         settings.maxSize = meanSize * std::min(most, 1 / std::sqrt(ratio));
         c.graded = !c.uniform;
-        if (!cover(c, sizes, settings) || !placeFlat(c)) {
-          context_.times.triangulate += msSince(clock);
-          return;
-        }
       }
     }
+    if (cover(c, sizes, settings)) placeFlat(c);
     context_.times.triangulate += msSince(clock);
+  }
+
+  // The area in space of a disk's flat patch over the disk's area (both in
+  // units of size^2), measured on a coarse patch (kCoarse times the sizes:
+  // about a ninth of the vertices to place), so that the patch itself is
+  // triangulated once, at its grading; 1 when the coarse front fails.
+  double flatAreaRatio(const Candidate& c, const std::vector<double>& sizes,
+                       const FrontSettings& settings) {
+    Candidate coarse;
+    coarse.domain = c.domain;
+    std::vector<double> coarseSizes = sizes;
+    for (double& size : coarseSizes) size *= kCoarse;
+    FrontSettings coarseSettings = settings;
+    coarseSettings.maxSize *= kCoarse;
+    if (!cover(coarse, coarseSizes, coarseSettings) || !placeFlat(coarse)) return 1;
+    double inSpace = 0;
+    for (const Triangle& t : coarse.patch.triangles)
+      inSpace += ((coarse.flat[std::size_t(t[1])] - coarse.flat[std::size_t(t[0])]) ^
+                  (coarse.flat[std::size_t(t[2])] - coarse.flat[std::size_t(t[0])]))
+                     .Norm() /
+                 2;
+    return inSpace / std::abs(signedArea(c.domain.uv));
   }
 
   // The advancing front over the candidate's domain, its new vertices
