@@ -175,6 +175,9 @@ struct Fairing::System {
   // coefficient, omega_rj times the row's weight; the row's own vertex first.
   std::vector<int> start, key;
   std::vector<double> coefficient;
+  // The pairs of a row's entries (i, j) over unknowns whose product adds
+  // to A^T A, and the slot in its values where it does (found once).
+  std::vector<std::array<int, 3>> products;
   Sparse normal;                  // A^T A, lower triangle
   Eigen::MatrixXd fixedPart;      // rows x 3: the fixed vertices' contribution
   Eigen::VectorXd rowWeight;      // 1 / (2 sqrt(A_r))
@@ -264,20 +267,19 @@ void Fairing::assemble(const std::vector<Point3>& x, const std::vector<TriangleW
               sys.key[std::size_t(j)] >= sys.key[std::size_t(i)])
             pairs.push_back({sys.key[std::size_t(j)] - first, sys.key[std::size_t(i)] - first});
     sys.normal = lowerPattern(unknowns, pairs);
+    // Where each product of two of a row's coefficients goes in A^T A.
+    for (std::size_t r = 0; r < rows_.size(); ++r)
+      for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
+        for (int j = sys.start[r]; j < sys.start[r + 1]; ++j) {
+          const int a = sys.key[std::size_t(i)], b = sys.key[std::size_t(j)];
+          if (a >= first && b >= a)
+            sys.products.push_back({i, j, slotOf(sys.normal, b - first, a - first)});
+        }
   }
   double* values = sys.normal.valuePtr();
   std::fill(values, values + sys.normal.nonZeros(), 0.0);
-  for (std::size_t r = 0; r < rows_.size(); ++r)
-    for (int i = sys.start[r]; i < sys.start[r + 1]; ++i) {
-      const int a = sys.key[std::size_t(i)];
-      if (a < first) continue;
-      for (int j = sys.start[r]; j < sys.start[r + 1]; ++j) {
-        const int b = sys.key[std::size_t(j)];
-        if (b < a) continue;
-        values[slotOf(sys.normal, b - first, a - first)] +=
-            sys.coefficient[std::size_t(i)] * sys.coefficient[std::size_t(j)];
-      }
-    }
+  for (const auto& [i, j, slot] : sys.products)
+    values[slot] += sys.coefficient[std::size_t(i)] * sys.coefficient[std::size_t(j)];
 }
 
 Eigen::MatrixXd Fairing::rightHandSide(const Eigen::MatrixXd& delta) const {

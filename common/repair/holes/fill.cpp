@@ -23,12 +23,18 @@ namespace {
 // in the domain are split (refineStretched): twice the size the front meant.
 constexpr double kMaxStretch = 2;
 // A first shape of at least this mean shape quality (1 = equilateral
-// triangles) over the hole's plane is used without making the disk's.
-constexpr double kRoundPatchQuality = 0.85;
+// triangles) over the hole's plane is used without making the disk's. (On
+// the fidelity holes of docs/BENCHMARKS.md the disk's shape was the rounder
+// one only where the plane's was below 0.7.)
+constexpr double kRoundPatchQuality = 0.8;
 // A disk whose flat patch covers less than this fraction of its area in
 // space (measured on a coarse patch of kCoarse times the sizes) is
 // triangulated with triangles that grow inwards by kDiskGrowth per layer,
-// up to kMostDiskScale times the border's size.
+// up to 1 / ratio times the border's size and at most kMostDiskScale: the
+// rows near the border keep its size, the larger ones inside make up for
+// the area the disk has beyond the surface (the patch over a hole three
+// quarters around a tube had 1.9 times the faces cut out when they grew to
+// 1 / sqrt(ratio)).
 // The dense disk (the last fallback, the border's spacing as split) grows
 // so too, up to kMostDenseDiskScale: with the border's spacing throughout,
 // the patch over spot's large round hole had 3.6 times the faces cut out
@@ -344,7 +350,7 @@ class HoleFiller {
       if (ratio < kDenseDisk) {
         settings.growth = kDiskGrowth;
         const double most = c.uniform ? kMostDenseDiskScale : kMostDiskScale;
-        settings.maxSize = meanSize * std::min(most, 1 / std::sqrt(ratio));
+        settings.maxSize = meanSize * std::min(most, 1 / ratio);
         c.graded = !c.uniform;
       }
     }
