@@ -107,9 +107,4 @@ std::pair<Point3, Point3> tangentFrame(const Point3& n) {
   return {u, n ^ u};
 }
 
-std::uint64_t edgeKey(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
-}
-
 }  // namespace meshmend::holes

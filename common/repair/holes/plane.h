@@ -123,7 +123,11 @@ class Grid {
 // Two unit vectors u, v with (u, v, n) right-handed and orthonormal, for a unit n.
 std::pair<Point3, Point3> tangentFrame(const Point3& n);
 
-std::uint64_t edgeKey(int a, int b);  // an undirected edge, as one number
+// An undirected edge, as one number (lower vertex in the high half).
+inline std::uint64_t edgeKey(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+}
 
 // A set of edge keys (never 0 nor ~0: edgeKey of two vertices >= 0 is
 // neither unless both are 0), open addressing with linear probing.

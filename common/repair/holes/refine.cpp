@@ -1,8 +1,8 @@
 #include "common/repair/holes/refine.h"
 
 #include <algorithm>
+#include <numeric>
 #include <tuple>
-#include <unordered_map>
 
 namespace meshmend::holes {
 
@@ -18,19 +18,44 @@ int cornerBefore(const Triangle& t, std::uint64_t key) {
   return k;
 }
 
-// The patch's inner edges (local key) and the two triangles on each.
-std::unordered_map<std::uint64_t, std::pair<int, int>> innerEdgeSides(const Patch& patch) {
-  std::unordered_map<std::uint64_t, std::pair<int, int>> sides;
-  sides.reserve(patch.triangles.size() * 2);
-  for (std::size_t t = 0; t < patch.triangles.size(); ++t)
+// The patch's inner edges (local key) and the two triangles on each, in
+// key order.
+using EdgeSides = std::vector<std::pair<std::uint64_t, std::pair<int, int>>>;
+EdgeSides innerEdgeSides(const Patch& patch) {
+  // The half-edges bucketed by their lower vertex (a counting sort), each
+  // bucket's few ordered by the higher one: pairs of equal ones are the
+  // inner edges, found in key order.
+  const std::vector<Triangle>& triangles = patch.triangles;
+  std::vector<int> start(patch.size() + 1, 0);
+  for (const Triangle& t : triangles)
+    for (int k = 0; k < 3; ++k) ++start[std::size_t(std::min(t[k], t[(k + 1) % 3])) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::pair<int, int>> halves(std::size_t(start.back()));  // (higher vertex, triangle)
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
-      const int a = patch.triangles[t][k], b = patch.triangles[t][(k + 1) % 3];
-      auto [it, added] = sides.try_emplace(edgeKey(a, b), int(t), -1);
-      if (!added) it->second.second = int(t);
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      halves[std::size_t(next[std::size_t(std::min(a, b))]++)] = {std::max(a, b), int(t)};
     }
-  for (auto it = sides.begin(); it != sides.end();)
-    it = it->second.second < 0 ? sides.erase(it) : std::next(it);
+  EdgeSides sides;
+  sides.reserve(halves.size() / 2);
+  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
+    const auto first = halves.begin() + start[v], last = halves.begin() + start[v + 1];
+    std::sort(first, last);
+    for (auto it = first; it != last && it + 1 != last; ++it)
+      if (it->first == (it + 1)->first) {
+        sides.push_back({edgeKey(int(v), it->first), {it->second, (it + 1)->second}});
+        ++it;
+      }
+  }
   return sides;
+}
+
+bool hasEdge(const EdgeSides& sides, std::uint64_t key) {
+  const auto it =
+      std::lower_bound(sides.begin(), sides.end(), key,
+                       [](const auto& side, std::uint64_t k) { return side.first < k; });
+  return it != sides.end() && it->first == key;
 }
 
 // Flips the patch's inner edges whose opposite angles at x add up to more
@@ -39,20 +64,20 @@ std::unordered_map<std::uint64_t, std::pair<int, int>> innerEdgeSides(const Patc
 // and the new edge is not there yet. A few passes.
 void flipToDelaunay(Patch& patch, const std::vector<Point3>& x,
                     const std::function<bool(int, int)>& forbidden) {
+  // The sine and cosine of the angle at `apex`, both times the lengths of
+  // its two sides: the angles at c and d add up to more than pi where the
+  // sine of their sum is negative.
   auto angleAt = [&](int apex, int a, int b) {
     const Point3 u = x[std::size_t(a)] - x[std::size_t(apex)],
                  v = x[std::size_t(b)] - x[std::size_t(apex)];
-    return std::atan2((u ^ v).Norm(), u * v);
+    return std::pair<double, double>((u ^ v).Norm(), u * v);
   };
   const std::vector<Vec2>& uv = patch.uv;
   for (int pass = 0; pass < kFlipPasses; ++pass) {
-    const auto sides = innerEdgeSides(patch);
-    // In key order, so that the result does not depend on the hash table's.
-    std::vector<std::pair<std::uint64_t, std::pair<int, int>>> edges(sides.begin(), sides.end());
-    std::sort(edges.begin(), edges.end());
+    const EdgeSides sides = innerEdgeSides(patch);
     std::vector<char> touched(patch.triangles.size(), 0);
     std::size_t flips = 0;
-    for (const auto& [key, side] : edges) {
+    for (const auto& [key, side] : sides) {
       if (touched[std::size_t(side.first)] || touched[std::size_t(side.second)]) continue;
       Triangle& t1 = patch.triangles[std::size_t(side.first)];
       Triangle& t2 = patch.triangles[std::size_t(side.second)];
@@ -61,8 +86,11 @@ void flipToDelaunay(Patch& patch, const std::vector<Point3>& x,
       int j = 0;
       while (t2[j] == a || t2[j] == b) ++j;
       const int d = t2[j];
-      if (c == d || sides.count(edgeKey(c, d)) || forbidden(c, d)) continue;
-      if (angleAt(c, a, b) + angleAt(d, b, a) <= M_PI) continue;
+      if (c == d) continue;
+      const auto [sinC, cosC] = angleAt(c, a, b);
+      const auto [sinD, cosD] = angleAt(d, b, a);
+      if (!(sinC * cosD + cosC * sinD < 0)) continue;
+      if (hasEdge(sides, edgeKey(c, d)) || forbidden(c, d)) continue;
       // (a, b, c) + (b, a, d) -> (a, d, c) + (d, b, c).
       if (orient(uv[std::size_t(a)], uv[std::size_t(d)], uv[std::size_t(c)]) <= 0 ||
           orient(uv[std::size_t(d)], uv[std::size_t(b)], uv[std::size_t(c)]) <= 0)
