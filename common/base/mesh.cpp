@@ -52,10 +52,6 @@ double smallestAngle(const Point3& a, const Point3& b, const Point3& c) {
   return std::atan2((u ^ v).Norm(), u * v);
 }
 
-bool isFinite(const Point3& p) {
-  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-}
-
 double scalarStep(const Point3& p, Scalar s) {
   const double m = std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
   if (s == Scalar::kFloat) {
@@ -330,15 +326,6 @@ std::vector<Triangle> trianglesOf(const Mesh& mesh) {
   return out;
 }
 
-void CoordinateMagnitudes::add(const Point3& p) {
-  for (int k = 0; k < 3; ++k) {
-    const double a = std::fabs(p[k]);
-    if (a == 0 || !std::isfinite(a)) continue;
-    smallest = std::min(smallest, a);
-    largest = std::max(largest, a);
-  }
-}
-
 void CoordinateMagnitudes::add(const CoordinateMagnitudes& other) {
   smallest = std::min(smallest, other.smallest);
   largest = std::max(largest, other.largest);
@@ -350,10 +337,10 @@ double CoordinateMagnitudes::binades() const {
 
 CoordinateMagnitudes magnitudesOf(const std::vector<Point3>& points,
                                   const std::vector<Triangle>& triangles) {
-  std::vector<bool> used(points.size(), false);
+  std::vector<char> used(points.size(), 0);
   for (const Triangle& t : triangles)
     for (int k = 0; k < 3; ++k)
-      if (t[k] >= 0 && std::size_t(t[k]) < points.size()) used[std::size_t(t[k])] = true;
+      if (t[k] >= 0 && std::size_t(t[k]) < points.size()) used[std::size_t(t[k])] = 1;
   CoordinateMagnitudes m;
   for (std::size_t v = 0; v < points.size(); ++v)
     if (used[v]) m.add(points[v]);
@@ -386,10 +373,15 @@ void requireFacesAndFiniteCoordinates(const Mesh& mesh, const std::string& what)
                                   " uses it: repair the file, or delete the faces that use it");
     throw InvalidInputError(bad + "; no face uses it: run \"Remove Unreferenced Vertices\" first");
   }
-  CoordinateMagnitudes m;
+  // Over the vertices the faces use (each is a corner of about six).
+  const Vertex* first = mesh.vert.data();
+  std::vector<char> used(mesh.vert.size(), 0);
   for (const Face& f : mesh.face)
     if (!f.IsD())
-      for (int k = 0; k < 3; ++k) m.add(f.cP(k));
+      for (int k = 0; k < 3; ++k) used[std::size_t(f.cV(k) - first)] = 1;
+  CoordinateMagnitudes m;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v]) m.add(first[v].cP());
   requireCoordinateSpan(m, what);
 }
 

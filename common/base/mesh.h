@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -215,7 +216,9 @@ inline double smallestAngleMeasure(const Point3& a, const Point3& b, const Point
   return others > 0 ? cross / others : 0;
 }
 
-bool isFinite(const Point3& p);
+inline bool isFinite(const Point3& p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
 
 // `p` as MeshLab stores it: each coordinate rounded to float.
 inline Point3 roundedToFloat(const Point3& p) {
@@ -249,7 +252,16 @@ inline constexpr double kMaxCoordinateBinades = 280;
 struct CoordinateMagnitudes {
   double smallest = std::numeric_limits<double>::infinity();
   double largest = 0;
-  void add(const Point3& p);
+  // Inline: it runs once per vertex of every input.
+  void add(const Point3& p) {
+    for (int k = 0; k < 3; ++k) {
+      const double a = p[k] < 0 ? -p[k] : p[k];
+      if (a > 0 && a <= std::numeric_limits<double>::max()) {  // nonzero and finite
+        smallest = a < smallest ? a : smallest;
+        largest = a > largest ? a : largest;
+      }
+    }
+  }
   void add(const CoordinateMagnitudes& other);
   // log2(largest / smallest); 0 without a nonzero coordinate.
   double binades() const;
