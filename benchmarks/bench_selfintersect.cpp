@@ -1,17 +1,17 @@
-// bench_selfintersect [--repeat N] [--limit S] FILE: self-intersection
-// removal, ours against CGAL 5.5 on the same input in the same run. Prints
-// one JSON object.
+// bench_selfintersect [--repeat N] [--limit S] [--threads N] FILE:
+// self-intersection removal, ours against CGAL 5.5 on the same input in the
+// same run. Prints one JSON object.
 //
 // Ours: removeSelfIntersections with the options of the filter (defaults,
 // rounded to float as MeshLab stores the result; its own verification
-// included). CGAL: PMP::experimental::remove_self_intersections (local
-// smoothing and hole filling; repair_self_intersections.h) and
-// PMP::experimental::autorefine_and_remove_self_intersections (autorefine,
-// drop the inner patches, stitch; corefinement.h in 5.5, autorefinement.h
-// only exists from 6.0), each on its own Surface_mesh copy. A file that a
-// Surface_mesh refuses (non-manifold edges or vertices) is first repaired as
-// a CGAL user would: repair_polygon_soup, then orient_polygon_soup. The
-// autorefinement needs a mesh without degenerate faces: it is skipped
+// included), on --threads threads (default 1, as the peers; 0: every CPU),
+// and as meshmend_remove_self_intersections_all_cores on every CPU. CGAL:
+// PMP::experimental::remove_self_intersections (local smoothing and hole filling;
+// repair_self_intersections.h) and PMP::experimental::autorefine_and_remove_self_intersections
+// (autorefine, drop the inner patches, stitch; corefinement.h in 5.5, autorefinement.h only exists
+// from 6.0), each on its own Surface_mesh copy. A file that a Surface_mesh refuses (non-manifold
+// edges or vertices) is first repaired as a CGAL user would: repair_polygon_soup, then
+// orient_polygon_soup. The autorefinement needs a mesh without degenerate faces: it is skipped
 // otherwise.
 //
 // Success is checked independently: in its child process, each method's
@@ -43,6 +43,7 @@
 
 #include "benchmarks/cgal_mesh.h"
 #include "benchmarks/harness.h"
+#include "common/base/parallel.h"
 #include "common/io/mesh_io.h"
 #include "common/repair/selfintersect/selfintersect.h"
 
@@ -260,26 +261,35 @@ Method cgalMethod(const std::string& name, const std::string& file, int repeat, 
 
 int main(int argc, char** argv) {
   CommandLine args(argc, argv);
-  const int repeat = std::max(1, args.integer("--repeat", 3)), limit = args.integer("--limit", 600);
-  if (!args.complete(1, 1, "bench_selfintersect [--repeat N] [--limit SECONDS] FILE")) return 1;
+  const int repeat = std::max(1, args.integer("--repeat", 3)), limit = args.integer("--limit", 600),
+            threads = std::max(0, args.integer("--threads", 1));
+  if (!args.complete(1, 1,
+                     "bench_selfintersect [--repeat N] [--limit SECONDS] [--threads N (0: all)] "
+                     "FILE"))
+    return 1;
   const std::string file = args.files()[0];
   std::vector<Method> methods;
   std::vector<Outcome*> outcomes;
-  outcomes.push_back(sharedOutcome());
-  methods.push_back({"meshmend_remove_self_intersections", "ours", [=, outcome = outcomes.back()] {
-                       auto input = std::make_shared<Mesh>(readMesh(file));
-                       SelfIntersectionOptions options;  // as the filter sets them
-                       options.round_to_float = true;
-                       const auto start = std::chrono::steady_clock::now();
-                       const SelfIntersectionResult r = removeSelfIntersections(*input, options);
-                       const double ms = msSince(start);
-                       record(outcome, check(soupOf(r.mesh)), ms,
-                              r.verified && r.remaining_intersecting_pairs == 0);
-                       const bool slow = ms > kSlowMs;
-                       return std::function<long()>([=] {
-                         return slow ? 0L : long(removeSelfIntersections(*input, options).mesh.fn);
-                       });
-                     }});
+  for (const char* name :
+       {"meshmend_remove_self_intersections", "meshmend_remove_self_intersections_all_cores"}) {
+    outcomes.push_back(sharedOutcome());
+    const bool first = methods.empty();
+    methods.push_back({name, first ? "ours" : "alternative", [=, outcome = outcomes.back()] {
+                         auto input = std::make_shared<Mesh>(readMesh(file));
+                         SelfIntersectionOptions options;  // as the filter sets them
+                         options.round_to_float = true;
+                         const auto start = std::chrono::steady_clock::now();
+                         const SelfIntersectionResult r = removeSelfIntersections(*input, options);
+                         const double ms = msSince(start);
+                         record(outcome, check(soupOf(r.mesh)), ms,
+                                r.verified && r.remaining_intersecting_pairs == 0);
+                         const bool slow = ms > kSlowMs;
+                         return std::function<long()>([=] {
+                           return slow ? 0L
+                                       : long(removeSelfIntersections(*input, options).mesh.fn);
+                         });
+                       }});
+  }
   outcomes.push_back(sharedOutcome());
   methods.push_back(
       cgalMethod("cgal_remove_self_intersections", file, repeat, outcomes.back(), false,
@@ -292,6 +302,11 @@ int main(int argc, char** argv) {
                                }));
   std::vector<JsonObject> results;
   for (std::size_t i = 0; i < methods.size(); ++i) {
+    // Ours on the threads asked for (every CPU for *_all_cores); the peers
+    // use one whatever this says.
+    const bool ours = methods[i].name.rfind("meshmend", 0) == 0;
+    setThreadCount(methods[i].name.find("_all_cores") != std::string::npos ? 0 : unsigned(threads));
+    const unsigned used = ours ? workerCount() : 1;
     Measurement r = measure(methods[i], repeat - 1, limit);
     const Outcome& o = *outcomes[i];
     if (r.ok) {  // the first run is the first sample; a slow method ran only that one
@@ -306,6 +321,7 @@ int main(int argc, char** argv) {
       r.error.erase(0, r.error.find_first_not_of(' '));  // an exception's message, as passed on
     }
     JsonObject j = toJson(r);
+    j.set("threads", long(used));
     if (o.checked) j.set("claimed_success", o.claimed).set("check", toJson(o));
     if (methods[i].role == "peer")
       j.set("input_repaired", o.input_repaired)

@@ -405,7 +405,7 @@ def selfintersect(repeat):
     for name, path in inputs:
         print(name, file=sys.stderr)
         text = subprocess.run([str(BUILD / "benchmarks" / "bench_selfintersect"), "--repeat",
-                               str(repeat), "--limit", str(limit), str(path)],
+                               str(repeat), "--limit", str(limit), "--threads", "1", str(path)],
                               capture_output=True, text=True, check=True).stdout
         rows.append((name, json.loads(text)))
     shutil.rmtree(tmp)
@@ -421,6 +421,12 @@ def selfintersect(repeat):
             return error if error.startswith(("crashed", "time limit", "skipped")) else f"threw “{error}”"
         return fmt(m["median_ms"]) + ("¹" if len(m["times_ms"]) == 1 and repeat > 1 else "")
 
+    def peak_cell(m):
+        """The timed runs' peak; none for a method that ran once (¹)."""
+        if not m.get("ok") or (len(m["times_ms"]) == 1 and repeat > 1):
+            return "–"
+        return f"{m['peak_rss_mb']:.0f}"
+
     def result_cell(m, before):
         c = m.get("check")
         if not m.get("ok") or not c:
@@ -433,11 +439,14 @@ def selfintersect(repeat):
 
     skipped = [name for name, result in rows for m in result["methods"]
                if m.get("error", "").strip().startswith("skipped")]
-    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}; medians of {repeat} runs in one "
-           "`bench_selfintersect` run per input (`benchmarks/run.py selfintersect`), each method in "
-           "a child process, so ours and the peers ran on the same input in the same run. Times "
-           "exclude file reading; a method whose first run takes over 10 s runs once (¹). "
-           f"Time limit {limit} s per method.",
+    out = [f"Measured on {machine()}, {time.strftime('%Y-%m-%d')}, **ours and the peers on 1 "
+           "thread** (`bench_selfintersect --threads 1`; CGAL's removal has no parallel code), and "
+           f"ours also on every CPU ({os.cpu_count()} threads, *all CPUs*); medians of {repeat} runs "
+           "in one `bench_selfintersect` run per input (`benchmarks/run.py selfintersect`), each "
+           "method in a child process, so ours and the peers ran on the same input in the same "
+           "run. Times exclude file reading; a method whose first run takes over 10 s runs once "
+           f"(¹). Time limit {limit} s per method. *Peak MB*: the child's peak resident memory "
+           "over the timed runs (its input and copies included; – where a method ran once).",
            "",
            "Ours: `removeSelfIntersections` with the options of the filter *MeshMend: Remove "
            "Self-Intersections* (defaults, result rounded to float as MeshLab stores it; its own "
@@ -464,9 +473,10 @@ def selfintersect(repeat):
            "49,896 faces: their shallow overlap is bounded by a circle of radius 0.14 that crosses "
            "about 100 face pairs, and the outer surface is the union of the two.",
            "",
-           "| input | faces | comp. | pairs before | ours ms | ours result | RSI ms | RSI result | "
-           "ARSI ms | ARSI result | RSI / ours | ARSI / ours |",
-           "|---|---:|---:|---:|---:|---|---:|---|---:|---|---:|---:|"]
+           "| input | faces | comp. | pairs before | ours ms | ours peak MB | ours result | "
+           "ours, all CPUs ms | RSI ms | RSI peak MB | RSI result | ARSI ms | ARSI peak MB | "
+           "ARSI result | RSI / ours | ARSI / ours |",
+           "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---|---:|---:|---|---:|---:|"]
     for name, result in rows:
         before = result["input"]
         by = {m["method"]: m for m in result["methods"]}
@@ -476,11 +486,12 @@ def selfintersect(repeat):
         if repaired:
             pairs += f" ({repaired[0]['input_pairs']:,})"
         cells = [f"{name}{' †' if repaired else ''}", f"{before['faces']:,}",
-                 str(before["components"]), pairs, time_cell(o), result_cell(o, before)]
+                 str(before["components"]), pairs, time_cell(o), peak_cell(o),
+                 result_cell(o, before), time_cell(by["meshmend_remove_self_intersections_all_cores"])]
         ratios = []
         for key in SELFINTERSECT_PEERS:
             c = by[key]
-            cells += [time_cell(c), result_cell(c, before)]
+            cells += [time_cell(c), peak_cell(c), result_cell(c, before)]
             both = succeeded(o, before) and succeeded(c, before)
             ratios.append(f"{c['median_ms'] / o['median_ms']:.1f}×" if both else "–")
         out.append("| " + " | ".join(cells + ratios) + " |")
@@ -493,6 +504,14 @@ def selfintersect(repeat):
             "repaired in under 100 ms. Measured on the generated mesh "
             f"({before['faces']:,} faces, {before['remaining_pairs']:,} pairs): {time_cell(o)} ms, "
             f"{'met' if met else 'not met'}."]
+    rsi = next({m["method"]: m for m in r["methods"]}["cgal_remove_self_intersections"]
+               for _, r in rows if r["file"] == str(generated))
+    if succeeded(o, before) and succeeded(rsi, before):
+        ratio = rsi["median_ms"] / o["median_ms"]
+        out += ["",
+                "**Against issue 43's target** (1 thread each): RSI / ours on the generated mesh "
+                f"{ratio:.1f}× (target: at least 5×, {'met' if ratio >= 5 else 'not met'}); peak "
+                f"memory ours {peak_cell(o)} MB, RSI {peak_cell(rsi)} MB."]
     return "\n".join(out)
 
 

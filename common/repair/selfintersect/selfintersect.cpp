@@ -110,24 +110,21 @@ void pretreatInput(Removal& w) {
 // The work bounds, before anything is cut: the split's cost grows with the
 // intersecting pairs (about 0.1 ms each) and, within a face, with the
 // square of the curves crossing there.
-void boundWork(Removal& w) {
-  reportProgress(w.options.progress, 8, "finding the self-intersections");
-  FindIntersectionsOptions fo;
-  fo.cross = false;
-  fo.progress = w.options.progress;
-  const FindIntersectionsResult found = findIntersectionsInArrays({&w.in}, fo);
-  w.r.intersecting_pairs_before = found.pairs.size();
+// The work bounds, on the pairs the split finds before it cuts anything
+// (the search is the split's own: not made twice).
+void boundWork(Removal& w, const std::vector<IntersectingPair>& pairs) {
+  w.r.intersecting_pairs_before = pairs.size();
   const std::size_t bound = w.options.max_intersecting_pairs;
-  if (bound > 0 && found.pairs.size() > bound)
+  if (bound > 0 && pairs.size() > bound)
     throw WorkLimitError(
-        "the mesh has " + std::to_string(found.pairs.size()) +
+        "the mesh has " + std::to_string(pairs.size()) +
         " intersecting face pairs, more than the work bound of " + std::to_string(bound) +
         " (max_intersecting_pairs): cutting them all would take minutes. Nothing was changed. "
         "Raise the bound if that is acceptable, or work on parts of the mesh (select a region "
         "and move it to its own layer)");
   const std::size_t tripleBound = w.options.max_triple_points_per_face;
   if (tripleBound == 0) return;
-  const TriplePoints most = mostTriplePoints(found.pairs, {w.in.triangles.size()}, tripleBound);
+  const TriplePoints most = mostTriplePoints(pairs, {w.in.triangles.size()}, tripleBound);
   if (most.count > tripleBound)
     throw WorkLimitError(
         "in face " + std::to_string(w.faceOrigin[most.face.face]) + " more than " +
@@ -151,6 +148,7 @@ void cutAlongCurves(Removal& w) {
   so.separate_meshes = false;
   so.snap_tolerance = w.options.snap_tolerance;
   so.progress = progressWithin(w.options.progress, 10, 50);
+  so.pairs_found = [&w](const std::vector<IntersectingPair>& pairs) { boundWork(w, pairs); };
   w.split = splitAlongIntersections({&work}, so);
   // The cut as the host stores it (output_stage.h): the region growing
   // decides on those coordinates, so that its decisions hold for the result.
@@ -337,8 +335,6 @@ SelfIntersectionResult removeOnce(const Mesh& input, const SelfIntersectionOptio
   millisecondsSince(lap);
   pretreatInput(w);
   ms.pretreat = millisecondsSince(lap);
-  boundWork(w);
-  ms.detect = millisecondsSince(lap);
   cutAlongCurves(w);
   ms.split = millisecondsSince(lap);
   growValidRegion(w);
@@ -463,7 +459,6 @@ JsonObject toJson(const SelfIntersectionResult& r) {
   const auto& t = r.stage_ms;
   j.set("stage_ms", JsonObject()
                         .set("pretreat", t.pretreat)
-                        .set("detect", t.detect)
                         .set("split", t.split)
                         .set("growing", t.growing)
                         .set("stitching", t.stitching)

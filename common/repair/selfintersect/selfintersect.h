@@ -121,10 +121,10 @@ struct SelfIntersectionResult {
   // kept every face. `mesh` is then the input exactly as it was.
   bool unchanged = false;
   double time_ms = 0;
-  // Where the time went, in milliseconds (the stages of the paper, then ours).
+  // Where the time went, in milliseconds (the stages of the paper, then
+  // ours); `split` finds the intersecting pairs and cuts along them.
   struct StageTimes {
-    double pretreat = 0, detect = 0, split = 0, growing = 0, stitching = 0, separation = 0,
-           verify = 0;
+    double pretreat = 0, split = 0, growing = 0, stitching = 0, separation = 0, verify = 0;
   } stage_ms;
 };
 

@@ -135,6 +135,7 @@ FindIntersectionsResult findCrossings(const std::vector<WeldedArrays>& inputs,
   };
   FindIntersectionsResult found = findIntersectionsInArrays(arrays, find);
   r.intersecting_pairs = found.pairs.size();
+  if (options.pairs_found) options.pairs_found(found.pairs);
   const std::size_t bound = options.max_triple_points_per_face;
   if (bound == 0) return found;
   std::vector<std::size_t> faces;

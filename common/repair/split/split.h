@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -64,6 +65,10 @@ struct SplitOptions {
   // long numbers (a spindle torus near its axis: thousands; real meshes:
   // under ten; CAD boxes overlapping in planes: a few hundred). 0 = no bound.
   std::size_t max_triple_points_per_face = 1000;
+  // Called once the intersecting pairs are found (faces numbered as the
+  // inputs, after welding and removing duplicate faces), before anything is
+  // cut: a caller's own work bounds, which refuse by throwing. None: no call.
+  std::function<void(const std::vector<IntersectingPair>& pairs)> pairs_found;
   Progress progress;  // called between stages
 };
 

@@ -204,6 +204,15 @@ TEST(Split, SelfIntersectionsOfOneMesh) {
   EXPECT_EQ(r.intersecting_pairs, 18u);
   EXPECT_EQ(*check(r.meshes[0]).self_intersecting_pairs, 0u);
   EXPECT_EQ(r.curve_loops, 1u);
+  // A caller's bound sees the pairs before anything is cut, and refuses by throwing.
+  std::size_t seen = 0;
+  o.pairs_found = [&](const std::vector<IntersectingPair>& pairs) {
+    seen = pairs.size();
+    for (const IntersectingPair& pair : pairs) EXPECT_TRUE(pair.a < pair.b);
+    throw WorkLimitError("too many");
+  };
+  EXPECT_THROW(splitAlongIntersections({&m}, o), WorkLimitError);
+  EXPECT_EQ(seen, 18u);
 }
 
 TEST(Split, VeryDifferentResolutions) {
