@@ -497,13 +497,14 @@ def selfintersect(repeat):
         out.append("| " + " | ".join(cells + ratios) + " |")
     if SMOKE:
         return "\n".join(out)
-    before, o = next((r["input"], r["methods"][0]) for _, r in rows if r["file"] == str(generated))
+    before, o, every = next((r["input"], r["methods"][0], r["methods"][1]) for _, r in rows
+                            if r["file"] == str(generated))
     met = succeeded(o, before) and o["median_ms"] < 100
     out += ["",
             "**Acceptance target** (issue 6): a 50k-face mesh with about 100 intersecting pairs "
             "repaired in under 100 ms. Measured on the generated mesh "
-            f"({before['faces']:,} faces, {before['remaining_pairs']:,} pairs): {time_cell(o)} ms, "
-            f"{'met' if met else 'not met'}."]
+            f"({before['faces']:,} faces, {before['remaining_pairs']:,} pairs): {time_cell(o)} ms "
+            f"on 1 thread, {'met' if met else 'not met'} ({time_cell(every)} ms on every CPU)."]
     rsi = next({m["method"]: m for m in r["methods"]}["cgal_remove_self_intersections"]
                for _, r in rows if r["file"] == str(generated))
     if succeeded(o, before) and succeeded(rsi, before):
