@@ -341,14 +341,10 @@ TEST(HoleFront, HoleAcrossASharpCornerInEveryMode) {
 
 TEST(HoleFront, HoleWrappingATubeIsTriangulatedOverADisk) {
   // A hole three quarters around an open tube: its border projects onto no
-  // plane as a simple polygon, so the front runs over a disk. The disk has
-  // more area than the surface the border bounds; its triangles grow
-  // inwards so that the patch has about as many faces as were cut out.
-  const Mesh tube = openTube(48, 24, 1, 3);
-  Mesh m = withHole(tube, [](const Point3& c) {
+  // plane as a simple polygon, so the front runs over a disk.
+  Mesh m = withHole(openTube(48, 24, 1, 3), [](const Point3& c) {
     return std::abs(std::atan2(c[1], c[0])) < 2.3 && c[2] > 1 && c[2] < 2;
   });
-  const double removed = double(tube.face.size() - m.face.size());
   const std::size_t ends = 2 * 48;
   HoleFillOptions o;
   o.selected_vertex_indices = {8 * 48};  // on the side hole's lower border (z = 1, angle 0)
@@ -358,8 +354,6 @@ TEST(HoleFront, HoleWrappingATubeIsTriangulatedOverADisk) {
   const HoleReport& side =
       *std::find_if(r.holes.begin(), r.holes.end(), [](const HoleReport& h) { return h.filled; });
   EXPECT_FALSE(side.planar_domain);
-  EXPECT_LE(double(side.faces_added), 1.5 * removed) << removed << " faces cut out";
-  EXPECT_GE(double(side.faces_added), removed / 1.5) << removed << " faces cut out";
   expectSound(m, ends);
 }
 
