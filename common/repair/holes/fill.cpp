@@ -31,11 +31,10 @@ constexpr double kRoundPatchQuality = 0.8;
 // space (measured on a coarse patch of kCoarse times the sizes) is
 // triangulated with triangles that grow inwards by kDiskGrowth per layer,
 // up to 1 / sqrt(ratio) times the border's size and at most kMostDiskScale.
-// (Growing to 1 / ratio brings a hole three quarters around a tube from 1.9
-// to 1.5 times the faces cut out, but the larger triangles stretch so much
-// in a bulging shape that its refinement, and the choice between the plane
-// and the disk, then turned on the last bits: a CAD hole got 635 faces on a
-// float host and 897 on a double one.)
+// (Not 1 / ratio, which would match the area better: triangles that large
+// stretch so far in a bulging shape that the refinement, and the choice
+// between the plane and the disk, turn on the last bits of the coordinates,
+// and a float host and a double one fill the same hole differently.)
 // The dense disk (the last fallback, the border's spacing as split) grows
 // so too, up to kMostDenseDiskScale: with the border's spacing throughout,
 // the patch over spot's large round hole had 3.6 times the faces cut out

@@ -107,11 +107,10 @@ void pretreatInput(Removal& w) {
   w.degenerateIn = collinearFaces(w.in.points, w.in.triangles);
 }
 
-// The work bounds, before anything is cut: the split's cost grows with the
-// intersecting pairs (about 0.1 ms each) and, within a face, with the
-// square of the curves crossing there.
 // The work bounds, on the pairs the split finds before it cuts anything
-// (the search is the split's own: not made twice).
+// (SplitOptions::pairs_found: the search is not made twice). The split's
+// cost grows with the intersecting pairs (about 0.1 ms each) and, within a
+// face, with the square of the curves crossing there.
 void boundWork(Removal& w, const std::vector<IntersectingPair>& pairs) {
   w.r.intersecting_pairs_before = pairs.size();
   const std::size_t bound = w.options.max_intersecting_pairs;
