@@ -14,6 +14,7 @@
 #include "common/base/timing.h"
 #include "common/exact/box_tree.h"
 #include "common/exact/predicates.h"
+#include "common/exact/vertex_fans.h"
 
 namespace meshmend {
 
@@ -35,6 +36,9 @@ struct Soup {
   // (side()).
   std::vector<Box> boxes;
   std::vector<PlaneFilter> planes;
+  // Per vertex: no two of its faces intersect (fansApartInProjection). Most
+  // candidate pairs of a mesh are neighbours around a vertex.
+  std::vector<char> fanApart;
 
   explicit Soup(const MeshArrays& mesh) : points(mesh.points), triangles(mesh.triangles) {}
   // The bounds, and with `withTree` the degenerate faces, boxes and planes.
@@ -67,6 +71,7 @@ struct Soup {
         planes[f] = PlaneFilter(a, b, c);
       }
     });
+    fanApart = fansApartInProjection(points, triangles);
   }
   const Point3& corner(std::uint32_t f, int i) const { return points[triangles[f][i]]; }
   // orient3d of face f's corners and p.
@@ -147,29 +152,36 @@ Candidates facesTouching(Soup& s, const Box& other) {
   return std::move(parts[0]);
 }
 
-// Are all three corners of face g of `gs` strictly on one side of the plane
-// of face f of `fs`?
-bool strictlyBeside(const Soup& fs, std::uint32_t f, const Soup& gs, std::uint32_t g) {
-  const int s0 = fs.side(f, gs.corner(g, 0));
-  if (s0 == 0) return false;
-  return fs.side(f, gs.corner(g, 1)) == s0 && fs.side(f, gs.corner(g, 2)) == s0;
-}
-
 // Exact: can the segment from corner i to corner j of face g meet face f?
 // False when both ends lie strictly on one side of f's plane.
 bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
   return s.side(f, s.corner(g, i)) * s.side(f, s.corner(g, j)) <= 0;
 }
 
-// The self-intersection rule for two faces of one mesh. Cheap exact plane
-// tests settle almost every pair of neighbours; the rest get the full test.
-bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
-  const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
+// Faces f and g that share no corner: their plane sides, each triangle's
+// against the other's plane, as trianglesIntersect takes them; false as
+// soon as one triangle lies strictly on one side (no contact).
+bool mayTouch(const Soup& s, std::uint32_t f, std::uint32_t g, PlaneSides& side) {
+  auto against = [&](std::uint32_t plane, std::uint32_t face, int* out) {
+    for (int i = 0; i < 3; ++i) out[i] = s.side(plane, s.corner(face, i));
+    return !(out[0] != 0 && out[1] == out[0] && out[2] == out[0]);
+  };
+  return against(f, g, side[1]) && against(g, f, side[0]);
+}
+
+// The self-intersection rule for two faces of one mesh that share the
+// corners `c` (fewer than three). Fans that project one-to-one and cheap
+// exact plane tests settle almost every pair of neighbours; the rest get the
+// full test.
+bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const SharedCorners& c) {
+  const Triangle& tf = s.triangles[f];
   switch (c.count) {
-    case 0:
-      if (strictlyBeside(s, f, s, g) || strictlyBeside(s, g, s, f)) return false;
-      break;
+    case 0: {
+      PlaneSides side;
+      return mayTouch(s, f, g, side) && trianglesIntersect(s.at(f), s.at(g), side);
+    }
     case 1:
+      if (s.fanApart[tf[c.ia]]) return false;
       // When either face's edge opposite the shared corner lies strictly on
       // one side of the other's plane, that face meets the plane only at the
       // shared corner: nothing beyond it. Both edges must reach the plane.
@@ -177,11 +189,10 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g) {
           !edgeMayMeet(s, g, (c.ib + 1) % 3, (c.ib + 2) % 3, f))
         return false;
       break;
-    case 2:  // folded faces are coplanar: the other's apex must lie in the plane
-      if (s.side(f, s.corner(g, c.ib)) != 0) return false;
-      break;
-    default:
-      return true;
+    default:  // folded faces are coplanar: the other's apex must lie in the plane
+      if (s.fanApart[tf[(c.ia + 1) % 3]] || s.fanApart[tf[(c.ia + 2) % 3]] ||
+          s.side(f, s.corner(g, c.ib)) != 0)
+        return false;
   }
   return intersectBeyondShared(s.at(f), s.at(g), c.count, c.ia, c.ib);
 }
@@ -263,8 +274,8 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
     trees[m]->selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
       if (s.degenerate[f] || s.degenerate[g]) return;
       ++found[worker].candidates;
-      if ((options.same_vertices || !sameVertices(s.triangles[f], s.triangles[g])) &&
-          selfIntersect(s, f, g))
+      const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
+      if (c.count == 3 ? options.same_vertices : selfIntersect(s, f, g, c))
         found[worker].pairs.push_back(
             {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
     });
