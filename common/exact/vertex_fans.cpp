@@ -11,9 +11,6 @@ namespace meshmend {
 
 namespace {
 
-// Longer fans are rare and left to the full test.
-constexpr int kMaxFan = 32;
-
 // Face (v, a, b) seen from its corner v: the edge of v's link it adds.
 struct Link {
   int a, b;
@@ -46,24 +43,20 @@ Links linksOf(std::size_t vertexCount, const std::vector<Triangle>& triangles) {
 // v in its faces? The fan's link edges then form closed walks, each of
 // which turns around v at least once in any projection where every face
 // turns the same way; oneToOne's single turn leaves one walk: one closed,
-// consistently oriented fan. (Comparisons without branches: which of them
-// hold is as good as random, and sorting mispredicted more than it saved.)
-bool closedFan(const Link* links, int k) {
-  int a[kMaxFan], b[kMaxFan];
-  for (int i = 0; i < k; ++i) {
-    a[i] = links[i].a;
-    b[i] = links[i].b;
+// consistently oriented fan. `seen` holds a mark per vertex, and `mark`
+// and `mark` + 1 are used by no other vertex's test.
+bool closedFan(const Link* links, int k, std::uint32_t* seen, std::uint32_t mark) {
+  for (int i = 0; i < k; ++i) {  // the first corners, each once
+    std::uint32_t& m = seen[links[i].a];
+    if (m == mark) return false;
+    m = mark;
   }
-  bool bad = false;
-  for (int i = 0; i < k; ++i) {
-    bool found = false;
-    for (int j = 0; j < k; ++j) {
-      found |= b[i] == a[j];
-      bad |= (j > i) & ((a[i] == a[j]) | (b[i] == b[j]));
-    }
-    bad |= !found;
+  for (int i = 0; i < k; ++i) {  // the second ones, each a first one, once
+    std::uint32_t& m = seen[links[i].b];
+    if (m != mark) return false;
+    m = mark + 1;
   }
-  return !bad;
+  return true;
 }
 
 // The axis along which the normals of two faces across the fan sum largest
@@ -107,11 +100,14 @@ std::vector<char> fansApartInProjection(const std::vector<Point3>& points,
   const Links in = linksOf(points.size(), triangles);
   std::vector<char> apart;
   resizeInHugePages(apart, points.size());
-  parallelChunks(points.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+  std::vector<std::vector<std::uint32_t>> seen(workerCount());  // closedFan's, per worker
+  parallelChunks(points.size(), [&](std::size_t begin, std::size_t end, unsigned worker) {
+    if (seen[worker].empty()) seen[worker].assign(points.size(), 0);
     for (std::size_t v = begin; v < end; ++v) {
       const Link* links = &in.links[in.offsets[v]];
       const int k = int(in.offsets[v + 1] - in.offsets[v]);
-      apart[v] = k >= 3 && k <= kMaxFan && closedFan(links, k) &&
+      // Vertex indices are ints: 2v + 2 fits.
+      apart[v] = k >= 3 && closedFan(links, k, seen[worker].data(), std::uint32_t(2 * v + 1)) &&
                  oneToOne(points[v], points, links, k, dominantAxis(points[v], points, links, k));
     }
   });
