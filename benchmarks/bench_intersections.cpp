@@ -3,7 +3,7 @@
 // inputs in the same run. Prints one JSON object.
 //
 // With two meshes: cross pairs (ours; CGAL box_intersection_d + do_intersect;
-// ours with the alternative Morton-order hierarchy), and the self-
+// ours with median-split hierarchies, no hashed grid), and the self-
 // intersections of the two joined into one mesh (ours; CGAL
 // PMP::self_intersections; the alternative layout), which is the same job for
 // all. With one mesh: its self-intersections (ours; CGAL; alternative).
@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
                               mb = std::make_shared<Mesh>(readMesh(b));
                          return std::function<long()>([=] { return cgalCross(*ma, *mb); });
                        }});
-    methods.push_back({"meshmend_cross_morton_layout", "alternative", [=] {
+    methods.push_back({"meshmend_cross_median_layout", "alternative", [=] {
                          auto ma = std::make_shared<Mesh>(readMesh(a)),
                               mb = std::make_shared<Mesh>(readMesh(b));
                          return std::function<long()>([=] {
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
          return std::function<long()>(
              [=] { return tm ? cgalSelfIntersections(*tm) : cgalSoupSelfIntersections(*m); });
        }});
-  methods.push_back({join ? "meshmend_self_joined_morton_layout" : "meshmend_self_morton_layout",
+  methods.push_back({join ? "meshmend_self_joined_median_layout" : "meshmend_self_median_layout",
                      "alternative", [=] {
                        auto m = std::make_shared<Mesh>(join ? appended(readMesh(a), readMesh(b))
                                                             : readMesh(a));

@@ -175,12 +175,13 @@ def intersections(repeat):
            "",
            "**Cross-intersections (bunny + dragon, as stored).** Ours: `findIntersections` between the two "
            "meshes. CGAL: `box_intersection_d` on the face boxes + exact `do_intersect` (Epick), the way "
-           "CGAL users find pairs between two meshes. Alternative: ours with the Morton-order hierarchy.",
+           "CGAL users find pairs between two meshes. Alternative: ours with median-split hierarchies "
+           "(no hashed grid between the meshes, no Morton-order hierarchy within each).",
            "",
-           "| input | faces | pairs | ours ms | CGAL ms | CGAL / ours | Morton layout ms | ours peak MB | CGAL peak MB |",
+           "| input | faces | pairs | ours ms | CGAL ms | CGAL / ours | median-split layout ms | ours peak MB | CGAL peak MB |",
            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for label, fa, fb, by in rows:
-        o, c, alt = by["meshmend_cross"], by["cgal_box_intersection_d_cross"], by["meshmend_cross_morton_layout"]
+        o, c, alt = by["meshmend_cross"], by["cgal_box_intersection_d_cross"], by["meshmend_cross_median_layout"]
         ratio = f"{c['median_ms'] / o['median_ms']:.1f}×" if o.get("ok") and c.get("ok") else "–"
         agree = "" if not c.get("ok") or c["result"] == o["result"] else " (differ!)"
         ours = cell(o)
@@ -195,11 +196,11 @@ def intersections(repeat):
             "refuses, so there CGAL runs `box_self_intersection_d` with the same rule and its exact "
             "predicates (as `meshcheck` does).",
             "",
-            "| input | faces | pairs | ours ms | CGAL ms | CGAL / ours | Morton layout ms | ours peak MB | CGAL peak MB |",
+            "| input | faces | pairs | ours ms | CGAL ms | CGAL / ours | median-split layout ms | ours peak MB | CGAL peak MB |",
             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for label, fa, fb, by in rows:
         o, c = by["meshmend_self_joined"], by["cgal_self_intersections_joined"]
-        alt = by["meshmend_self_joined_morton_layout"]
+        alt = by["meshmend_self_joined_median_layout"]
         ratio = f"{c['median_ms'] / o['median_ms']:.1f}×" if o.get("ok") and c.get("ok") else "–"
         agree = "" if not c.get("ok") or c["result"] == o["result"] else " (differ!)"
         out.append(f"| bunny + dragon {label} | {fa + fb:,} | {o['result']:,}{agree} | {cell(o)} | {cell(c)} | "

@@ -325,8 +325,10 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
   std::iota(order_.begin(), order_.end(), 0u);
   if (boxes_.empty()) return;
   if (layout == Layout::kMorton) {
-    sortByMorton();
+    resizeInHugePages(codes_, boxes_.size());
+    sortByMorton(0, std::uint32_t(boxes_.size()));
     buildParallel(false);
+    codes_ = {};
     return;
   }
   resizeInHugePages(centres_, boxes_.size());
@@ -341,7 +343,8 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
 
 // Builds the two halves of the root in parallel (for large inputs), then joins
 // them under the root. With `splitByMedian`, the halves are the two sides of
-// the median along the widest axis; otherwise the current order is kept.
+// the median along the widest axis; otherwise the current (Morton) order is
+// kept and split by mortonSplit.
 void BoxTree::buildParallel(bool splitByMedian) {
   const std::uint32_t n = std::uint32_t(boxes_.size());
   auto one = [&](std::uint32_t b, std::uint32_t e, std::vector<Node>& out) {
@@ -367,7 +370,7 @@ void BoxTree::buildParallel(bool splitByMedian) {
       centers.hi[k] = std::max(centers.hi[k], c);
     }
   }
-  const std::uint32_t mid = n / 2;
+  const std::uint32_t mid = splitByMedian ? n / 2 : mortonSplit(0, n);
   if (splitByMedian) {
     int axis = 0;
     for (int k = 1; k < 3; ++k)
@@ -412,28 +415,32 @@ std::uint32_t spread(std::uint32_t x) {
 
 }  // namespace
 
-// Orders the primitives along a Morton curve through their box centres
-// (10 bits per axis, least-significant-digit radix sort).
-void BoxTree::sortByMorton() {
+// Orders the primitives order_[begin..end) along a Morton curve through their
+// box centres, within those centres' bounds (10 bits per axis,
+// least-significant-digit radix sort), and sets their codes_.
+void BoxTree::sortByMorton(std::uint32_t begin, std::uint32_t end) {
   Box centers{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
-  for (const Box& b : boxes_)
+  for (std::uint32_t i = begin; i < end; ++i)
     for (int k = 0; k < 3; ++k) {
+      const Box& b = boxes_[order_[i]];
       const float c = 0.5f * (b.lo[k] + b.hi[k]);
       centers.lo[k] = std::min(centers.lo[k], c);
       centers.hi[k] = std::max(centers.hi[k], c);
     }
-  const std::size_t n = boxes_.size();
-  std::vector<std::uint32_t> code(n), tmpCode(n), tmpOrder(n);
+  const std::size_t n = end - begin;
+  std::uint32_t* code = codes_.data() + begin;
+  std::uint32_t* order = order_.data() + begin;
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t q[3];
     for (int k = 0; k < 3; ++k) {
       const float extent = centers.hi[k] - centers.lo[k];
-      const float c = 0.5f * (boxes_[i].lo[k] + boxes_[i].hi[k]);
+      const float c = 0.5f * (boxes_[order[i]].lo[k] + boxes_[order[i]].hi[k]);
       const float t = extent > 0 ? (c - centers.lo[k]) / extent : 0.f;
       q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, t * 1023.f)));
     }
     code[i] = spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2);
   }
+  std::vector<std::uint32_t> tmpCode(n), tmpOrder(n);
   for (int shift = 0; shift < 30; shift += 10) {  // three passes of 10 bits
     std::vector<std::uint32_t> count(1025, 0);
     for (std::size_t i = 0; i < n; ++i) ++count[((code[i] >> shift) & 1023) + 1];
@@ -441,10 +448,10 @@ void BoxTree::sortByMorton() {
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint32_t slot = count[(code[i] >> shift) & 1023]++;
       tmpCode[slot] = code[i];
-      tmpOrder[slot] = order_[i];
+      tmpOrder[slot] = order[i];
     }
-    code.swap(tmpCode);
-    order_.swap(tmpOrder);
+    std::copy(tmpCode.begin(), tmpCode.end(), code);
+    std::copy(tmpOrder.begin(), tmpOrder.end(), order);
   }
 }
 
@@ -474,8 +481,20 @@ std::uint32_t BoxTree::groups(std::uint32_t n, std::uint32_t most, std::vector<L
   return size;
 }
 
-// A balanced hierarchy over the current order: split every range at its middle.
-void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) const {
+// Where the sorted codes of begin..end first have their highest differing
+// bit set (the middle where all are equal): the two sides are the halves of
+// the curve's cell that holds the range.
+std::uint32_t BoxTree::mortonSplit(std::uint32_t begin, std::uint32_t end) const {
+  const std::uint32_t first = codes_[begin], last = codes_[end - 1];
+  if (first == last) return begin + (end - begin) / 2;
+  const std::uint32_t bit = std::uint32_t(1) << (31 - __builtin_clz(first ^ last));
+  return std::uint32_t(std::partition_point(codes_.begin() + begin, codes_.begin() + end,
+                                            [bit](std::uint32_t code) { return !(code & bit); }) -
+                       codes_.begin());
+}
+
+// A hierarchy over the Morton order: each range split by mortonSplit.
+void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) {
   const std::uint32_t self = std::uint32_t(out.size());
   out.push_back({});
   if (end - begin <= kLeafSize) {
@@ -484,7 +503,11 @@ void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<N
     out[self] = {box, begin, (end - begin) | kLeaf};
     return;
   }
-  const std::uint32_t mid = begin + (end - begin) / 2;
+  // A cluster finer than the codes' cells (a small, detailed part far from
+  // the rest) is coded again within its own bounds: otherwise it would be
+  // split in an arbitrary order, into children that all overlap.
+  if (codes_[begin] == codes_[end - 1]) sortByMorton(begin, end);
+  const std::uint32_t mid = mortonSplit(begin, end);
   const std::uint32_t left = std::uint32_t(out.size());
   buildInOrder(begin, mid, out);
   const std::uint32_t right = std::uint32_t(out.size());

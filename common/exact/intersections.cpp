@@ -266,7 +266,7 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
   for (std::size_t m = 0; m < n; ++m)
     trees.push_back(std::make_shared<const BoxTree>(
         std::move(soups[m].boxes),
-        options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit));
+        options.layout == 1 ? BoxTree::Layout::kMedianSplit : BoxTree::Layout::kMorton));
   r.build_ms = msSince(buildStart);
   for (std::size_t m = 0; m < n; ++m) {
     reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
@@ -323,8 +323,7 @@ void searchBetween(std::vector<Soup>& soups, std::size_t m, std::size_t k,
     if (options.layout == 0) grid.emplace(sc.boxes);
     if (!grid || !grid->suits(lc.boxes)) {
       grid.reset();
-      tree.emplace(sc.boxes,
-                   options.layout == 1 ? BoxTree::Layout::kMorton : BoxTree::Layout::kMedianSplit);
+      tree.emplace(sc.boxes, BoxTree::Layout::kMedianSplit);
     }
     planesAside.wait();
   }

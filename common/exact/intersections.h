@@ -28,7 +28,11 @@ struct FindIntersectionsOptions {
   // nothing in them and no rounding moves them apart: the split and its
   // checks of the float result leave them out.
   bool same_vertices = true;
-  int layout = 0;  // candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy
+  // The candidate search: 0 (the default) a Morton-order hierarchy of each
+  // mesh's faces for its own pairs, and between meshes a hashed grid (a
+  // median-split hierarchy where it does not suit); 1 median-split
+  // hierarchies for both (the alternative the benchmarks measure).
+  int layout = 0;
   // Hand each mesh's tree of its faces' boxes (built for `self`) to the
   // result's face_trees, for later searches near a few faces.
   bool keep_trees = false;

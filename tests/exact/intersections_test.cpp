@@ -353,15 +353,9 @@ TEST(Intersections, BadInput) {
   EXPECT_THROW(findIntersections({&nan}), InvalidInputError);
 }
 
-TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(0, 10);
-  std::vector<Box> boxes;
-  for (int i = 0; i < 30000; ++i) {
-    const Point3 a(u(rng), u(rng), u(rng));
-    boxes.push_back(boxOf(a, a + Point3(0.1, 0.2, 0.1), a + Point3(0.2, 0.05, 0.15)));
-  }
-  const BoxTree tree(boxes);
+// The tree's self-join and a query against brute force.
+void expectTreeFindsEveryOverlap(const std::vector<Box>& boxes, BoxTree::Layout layout) {
+  const BoxTree tree(boxes, layout);
   std::vector<std::size_t> perWorker(workerCount(), 0);
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned w) {
     EXPECT_LT(i, j);
@@ -379,12 +373,41 @@ TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
     for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo[0] <= boxes[order[i]].hi[0];
          ++j)
       expected += overlap(boxes[order[i]], boxes[order[j]]);
+  EXPECT_GT(expected, 0u);
   EXPECT_EQ(pairs, expected);
   std::size_t hits = 0;
   tree.query(boxes[17], 0, [&](std::uint32_t, unsigned) { ++hits; });
   std::size_t expectedHits = 0;
   for (const Box& b : boxes) expectedHits += overlap(b, boxes[17]);
   EXPECT_EQ(hits, expectedHits);
+}
+
+TEST(BoxTree, QueryAndSelfPairsFindEveryOverlap) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 10);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 30000; ++i) {
+    const Point3 a(u(rng), u(rng), u(rng));
+    boxes.push_back(boxOf(a, a + Point3(0.1, 0.2, 0.1), a + Point3(0.2, 0.05, 0.15)));
+  }
+  expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMedianSplit);
+  expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMorton);
+}
+
+// A cluster far smaller than the whole extent (one box far away): the
+// Morton codes of the cluster are all equal, and its ranges are split at
+// their middle.
+TEST(BoxTree, ClusteredBoxesWithAnOutlierFindEveryOverlap) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(0, 1e-3);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 25000; ++i) {
+    const Point3 a(u(rng), u(rng), u(rng));
+    boxes.push_back(boxOf(a, a + Point3(2e-5, 1e-5, 0), a + Point3(0, 2e-5, 1e-5)));
+  }
+  boxes.push_back(boxOf(Point3(1e6, 1e6, 1e6)));
+  expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMorton);
+  expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMedianSplit);
 }
 
 // Every query reports exactly the boxes that overlap it (touching counts),
