@@ -329,6 +329,7 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
     sortByMorton(0, std::uint32_t(boxes_.size()));
     buildParallel(false);
     codes_ = {};
+    orderBoxes();
     return;
   }
   resizeInHugePages(centres_, boxes_.size());
@@ -339,6 +340,12 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
   buildParallel(true);
   for (std::size_t i = 0; i < centres_.size(); ++i) order_[i] = centres_[i].index;
   centres_ = {};
+  orderBoxes();
+}
+
+void BoxTree::orderBoxes() {
+  resizeInHugePages(ordered_, boxes_.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) ordered_[i] = boxes_[order_[i]];
 }
 
 // Builds the two halves of the root in parallel (for large inputs), then joins

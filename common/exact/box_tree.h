@@ -254,6 +254,7 @@ class BoxTree {
   void sortByMorton(std::uint32_t begin, std::uint32_t end);
   std::uint32_t mortonSplit(std::uint32_t begin, std::uint32_t end) const;
   void buildParallel(bool splitByMedian);
+  void orderBoxes();
 
   template <class Visit>
   void within(std::uint32_t n, unsigned worker, Visit& visit) const;
@@ -270,6 +271,7 @@ class BoxTree {
 
   std::vector<Box> boxes_;
   std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
+  std::vector<Box> ordered_;          // boxes_[order_[i]]: a leaf's boxes side by side
   // While a median-split hierarchy is built: per primitive in the current
   // order, lo + hi of its box on each axis and its index. Selecting medians
   // on these, next to each other in memory, does the same as on order_ with
@@ -294,8 +296,10 @@ void BoxTree::within(std::uint32_t n, unsigned worker, Visit& visit) const {
     const std::uint32_t first = node.a, last = node.a + count(node);
     for (std::uint32_t i = first; i < last; ++i)
       for (std::uint32_t j = i + 1; j < last; ++j) {
-        const std::uint32_t p = order_[i], q = order_[j];
-        if (overlap(boxes_[p], boxes_[q])) visit(std::min(p, q), std::max(p, q), worker);
+        if (overlap(ordered_[i], ordered_[j])) {
+          const std::uint32_t p = order_[i], q = order_[j];
+          visit(std::min(p, q), std::max(p, q), worker);
+        }
       }
     return;
   }
@@ -310,13 +314,13 @@ void BoxTree::between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& 
   if (!overlap(nx.box, ny.box)) return;
   if (leaf(nx) && leaf(ny)) {
     for (std::uint32_t i = nx.a; i < nx.a + count(nx); ++i) {
-      const std::uint32_t p = order_[i];
-      const Box& bp = boxes_[p];
+      const Box& bp = ordered_[i];
       if (!overlap(bp, ny.box)) continue;
-      for (std::uint32_t j = ny.a; j < ny.a + count(ny); ++j) {
-        const std::uint32_t q = order_[j];
-        if (overlap(bp, boxes_[q])) visit(std::min(p, q), std::max(p, q), worker);
-      }
+      for (std::uint32_t j = ny.a; j < ny.a + count(ny); ++j)
+        if (overlap(bp, ordered_[j])) {
+          const std::uint32_t p = order_[i], q = order_[j];
+          visit(std::min(p, q), std::max(p, q), worker);
+        }
     }
     return;
   }
@@ -396,7 +400,7 @@ void BoxTree::query(const Box& q, unsigned worker, Visit&& visit) const {
     if (!overlap(n.box, q)) continue;
     if (leaf(n)) {
       for (std::uint32_t i = n.a; i < n.a + count(n); ++i)
-        if (overlap(boxes_[order_[i]], q)) visit(order_[i], worker);
+        if (overlap(ordered_[i], q)) visit(order_[i], worker);
     } else {
       stack[top++] = n.a;
       stack[top++] = n.b;

@@ -32,16 +32,14 @@ struct Soup {
   bool degenerateKnown = false;
   Box bounds{{1, 1, 1}, {0, 0, 0}};  // of every point, rounded outward to float
   // Only for the search within the mesh (`withTree`): every face's box
-  // (moved into the mesh's tree) and the filter of its exact plane sides
-  // (side()).
+  // (moved into the mesh's tree).
   std::vector<Box> boxes;
-  std::vector<PlaneFilter> planes;
   // Per vertex: no two of its faces intersect (fansApartInProjection). Most
   // candidate pairs of a mesh are neighbours around a vertex.
   std::vector<char> fanApart;
 
   explicit Soup(const MeshArrays& mesh) : points(mesh.points), triangles(mesh.triangles) {}
-  // The bounds, and with `withTree` the degenerate faces, boxes and planes.
+  // The bounds, and with `withTree` the degenerate faces, boxes and fans.
   void prepare(bool withTree) {
     Point3 lo = points.empty() ? Point3(0, 0, 0) : points[0], hi = lo;
     for (const Point3& p : points)
@@ -61,23 +59,23 @@ struct Soup {
       for (std::size_t v = begin; v < end; ++v) pointBoxes[v] = boxOf(points[v]);
     });
     resizeInHugePages(boxes, triangles.size());
-    resizeInHugePages(planes, triangles.size());
     parallelChunks(triangles.size(), [&](std::size_t begin, std::size_t end, unsigned) {
       for (std::size_t f = begin; f < end; ++f) {
         const Triangle& t = triangles[f];
         const Point3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
         boxes[f] = hull(pointBoxes[t[0]], pointBoxes[t[1]], pointBoxes[t[2]]);
         degenerate[f] = collinear(a, b, c);
-        planes[f] = PlaneFilter(a, b, c);
       }
     });
     fanApart = fansApartInProjection(points, triangles);
   }
   const Point3& corner(std::uint32_t f, int i) const { return points[triangles[f][i]]; }
-  // orient3d of face f's corners and p.
-  int side(std::uint32_t f, const Point3& p) const {
-    const Triangle& t = triangles[f];
-    return planes[f].side(points[t[0]], points[t[1]], points[t[2]], p);
+  // The exact sides of points against face f's plane. Made for a pair, not
+  // kept per face: the fans settle most pairs without one, and a filter per
+  // face took twice the memory of the boxes.
+  PlaneSide plane(std::uint32_t f) const {
+    const TrianglePoints t = at(f);
+    return PlaneSide(t[0], t[1], t[2]);
   }
   TrianglePoints at(std::uint32_t f) const {
     const Triangle& t = triangles[f];
@@ -155,7 +153,8 @@ Candidates facesTouching(Soup& s, const Box& other) {
 // Exact: can the segment from corner i to corner j of face g meet face f?
 // False when both ends lie strictly on one side of f's plane.
 bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
-  return s.side(f, s.corner(g, i)) * s.side(f, s.corner(g, j)) <= 0;
+  const PlaneSide side = s.plane(f);
+  return side(s.corner(g, i)) * side(s.corner(g, j)) <= 0;
 }
 
 // Faces f and g that share no corner: their plane sides, each triangle's
@@ -163,7 +162,8 @@ bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) 
 // soon as one triangle lies strictly on one side (no contact).
 bool mayTouch(const Soup& s, std::uint32_t f, std::uint32_t g, PlaneSides& side) {
   auto against = [&](std::uint32_t plane, std::uint32_t face, int* out) {
-    for (int i = 0; i < 3; ++i) out[i] = s.side(plane, s.corner(face, i));
+    const PlaneSide sideOf = s.plane(plane);
+    for (int i = 0; i < 3; ++i) out[i] = sideOf(s.corner(face, i));
     return !(out[0] != 0 && out[1] == out[0] && out[2] == out[0]);
   };
   return against(f, g, side[1]) && against(g, f, side[0]);
@@ -191,7 +191,7 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const Shared
       break;
     default:  // folded faces are coplanar: the other's apex must lie in the plane
       if (s.fanApart[tf[(c.ia + 1) % 3]] || s.fanApart[tf[(c.ia + 2) % 3]] ||
-          s.side(f, s.corner(g, c.ib)) != 0)
+          s.plane(f)(s.corner(g, c.ib)) != 0)
         return false;
   }
   return intersectBeyondShared(s.at(f), s.at(g), c.count, c.ia, c.ib);
