@@ -437,29 +437,38 @@ void BoxTree::sortByMorton(std::uint32_t begin, std::uint32_t end) {
   const std::size_t n = end - begin;
   std::uint32_t* code = codes_.data() + begin;
   std::uint32_t* order = order_.data() + begin;
+  float scale[3];  // any map that keeps the centres' order will do
+  for (int k = 0; k < 3; ++k) {
+    const float extent = centers.hi[k] - centers.lo[k];
+    scale[k] = extent > 0 ? 1023.f / extent : 0.f;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t q[3];
     for (int k = 0; k < 3; ++k) {
-      const float extent = centers.hi[k] - centers.lo[k];
       const float c = 0.5f * (boxes_[order[i]].lo[k] + boxes_[order[i]].hi[k]);
-      const float t = extent > 0 ? (c - centers.lo[k]) / extent : 0.f;
-      q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, t * 1023.f)));
+      q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, (c - centers.lo[k]) * scale[k])));
     }
     code[i] = spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2);
   }
-  std::vector<std::uint32_t> tmpCode(n), tmpOrder(n);
-  for (int shift = 0; shift < 30; shift += 10) {  // three passes of 10 bits
-    std::vector<std::uint32_t> count(1025, 0);
-    for (std::size_t i = 0; i < n; ++i) ++count[((code[i] >> shift) & 1023) + 1];
+  // Three passes of 10 bits, back and forth between the arrays and a copy.
+  std::vector<std::uint32_t> otherCode(n), otherOrder(n);
+  std::uint32_t *fromCode = code, *fromOrder = order, *toCode = otherCode.data(),
+                *toOrder = otherOrder.data();
+  std::uint32_t count[1025];
+  for (int shift = 0; shift < 30; shift += 10) {
+    std::fill(count, count + 1025, 0);
+    for (std::size_t i = 0; i < n; ++i) ++count[((fromCode[i] >> shift) & 1023) + 1];
     for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t slot = count[(code[i] >> shift) & 1023]++;
-      tmpCode[slot] = code[i];
-      tmpOrder[slot] = order[i];
+      const std::uint32_t slot = count[(fromCode[i] >> shift) & 1023]++;
+      toCode[slot] = fromCode[i];
+      toOrder[slot] = fromOrder[i];
     }
-    std::copy(tmpCode.begin(), tmpCode.end(), code);
-    std::copy(tmpOrder.begin(), tmpOrder.end(), order);
+    std::swap(fromCode, toCode);
+    std::swap(fromOrder, toOrder);
   }
+  std::copy(fromCode, fromCode + n, code);  // an odd number of passes: from the copy
+  std::copy(fromOrder, fromOrder + n, order);
 }
 
 void BoxTree::groups(std::uint32_t most, std::vector<Leaf>& leaves,
