@@ -61,8 +61,8 @@ bool closedFan(const Link* links, int k, std::uint32_t* seen, std::uint32_t mark
 
 // The axis along which the normals of two faces across the fan sum largest
 // (as rounded, and from two faces only: any axis gives an exact answer, and
-// this one all but a few in a hundred thousand of the fans that the summed
-// normal of all faces sets apart).
+// on the dragon this one sets apart all but one in ten thousand of the fans
+// that the summed normal of all faces does).
 int dominantAxis(const Point3& v, const std::vector<Point3>& P, const Link* links, int k) {
   auto normal = [&](const Link& l) {
     return (P[std::size_t(l.a)] - v) ^ (P[std::size_t(l.b)] - v);
