@@ -343,9 +343,16 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
   orderBoxes();
 }
 
+// The boxes in leaf order, and where each one went; the boxes as given are
+// no longer needed.
 void BoxTree::orderBoxes() {
   resizeInHugePages(ordered_, boxes_.size());
-  for (std::size_t i = 0; i < order_.size(); ++i) ordered_[i] = boxes_[order_[i]];
+  resizeInHugePages(place_, boxes_.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    ordered_[i] = boxes_[order_[i]];
+    place_[order_[i]] = std::uint32_t(i);
+  }
+  boxes_ = {};
 }
 
 // Builds the two halves of the root in parallel (for large inputs), then joins

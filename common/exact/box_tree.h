@@ -205,8 +205,8 @@ class BoxTree {
   // Builds the hierarchy over `boxes` (primitive i = boxes[i]), using both cores.
   explicit BoxTree(std::vector<Box> boxes, Layout layout = Layout::kMedianSplit);
 
-  std::size_t size() const { return boxes_.size(); }
-  const std::vector<Box>& boxes() const { return boxes_; }  // as given
+  std::size_t size() const { return order_.size(); }
+  const Box& box(std::uint32_t i) const { return ordered_[place_[i]]; }  // boxes[i], as given
   const Box& bounds() const { return nodes_.empty() ? empty_ : nodes_[0].box; }
 
   // Calls visit(i, j, worker) once for every pair i < j of overlapping boxes,
@@ -269,9 +269,10 @@ class BoxTree {
   void pairTasks(std::uint32_t x, std::uint32_t y, int depth,
                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
 
-  std::vector<Box> boxes_;
+  std::vector<Box> boxes_;            // as given, while the hierarchy is built
   std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
   std::vector<Box> ordered_;          // boxes_[order_[i]]: a leaf's boxes side by side
+  std::vector<std::uint32_t> place_;  // where primitive i is in order_
   // While a median-split hierarchy is built: per primitive in the current
   // order, lo + hi of its box on each axis and its index. Selecting medians
   // on these, next to each other in memory, does the same as on order_ with

@@ -604,13 +604,12 @@ void markNear(const BoxTree& tree, const BoxTree& changed, std::atomic<std::uint
   std::vector<BoxTree::Leaf> leaves;
   std::vector<BoxTree::Group> groups;
   changed.groups(kNearFaceGroup, leaves, groups);
-  const std::vector<Box>&boxes = changed.boxes(), &own = tree.boxes();
   auto overlapsGroup = [&](const Box& b, const BoxTree::Group& group) {
     for (std::uint32_t l = group.firstLeaf; l < group.firstLeaf + group.leafCount; ++l) {
       const BoxTree::Leaf& leaf = leaves[l];
       if (!overlap(b, leaf.box)) continue;
       for (std::uint32_t i = 0; i < leaf.count; ++i)
-        if (overlap(b, boxes[leaf.first[i]])) return true;
+        if (overlap(b, changed.box(leaf.first[i]))) return true;
     }
     return false;
   };
@@ -619,7 +618,7 @@ void markNear(const BoxTree& tree, const BoxTree& changed, std::atomic<std::uint
       [&](std::size_t begin, std::size_t end, unsigned worker) {
         for (std::size_t g = begin; g < end; ++g)
           tree.query(groups[g].box, worker, [&](std::uint32_t j, unsigned) {
-            if (!taken[j].load(std::memory_order_relaxed) && overlapsGroup(own[j], groups[g]))
+            if (!taken[j].load(std::memory_order_relaxed) && overlapsGroup(tree.box(j), groups[g]))
               taken[j].store(1, std::memory_order_relaxed);
           });
       },
