@@ -365,7 +365,7 @@ void BoxTree::buildParallel(bool splitByMedian) {
     if (splitByMedian)
       build(b, e, out);
     else
-      buildInOrder(b, e, out);
+      buildInOrder(b, e, out, n < 20000 ? 0 : 1);  // the large root's split is made below
   };
   // Leaves hold four to eight boxes, so a tree over m boxes has fewer than m
   // nodes: each part's room is made once.
@@ -478,6 +478,22 @@ void BoxTree::sortByMorton(std::uint32_t begin, std::uint32_t end) {
   std::copy(fromOrder, fromOrder + n, order);
 }
 
+int BoxTree::depth() const {
+  int deepest = 0;
+  std::vector<std::pair<std::uint32_t, int>> open;
+  if (!nodes_.empty()) open.push_back({0, 0});
+  while (!open.empty()) {
+    const auto [n, d] = open.back();
+    open.pop_back();
+    deepest = std::max(deepest, d);
+    if (!leaf(nodes_[n])) {
+      open.push_back({nodes_[n].a, d + 1});
+      open.push_back({nodes_[n].b, d + 1});
+    }
+  }
+  return deepest;
+}
+
 void BoxTree::groups(std::uint32_t most, std::vector<Leaf>& leaves,
                      std::vector<Group>& groups) const {
   leaves.clear();
@@ -516,8 +532,14 @@ std::uint32_t BoxTree::mortonSplit(std::uint32_t begin, std::uint32_t end) const
                        codes_.begin());
 }
 
-// A hierarchy over the Morton order: each range split by mortonSplit.
-void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out) {
+// A hierarchy over the Morton order: each range split by mortonSplit, and
+// at its middle from kDeepestCodeSplit on. Splits at the codes' bits can be
+// as uneven as the boxes are (a part graded towards a point, coded again
+// within each cluster, would split off a few boxes per level); the middle
+// bounds the depth by kDeepestCodeSplit + log2(size), which query()'s stack
+// and the traversals' recursion rely on.
+void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out,
+                           int depth) {
   const std::uint32_t self = std::uint32_t(out.size());
   out.push_back({});
   if (end - begin <= kLeafSize) {
@@ -529,12 +551,13 @@ void BoxTree::buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<N
   // A cluster finer than the codes' cells (a small, detailed part far from
   // the rest) is coded again within its own bounds: otherwise it would be
   // split in an arbitrary order, into children that all overlap.
-  if (codes_[begin] == codes_[end - 1]) sortByMorton(begin, end);
-  const std::uint32_t mid = mortonSplit(begin, end);
+  const bool byCode = depth < kDeepestCodeSplit;
+  if (byCode && codes_[begin] == codes_[end - 1]) sortByMorton(begin, end);
+  const std::uint32_t mid = byCode ? mortonSplit(begin, end) : begin + (end - begin) / 2;
   const std::uint32_t left = std::uint32_t(out.size());
-  buildInOrder(begin, mid, out);
+  buildInOrder(begin, mid, out, depth + 1);
   const std::uint32_t right = std::uint32_t(out.size());
-  buildInOrder(mid, end, out);
+  buildInOrder(mid, end, out, depth + 1);
   Box box = out[left].box;
   grow(box, out[right].box);
   out[self] = {box, left, right};

@@ -207,6 +207,9 @@ class BoxTree {
 
   std::size_t size() const { return order_.size(); }
   const Box& box(std::uint32_t i) const { return ordered_[place_[i]]; }  // boxes[i], as given
+  // The number of nodes on the longest path from the root to a leaf, less
+  // one (0 for a single leaf): at most 61, for query()'s stack.
+  int depth() const;
   const Box& bounds() const { return nodes_.empty() ? empty_ : nodes_[0].box; }
 
   // Calls visit(i, j, worker) once for every pair i < j of overlapping boxes,
@@ -245,12 +248,16 @@ class BoxTree {
   // deep; the leaves' extra box tests cost less), with six 1 % fewer and
   // with twelve as many, while the output stage's search did more.
   static constexpr std::uint32_t kLeafSize = 8;
+  // Below this depth a Morton-order hierarchy splits at its codes' bits, from
+  // it on at the middle: leaves lie at most 32 + 29 deep (2^32 boxes, eight
+  // a leaf), within query()'s stack of 64.
+  static constexpr int kDeepestCodeSplit = 32;
 
   bool leaf(const Node& n) const { return n.b & kLeaf; }
   std::uint32_t count(const Node& n) const { return n.b & ~kLeaf; }
 
   void build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out);
-  void buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out);
+  void buildInOrder(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out, int depth);
   void sortByMorton(std::uint32_t begin, std::uint32_t end);
   std::uint32_t mortonSplit(std::uint32_t begin, std::uint32_t end) const;
   void buildParallel(bool splitByMedian);
@@ -393,7 +400,7 @@ void HashedBoxGrid::query(const Box& q, Visit&& visit) const {
 template <class Visit>
 void BoxTree::query(const Box& q, unsigned worker, Visit&& visit) const {
   if (nodes_.empty()) return;
-  std::uint32_t stack[64];
+  std::uint32_t stack[64];  // the depth stays under 63 (kDeepestCodeSplit)
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {

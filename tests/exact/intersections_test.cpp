@@ -410,6 +410,34 @@ TEST(BoxTree, ClusteredBoxesWithAnOutlierFindEveryOverlap) {
   expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMedianSplit);
 }
 
+// Clusters nested about a point, each a sixteenth the size of the last (a
+// part graded towards a point): coded again at every cluster, the codes'
+// splits would peel off a few boxes per level, far deeper than a query's
+// stack; the depth stays bounded and every overlap is found.
+TEST(BoxTree, NestedClustersKeepTheTreeShallow) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Box> boxes;
+  for (int level = 0; level < 30; ++level) {
+    const double scale = std::ldexp(1.0, -4 * level);
+    for (int i = 0; i < 100; ++i) {
+      const Point3 a = Point3(u(rng), u(rng), u(rng)) * scale;
+      boxes.push_back(
+          boxOf(a, a + Point3(0.02, 0.01, 0) * scale, a + Point3(0, 0.02, 0.01) * scale));
+    }
+  }
+  expectTreeFindsEveryOverlap(boxes, BoxTree::Layout::kMorton);
+  const BoxTree tree(boxes, BoxTree::Layout::kMorton);
+  EXPECT_LE(tree.depth(), 61);
+  EXPECT_LE(BoxTree(boxes, BoxTree::Layout::kMedianSplit).depth(), 12);
+  for (const Box& b : {boxes[0], boxes[1500], boxes[2999]}) {
+    std::size_t hits = 0, expected = 0;
+    tree.query(b, 0, [&](std::uint32_t, unsigned) { ++hits; });
+    for (const Box& x : boxes) expected += overlap(x, b);
+    EXPECT_EQ(hits, expected);
+  }
+}
+
 // Every query reports exactly the boxes that overlap it (touching counts),
 // each once, against brute force.
 void expectGridFindsEveryOverlapOnce(const HashedBoxGrid& grid, const std::vector<Box>& boxes,
