@@ -64,7 +64,8 @@ OptionTable<FindIntersectionsOptions> findTable() {
       "also return the exact intersection segments (rounded to double) as (points, edges)");
   t.add(
       "layout", [](FindIntersectionsOptions& o) -> int& { return o.layout; },
-      "candidate search: 0 median-split hierarchy, 1 Morton-order hierarchy");
+      "candidate search: 0 (default) a Morton-order hierarchy within each mesh and a hashed grid "
+      "between meshes, 1 median-split hierarchies for both");
   return t;
 }
 
@@ -73,7 +74,7 @@ py::tuple findArrays(py::handle meshes, py::kwargs kwargs) {
   const std::vector<Mesh> inputs = meshesFrom(meshes);
   FindIntersectionsOptions options = findTable().parse("find_intersections", kwargs, {});
   if (options.layout != 0 && options.layout != 1)
-    throw InvalidInputError("layout must be 0 (median split) or 1 (Morton order)");
+    throw InvalidInputError("layout must be 0 (the default) or 1 (median-split hierarchies)");
   options.progress = call.progress();
   std::vector<const Mesh*> pointers;
   for (const Mesh& m : inputs) pointers.push_back(&m);
