@@ -188,9 +188,12 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
   };
   // A point stored as float inside the grid (most): its cell along each
   // axis as cellRange() finds it (the same float arithmetic), the clamp at
-  // the low end needless inside.
+  // the low end needless inside; -1 where the product is NaN (an offset
+  // past float times the zero cells per unit of an extent past float),
+  // which cellRange() takes as spanning the axis.
   auto axisCell = [&](float x, int k) {
-    return int(std::min((x - bounds_.lo[k]) * cellsPerUnit_[k], float(kCells - 1)));
+    const float c = (x - bounds_.lo[k]) * cellsPerUnit_[k];
+    return c >= 0 ? int(std::min(c, float(kCells - 1))) : -1;
   };
   std::vector<std::uint32_t> cell(P.size());
   parallelChunks(P.size(), [&](std::size_t begin, std::size_t end, unsigned) {
@@ -200,10 +203,14 @@ std::vector<std::uint32_t> BoxGrid::facesTouching(const std::vector<Point3>& P,
       const bool stored = (double(x) == p[0]) & (double(y) == p[1]) & (double(z) == p[2]);
       const bool in = (x >= bounds_.lo[0]) & (x <= bounds_.hi[0]) & (y >= bounds_.lo[1]) &
                       (y <= bounds_.hi[1]) & (z >= bounds_.lo[2]) & (z <= bounds_.hi[2]);
-      if (stored & in)
-        cell[v] = std::uint32_t(index(axisCell(x, 0), axisCell(y, 1), axisCell(z, 2)));
-      else
-        cell[v] = code(stored ? Box{{x, y, z}, {x, y, z}} : boxOf(p));
+      if (stored & in) {
+        const int cx = axisCell(x, 0), cy = axisCell(y, 1), cz = axisCell(z, 2);
+        if ((cx | cy | cz) >= 0) {
+          cell[v] = std::uint32_t(index(cx, cy, cz));
+          continue;
+        }
+      }
+      cell[v] = code(stored ? Box{{x, y, z}, {x, y, z}} : boxOf(p));
     }
   });
   // A face's box starts at its corners' lowest start and ends at their

@@ -178,6 +178,27 @@ TEST(BoxGrid, FacesTouchingAreThoseWhoseBoxesTouch) {
   }
 }
 
+// A grid whose extent overflows float along an axis (corners near -/+3e38):
+// a point's offset times the cells per unit is NaN there (infinity times
+// zero); faces with such corners are found as touches() finds them (the
+// cells' boxes: one cell along x, both boxes in it).
+TEST(BoxGrid, FacesTouchingAcrossAnExtentPastFloat) {
+  const float big = 3e38f;
+  const std::vector<Box> boxes = {{{-big, 0, 0}, {-big, 1, 1}}, {{big, 0, 0}, {big, 1, 1}}};
+  const BoxGrid grid(boxes);
+  const std::vector<Point3> points = {{big, 0.5, 0.5}, {big, 0.6, 0.5}, {big, 0.5, 0.6},
+                                      {-big, 5, 5},    {-big, 6, 5},    {-big, 5, 6},
+                                      {0, 0.5, 0.5},   {1, 0.5, 0.5},   {0, 0.6, 0.6}};
+  const std::vector<Triangle> triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
+  std::vector<std::uint32_t> expected;
+  for (std::uint32_t f = 0; f < triangles.size(); ++f) {
+    const Triangle& t = triangles[f];
+    if (grid.touches(boxOf(points[t[0]], points[t[1]], points[t[2]]))) expected.push_back(f);
+  }
+  EXPECT_EQ(expected, (std::vector<std::uint32_t>{0, 2}));  // face 1 is above the grid in y
+  EXPECT_EQ(grid.facesTouching(points, triangles, std::vector<char>(3, 0)), expected);
+}
+
 // Boxes spanning one or two cells along each axis (most faces' boxes): a
 // box overlapping one of the grid's touches it, along whichever axes it
 // spans two cells, and a box more than two cells from all of them does not.
