@@ -353,10 +353,17 @@ BoxTree::BoxTree(std::vector<Box> boxes, Layout layout) : boxes_(std::move(boxes
 // The boxes in leaf order, and where each one went; the boxes as given are
 // no longer needed.
 void BoxTree::orderBoxes() {
-  resizeInHugePages(ordered_, boxes_.size());
+  stride_ = boxes_.size() + kLeafSize - 1;
+  resizeInHugePages(bounds_, 6 * stride_);
   resizeInHugePages(place_, boxes_.size());
+  float* lo[3] = {&bounds_[0], &bounds_[stride_], &bounds_[2 * stride_]};
+  float* hi[3] = {&bounds_[3 * stride_], &bounds_[4 * stride_], &bounds_[5 * stride_]};
   for (std::size_t i = 0; i < order_.size(); ++i) {
-    ordered_[i] = boxes_[order_[i]];
+    const Box& b = boxes_[order_[i]];
+    for (int k = 0; k < 3; ++k) {
+      lo[k][i] = b.lo[k];
+      hi[k][i] = b.hi[k];
+    }
     place_[order_[i]] = std::uint32_t(i);
   }
   boxes_ = {};

@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <xmmintrin.h>
+
 #include "common/base/mesh.h"
 #include "common/base/parallel.h"
 
@@ -206,7 +208,7 @@ class BoxTree {
   explicit BoxTree(std::vector<Box> boxes, Layout layout = Layout::kMedianSplit);
 
   std::size_t size() const { return order_.size(); }
-  const Box& box(std::uint32_t i) const { return ordered_[place_[i]]; }  // boxes[i], as given
+  Box box(std::uint32_t i) const { return leafBox(place_[i]); }  // boxes[i], as given
   // The number of nodes on the longest path from the root to a leaf, less
   // one (0 for a single leaf): at most 61, for query()'s stack.
   int depth() const;
@@ -248,12 +250,20 @@ class BoxTree {
   // deep; the leaves' extra box tests cost less), with six 1 % fewer and
   // with twelve as many, while the output stage's search did more.
   static constexpr std::uint32_t kLeafSize = 8;
+  static_assert(kLeafSize <= 8, "overlapMask() tests a leaf in two groups of four");
   // Below this depth a Morton-order hierarchy splits at its codes' bits, from
   // it on at the middle: leaves lie at most 32 + 29 deep (2^32 boxes, eight
   // a leaf), within query()'s stack of 64.
   static constexpr int kDeepestCodeSplit = 32;
 
   bool leaf(const Node& n) const { return n.b & kLeaf; }
+  const float* bound(int k) const { return bounds_.data() + std::size_t(k) * stride_; }
+  Box leafBox(std::uint32_t i) const {
+    return {{bound(0)[i], bound(1)[i], bound(2)[i]}, {bound(3)[i], bound(4)[i], bound(5)[i]}};
+  }
+  // Bit j set where `q` overlaps box first + j, of the `count` (at most
+  // kLeafSize) from `first`: overlap() on each, four at a time.
+  unsigned overlapMask(const Box& q, std::uint32_t first, std::uint32_t count) const;
   std::uint32_t count(const Node& n) const { return n.b & ~kLeaf; }
 
   void build(std::uint32_t begin, std::uint32_t end, std::vector<Node>& out);
@@ -278,7 +288,11 @@ class BoxTree {
 
   std::vector<Box> boxes_;            // as given, while the hierarchy is built
   std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
-  std::vector<Box> ordered_;          // boxes_[order_[i]]: a leaf's boxes side by side
+  // boxes_[order_[i]], one array per bound (lo x, y, z, hi x, y, z; each
+  // `stride_` floats, kLeafSize - 1 of them room after the last box): a box
+  // is tested against four of a leaf's in one SSE comparison per bound.
+  std::vector<float> bounds_;
+  std::size_t stride_ = 0;
   std::vector<std::uint32_t> place_;  // where primitive i is in order_
   // While a median-split hierarchy is built: per primitive in the current
   // order, lo + hi of its box on each axis and its index. Selecting medians
@@ -295,20 +309,37 @@ class BoxTree {
   Box empty_{{1, 1, 1}, {0, 0, 0}};
 };
 
-// ---- templates -----------------------------------------------------------------
+// ---- inline and templates ------------------------------------------------------
+
+inline unsigned BoxTree::overlapMask(const Box& q, std::uint32_t first, std::uint32_t count) const {
+  const __m128 loX = _mm_set1_ps(q.lo[0]), loY = _mm_set1_ps(q.lo[1]), loZ = _mm_set1_ps(q.lo[2]);
+  const __m128 hiX = _mm_set1_ps(q.hi[0]), hiY = _mm_set1_ps(q.hi[1]), hiZ = _mm_set1_ps(q.hi[2]);
+  auto axis = [&](int k, std::uint32_t at, __m128 lo, __m128 hi) {  // as overlap(): NaN is false
+    return _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(bound(k) + at), hi),
+                      _mm_cmple_ps(lo, _mm_loadu_ps(bound(3 + k) + at)));
+  };
+  auto four = [&](std::uint32_t at) {
+    const __m128 x = axis(0, at, loX, hiX), y = axis(1, at, loY, hiY), z = axis(2, at, loZ, hiZ);
+    return unsigned(_mm_movemask_ps(_mm_and_ps(x, _mm_and_ps(y, z))));
+  };
+  unsigned mask = four(first);
+  if (count > 4) mask |= four(first + 4) << 4;
+  return mask & ((1u << count) - 1);
+}
 
 template <class Visit>
 void BoxTree::within(std::uint32_t n, unsigned worker, Visit& visit) const {
   const Node& node = nodes_[n];
   if (leaf(node)) {
-    const std::uint32_t first = node.a, last = node.a + count(node);
-    for (std::uint32_t i = first; i < last; ++i)
-      for (std::uint32_t j = i + 1; j < last; ++j) {
-        if (overlap(ordered_[i], ordered_[j])) {
-          const std::uint32_t p = order_[i], q = order_[j];
-          visit(std::min(p, q), std::max(p, q), worker);
-        }
+    const std::uint32_t first = node.a, n = count(node);
+    for (std::uint32_t i = 0; i + 1 < n; ++i) {
+      const std::uint32_t p = order_[first + i];
+      std::uint32_t later = overlapMask(leafBox(first + i), first, n) & ~((2u << i) - 1);
+      for (; later; later &= later - 1) {
+        const std::uint32_t q = order_[first + std::uint32_t(__builtin_ctz(later))];
+        visit(std::min(p, q), std::max(p, q), worker);
       }
+    }
     return;
   }
   within(node.a, worker, visit);
@@ -321,14 +352,12 @@ void BoxTree::between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& 
   const Node &nx = nodes_[x], &ny = nodes_[y];
   if (!overlap(nx.box, ny.box)) return;
   if (leaf(nx) && leaf(ny)) {
-    for (std::uint32_t i = nx.a; i < nx.a + count(nx); ++i) {
-      const Box& bp = ordered_[i];
-      if (!overlap(bp, ny.box)) continue;
-      for (std::uint32_t j = ny.a; j < ny.a + count(ny); ++j)
-        if (overlap(bp, ordered_[j])) {
-          const std::uint32_t p = order_[i], q = order_[j];
-          visit(std::min(p, q), std::max(p, q), worker);
-        }
+    for (std::uint32_t near = overlapMask(ny.box, nx.a, count(nx)); near; near &= near - 1) {
+      const std::uint32_t i = nx.a + std::uint32_t(__builtin_ctz(near)), p = order_[i];
+      for (std::uint32_t hit = overlapMask(leafBox(i), ny.a, count(ny)); hit; hit &= hit - 1) {
+        const std::uint32_t q = order_[ny.a + std::uint32_t(__builtin_ctz(hit))];
+        visit(std::min(p, q), std::max(p, q), worker);
+      }
     }
     return;
   }
@@ -407,8 +436,8 @@ void BoxTree::query(const Box& q, unsigned worker, Visit&& visit) const {
     const Node& n = nodes_[stack[--top]];
     if (!overlap(n.box, q)) continue;
     if (leaf(n)) {
-      for (std::uint32_t i = n.a; i < n.a + count(n); ++i)
-        if (overlap(ordered_[i], q)) visit(order_[i], worker);
+      for (std::uint32_t hit = overlapMask(q, n.a, count(n)); hit; hit &= hit - 1)
+        visit(order_[n.a + std::uint32_t(__builtin_ctz(hit))], worker);
     } else {
       stack[top++] = n.a;
       stack[top++] = n.b;
