@@ -73,9 +73,14 @@ struct Soup {
   // The exact sides of points against face f's plane. Made for a pair, not
   // kept per face: the fans settle most pairs without one, and a filter per
   // face took twice the memory of the boxes.
-  PlaneSide plane(std::uint32_t f) const {
-    const TrianglePoints t = at(f);
-    return PlaneSide(t[0], t[1], t[2]);
+  struct Plane {
+    const Point3 &a, &b, &c;  // the face's corners, in the soup
+    PlaneFilter filter;
+    int operator()(const Point3& p) const { return filter.side(a, b, c, p); }
+  };
+  Plane plane(std::uint32_t f) const {
+    const Point3 &a = corner(f, 0), &b = corner(f, 1), &c = corner(f, 2);
+    return {a, b, c, PlaneFilter(a, b, c)};
   }
   TrianglePoints at(std::uint32_t f) const {
     const Triangle& t = triangles[f];
@@ -153,7 +158,7 @@ Candidates facesTouching(Soup& s, const Box& other) {
 // Exact: can the segment from corner i to corner j of face g meet face f?
 // False when both ends lie strictly on one side of f's plane.
 bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
-  const PlaneSide side = s.plane(f);
+  const Soup::Plane side = s.plane(f);
   return side(s.corner(g, i)) * side(s.corner(g, j)) <= 0;
 }
 
@@ -162,26 +167,32 @@ bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) 
 // soon as one triangle lies strictly on one side (no contact).
 bool mayTouch(const Soup& s, std::uint32_t f, std::uint32_t g, PlaneSides& side) {
   auto against = [&](std::uint32_t plane, std::uint32_t face, int* out) {
-    const PlaneSide sideOf = s.plane(plane);
+    const Soup::Plane sideOf = s.plane(plane);
     for (int i = 0; i < 3; ++i) out[i] = sideOf(s.corner(face, i));
     return !(out[0] != 0 && out[1] == out[0] && out[2] == out[0]);
   };
   return against(f, g, side[1]) && against(g, f, side[0]);
 }
 
-// The self-intersection rule for two faces of one mesh that share the
-// corners `c` (fewer than three). Fans that project one-to-one and cheap
-// exact plane tests settle almost every pair of neighbours; the rest get the
-// full test.
-bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const SharedCorners& c) {
+// Two faces of one mesh that share a corner whose fan is apart in
+// projection, or both corners of an edge one of whose ends' is: they do not
+// intersect by the rule (most pairs of a mesh; inline, ahead of the tests).
+inline bool apartAroundSharedCorner(const Soup& s, std::uint32_t f, const SharedCorners& c) {
   const Triangle& tf = s.triangles[f];
+  if (c.count == 1) return s.fanApart[tf[c.ia]];
+  return c.count == 2 && (s.fanApart[tf[(c.ia + 1) % 3]] | s.fanApart[tf[(c.ia + 2) % 3]]);
+}
+
+// The self-intersection rule for two faces of one mesh that share the
+// corners `c` (fewer than three), not apart around them. Cheap exact plane
+// tests settle almost every such pair; the rest get the full test.
+bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const SharedCorners& c) {
   switch (c.count) {
     case 0: {
       PlaneSides side;
       return mayTouch(s, f, g, side) && trianglesIntersect(s.at(f), s.at(g), side);
     }
     case 1:
-      if (s.fanApart[tf[c.ia]]) return false;
       // When either face's edge opposite the shared corner lies strictly on
       // one side of the other's plane, that face meets the plane only at the
       // shared corner: nothing beyond it. Both edges must reach the plane.
@@ -190,9 +201,7 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const Shared
         return false;
       break;
     default:  // folded faces are coplanar: the other's apex must lie in the plane
-      if (s.fanApart[tf[(c.ia + 1) % 3]] || s.fanApart[tf[(c.ia + 2) % 3]] ||
-          s.plane(f)(s.corner(g, c.ib)) != 0)
-        return false;
+      if (s.plane(f)(s.corner(g, c.ib)) != 0) return false;
   }
   return intersectBeyondShared(s.at(f), s.at(g), c.count, c.ia, c.ib);
 }
@@ -275,7 +284,8 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
       if (s.degenerate[f] || s.degenerate[g]) return;
       ++found[worker].candidates;
       const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
-      if (c.count == 3 ? options.same_vertices : selfIntersect(s, f, g, c))
+      if (c.count == 3 ? options.same_vertices
+                       : !apartAroundSharedCorner(s, f, c) && selfIntersect(s, f, g, c))
         found[worker].pairs.push_back(
             {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
     });
