@@ -264,6 +264,14 @@ void requireFacesAndFinite(const std::vector<const MeshArrays*>& meshes) {
   requireCoordinateSpan(all, meshes.size() == 1 ? "the mesh" : "the meshes together");
 }
 
+// Out of line: the visit of each candidate pair stays small enough to be
+// inlined into the traversal's loops (a call per pair cost more than the
+// fans' test), and few pairs are found.
+[[gnu::noinline]] void recordSelfPair(WorkerFindings& found, std::uint32_t m, std::uint32_t f,
+                                      std::uint32_t g) {
+  found.pairs.push_back({{{m, f}, {m, g}}, {{0, 0, 0}, {0, 0, 0}}, false});
+}
+
 // Each mesh's own pairs, from a tree of its faces' boxes; returns the
 // milliseconds spent building the trees.
 double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& options,
@@ -280,14 +288,17 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
   for (std::size_t m = 0; m < n; ++m) {
     reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
     const Soup& s = soups[m];
-    trees[m]->selfPairs([&](std::uint32_t f, std::uint32_t g, unsigned worker) {
+    // Inlined into the traversal's leaf loops: as a call (GCC's choice), the
+    // visit of 6.7 M candidate pairs on bunny + dragon took 4 % more
+    // instructions.
+    trees[m]->selfPairs([&](std::uint32_t f, std::uint32_t g,
+                            unsigned worker) __attribute__((always_inline)) {
       if (s.degenerate[f] || s.degenerate[g]) return;
       ++found[worker].candidates;
       const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
       if (c.count == 3 ? options.same_vertices
                        : !apartAroundSharedCorner(s, f, c) && selfIntersect(s, f, g, c))
-        found[worker].pairs.push_back(
-            {{{std::uint32_t(m), f}, {std::uint32_t(m), g}}, {{0, 0, 0}, {0, 0, 0}}, false});
+        recordSelfPair(found[worker], std::uint32_t(m), f, g);
     });
   }
   if (options.keep_trees) r.face_trees = std::move(trees);
