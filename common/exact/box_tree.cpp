@@ -433,15 +433,14 @@ void BoxTree::buildParallel(bool splitByMedian) {
 
 namespace {
 
-// Spreads the low 10 bits of x to every third bit.
-std::uint32_t spread(std::uint32_t x) {
-  x &= 0x3ff;
-  x = (x | (x << 16)) & 0x030000ff;
-  x = (x | (x << 8)) & 0x0300f00f;
-  x = (x | (x << 4)) & 0x030c30c3;
-  x = (x | (x << 2)) & 0x09249249;
-  return x;
-}
+// Bit k of i moved to bit 3k, for every 10-bit i: a look-up per axis
+// instead of five shifts and masks.
+constexpr std::array<std::uint32_t, 1024> kSpread = [] {
+  std::array<std::uint32_t, 1024> t{};
+  for (std::uint32_t i = 0; i < 1024; ++i)
+    for (int k = 0; k < 10; ++k) t[i] |= (i >> k & 1u) << 3 * k;
+  return t;
+}();
 
 }  // namespace
 
@@ -471,16 +470,22 @@ void BoxTree::sortByMorton(std::uint32_t begin, std::uint32_t end) {
       const float c = 0.5f * (boxes_[order[i]].lo[k] + boxes_[order[i]].hi[k]);
       q[k] = std::uint32_t(std::min(1023.f, std::max(0.f, (c - centers.lo[k]) * scale[k])));
     }
-    code[i] = spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2);
+    code[i] = kSpread[q[0]] | kSpread[q[1]] << 1 | kSpread[q[2]] << 2;
   }
-  // Three passes of 10 bits, back and forth between the arrays and a copy.
+  // Three passes of 10 bits, back and forth between the arrays and a copy;
+  // the three digits' counts in one reading (a pass does not change them).
   std::vector<std::uint32_t> otherCode(n), otherOrder(n);
   std::uint32_t *fromCode = code, *fromOrder = order, *toCode = otherCode.data(),
                 *toOrder = otherOrder.data();
-  std::uint32_t count[1025];
+  std::uint32_t counts[3][1025] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t c = code[i];
+    ++counts[0][(c & 1023) + 1];
+    ++counts[1][(c >> 10 & 1023) + 1];
+    ++counts[2][(c >> 20 & 1023) + 1];
+  }
   for (int shift = 0; shift < 30; shift += 10) {
-    std::fill(count, count + 1025, 0);
-    for (std::size_t i = 0; i < n; ++i) ++count[((fromCode[i] >> shift) & 1023) + 1];
+    std::uint32_t* count = counts[shift / 10];
     for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint32_t slot = count[(fromCode[i] >> shift) & 1023]++;
