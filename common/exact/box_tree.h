@@ -218,6 +218,13 @@ class BoxTree {
   // from several threads (worker = 0..workerCount()-1).
   template <class Visit>
   void selfPairs(Visit&& visit) const;
+  // The same pairs by their places in the tree's order (visit(x, y, worker),
+  // boxes primitive(x) and primitive(y), in no particular order): for a
+  // caller that keeps its own data per primitive in that order, side by side
+  // for the pairs of two leaves.
+  template <class Visit>
+  void selfPairsByPlace(Visit&& visit) const;
+  std::uint32_t primitive(std::uint32_t place) const { return order_[place]; }
 
   // Calls visit(i, worker) for every box of this tree that overlaps `query`.
   template <class Visit>
@@ -333,12 +340,9 @@ void BoxTree::within(std::uint32_t n, unsigned worker, Visit& visit) const {
   if (leaf(node)) {
     const std::uint32_t first = node.a, n = count(node);
     for (std::uint32_t i = 0; i + 1 < n; ++i) {
-      const std::uint32_t p = order_[first + i];
       std::uint32_t later = overlapMask(leafBox(first + i), first, n) & ~((2u << i) - 1);
-      for (; later; later &= later - 1) {
-        const std::uint32_t q = order_[first + std::uint32_t(__builtin_ctz(later))];
-        visit(std::min(p, q), std::max(p, q), worker);
-      }
+      for (; later; later &= later - 1)
+        visit(first + i, first + std::uint32_t(__builtin_ctz(later)), worker);
     }
     return;
   }
@@ -353,11 +357,9 @@ void BoxTree::between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& 
   if (!overlap(nx.box, ny.box)) return;
   if (leaf(nx) && leaf(ny)) {
     for (std::uint32_t near = overlapMask(ny.box, nx.a, count(nx)); near; near &= near - 1) {
-      const std::uint32_t i = nx.a + std::uint32_t(__builtin_ctz(near)), p = order_[i];
-      for (std::uint32_t hit = overlapMask(leafBox(i), ny.a, count(ny)); hit; hit &= hit - 1) {
-        const std::uint32_t q = order_[ny.a + std::uint32_t(__builtin_ctz(hit))];
-        visit(std::min(p, q), std::max(p, q), worker);
-      }
+      const std::uint32_t i = nx.a + std::uint32_t(__builtin_ctz(near));
+      for (std::uint32_t hit = overlapMask(leafBox(i), ny.a, count(ny)); hit; hit &= hit - 1)
+        visit(i, ny.a + std::uint32_t(__builtin_ctz(hit)), worker);
     }
     return;
   }
@@ -376,6 +378,14 @@ void BoxTree::between(std::uint32_t x, std::uint32_t y, unsigned worker, Visit& 
 
 template <class Visit>
 void BoxTree::selfPairs(Visit&& visit) const {
+  selfPairsByPlace([&](std::uint32_t x, std::uint32_t y, unsigned worker) {
+    const std::uint32_t p = order_[x], q = order_[y];
+    visit(std::min(p, q), std::max(p, q), worker);
+  });
+}
+
+template <class Visit>
+void BoxTree::selfPairsByPlace(Visit&& visit) const {
   if (nodes_.empty()) return;
   // Split the traversal into independent tasks: (n, n) = all pairs within
   // node n, (x, y) = pairs between two nodes; workers take them in turn.

@@ -174,15 +174,6 @@ bool mayTouch(const Soup& s, std::uint32_t f, std::uint32_t g, PlaneSides& side)
   return against(f, g, side[1]) && against(g, f, side[0]);
 }
 
-// Two faces of one mesh that share a corner whose fan is apart in
-// projection, or both corners of an edge one of whose ends' is: they do not
-// intersect by the rule (most pairs of a mesh; inline, ahead of the tests).
-inline bool apartAroundSharedCorner(const Soup& s, std::uint32_t f, const SharedCorners& c) {
-  const Triangle& tf = s.triangles[f];
-  if (c.count == 1) return s.fanApart[tf[c.ia]];
-  return c.count == 2 && (s.fanApart[tf[(c.ia + 1) % 3]] | s.fanApart[tf[(c.ia + 2) % 3]]);
-}
-
 // The self-intersection rule for two faces of one mesh that share the
 // corners `c` (fewer than three), not apart around them. Cheap exact plane
 // tests settle almost every such pair; the rest get the full test.
@@ -264,6 +255,39 @@ void requireFacesAndFinite(const std::vector<const MeshArrays*>& meshes) {
   requireCoordinateSpan(all, meshes.size() == 1 ? "the mesh" : "the meshes together");
 }
 
+// A mesh's faces in its tree's order, for the visit of its candidate pairs
+// (those of two leaves side by side, where the faces' own arrays are read
+// scattered): each face's corners, a corner v as ~v (negative) where v's
+// fan is apart in projection, which keeps corners equal where they were;
+// and whether the face is degenerate.
+struct PlacedFaces {
+  std::vector<Triangle> corners;
+  std::vector<char> degenerate;
+
+  PlacedFaces(const Soup& s, const BoxTree& tree) {
+    resizeInHugePages(corners, tree.size());
+    resizeInHugePages(degenerate, tree.size());
+    parallelChunks(tree.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+      for (std::size_t x = begin; x < end; ++x) {
+        const std::uint32_t f = tree.primitive(std::uint32_t(x));
+        for (int i = 0; i < 3; ++i) {
+          const int v = s.triangles[f][i];
+          corners[x][i] = s.fanApart[std::size_t(v)] ? ~v : v;
+        }
+        degenerate[x] = s.degenerate[f];
+      }
+    });
+  }
+  // Do the faces at x and y, sharing the corners `c` (fewer than three),
+  // share a corner whose fan is apart, or an edge with such an end? They do
+  // not intersect by the rule then (most pairs of a mesh).
+  bool apartAroundShared(std::uint32_t x, const SharedCorners& c) const {
+    const Triangle& t = corners[x];
+    if (c.count == 1) return t[c.ia] < 0;
+    return c.count == 2 && ((t[(c.ia + 1) % 3] | t[(c.ia + 2) % 3]) < 0);
+  }
+};
+
 // Out of line: the visit of each candidate pair stays small enough to be
 // inlined into the traversal's loops (a call per pair cost more than the
 // fans' test), and few pairs are found.
@@ -288,16 +312,20 @@ double searchSelf(std::vector<Soup>& soups, const FindIntersectionsOptions& opti
   for (std::size_t m = 0; m < n; ++m) {
     reportProgress(options.progress, int(10 + 40 * m / n), "Self-intersections");
     const Soup& s = soups[m];
+    const BoxTree& tree = *trees[m];
+    const PlacedFaces placed(s, tree);
     // Inlined into the traversal's leaf loops: as a call (GCC's choice), the
     // visit of 6.7 M candidate pairs on bunny + dragon took 4 % more
     // instructions.
-    trees[m]->selfPairs([&](std::uint32_t f, std::uint32_t g,
-                            unsigned worker) __attribute__((always_inline)) {
-      if (s.degenerate[f] || s.degenerate[g]) return;
+    tree.selfPairsByPlace([&](std::uint32_t x, std::uint32_t y,
+                              unsigned worker) __attribute__((always_inline)) {
+      if (placed.degenerate[x] | placed.degenerate[y]) return;
       ++found[worker].candidates;
-      const SharedCorners c = sharedCorners(s.triangles[f], s.triangles[g]);
-      if (c.count == 3 ? options.same_vertices
-                       : !apartAroundSharedCorner(s, f, c) && selfIntersect(s, f, g, c))
+      SharedCorners c = sharedCorners(placed.corners[x], placed.corners[y]);
+      if (c.count < 3 && placed.apartAroundShared(x, c)) return;
+      std::uint32_t f = tree.primitive(x), g = tree.primitive(y);
+      if (f > g) std::swap(f, g), std::swap(c.ia, c.ib);  // c as sharedCorners(f, g)
+      if (c.count == 3 ? options.same_vertices : selfIntersect(s, f, g, c))
         recordSelfPair(found[worker], std::uint32_t(m), f, g);
     });
   }
