@@ -366,6 +366,8 @@ void BoxTree::orderBoxes() {
     }
     place_[order_[i]] = std::uint32_t(i);
   }
+  for (int k = 0; k < 6; ++k)  // the room after the last box, read by overlapMask() and masked
+    std::fill_n(bounds_.begin() + std::ptrdiff_t(k * stride_ + boxes_.size()), kLeafSize - 1, 0.f);
   boxes_ = {};
 }
 
@@ -474,7 +476,7 @@ void BoxTree::sortByMorton(std::uint32_t begin, std::uint32_t end) {
   }
   // Three passes of 10 bits, back and forth between the arrays and a copy;
   // the three digits' counts in one reading (a pass does not change them).
-  std::vector<std::uint32_t> otherCode(n), otherOrder(n);
+  Array<std::uint32_t> otherCode(n), otherOrder(n);
   std::uint32_t *fromCode = code, *fromOrder = order, *toCode = otherCode.data(),
                 *toOrder = otherOrder.data();
   std::uint32_t counts[3][1025] = {};

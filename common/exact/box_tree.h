@@ -15,6 +15,7 @@
 
 #include <xmmintrin.h>
 
+#include "common/base/huge_pages.h"
 #include "common/base/mesh.h"
 #include "common/base/parallel.h"
 
@@ -293,14 +294,18 @@ class BoxTree {
   void pairTasks(std::uint32_t x, std::uint32_t y, int depth,
                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
 
-  std::vector<Box> boxes_;            // as given, while the hierarchy is built
-  std::vector<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
+  std::vector<Box> boxes_;  // as given, while the hierarchy is built
+  // The arrays below are each written whole before they are read: new
+  // elements are left uninitialized (no pass zeroing them first).
+  template <class T>
+  using Array = std::vector<T, DefaultInitAllocator<T>>;
+  Array<std::uint32_t> order_;  // primitive indices, leaves own contiguous ranges
   // boxes_[order_[i]], one array per bound (lo x, y, z, hi x, y, z; each
   // `stride_` floats, kLeafSize - 1 of them room after the last box): a box
   // is tested against four of a leaf's in one SSE comparison per bound.
-  std::vector<float> bounds_;
+  Array<float> bounds_;
   std::size_t stride_ = 0;
-  std::vector<std::uint32_t> place_;  // where primitive i is in order_
+  Array<std::uint32_t> place_;  // where primitive i is in order_
   // While a median-split hierarchy is built: per primitive in the current
   // order, lo + hi of its box on each axis and its index. Selecting medians
   // on these, next to each other in memory, does the same as on order_ with
@@ -311,7 +316,7 @@ class BoxTree {
   };
   std::vector<Centre> centres_;
   // While a Morton-order hierarchy is built: the primitives' codes, in order.
-  std::vector<std::uint32_t> codes_;
+  Array<std::uint32_t> codes_;
   std::vector<Node> nodes_;
   Box empty_{{1, 1, 1}, {0, 0, 0}};
 };
