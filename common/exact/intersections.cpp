@@ -201,13 +201,20 @@ bool selfIntersect(const Soup& s, std::uint32_t f, std::uint32_t g, const Shared
 
 FindIntersectionsResult findIntersections(const std::vector<const Mesh*>& meshes,
                                           const FindIntersectionsOptions& options) {
-  for (std::size_t m = 0; m < meshes.size(); ++m)
-    requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
   std::vector<MeshArrays> arrays;
   for (const Mesh* mesh : meshes) arrays.push_back(arraysOf(*mesh));
   std::vector<const MeshArrays*> pointers;
   for (const MeshArrays& a : arrays) pointers.push_back(&a);
-  return findIntersectionsInArrays(pointers, options);
+  try {
+    return findIntersectionsInArrays(pointers, options);  // checks the arrays first
+  } catch (const InvalidInputError&) {
+    // The meshes' own checks where the arrays' fail: the same tests, with a
+    // message that names the vertex and the faces that use it (run only
+    // then: on a large mesh they took 2 % of the search).
+    for (std::size_t m = 0; m < meshes.size(); ++m)
+      requireFacesAndFiniteCoordinates(*meshes[m], "mesh " + std::to_string(m));
+    throw;
+  }
 }
 
 std::size_t selfIntersectingPairs(const Mesh& mesh, bool asFloat, bool sameVertices) {
