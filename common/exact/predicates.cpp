@@ -13,15 +13,12 @@ namespace meshmend {
 
 namespace {
 
-constexpr double kEpsilon = PlaneFilter::kEpsilon;  // 2^-53
-// Shewchuk's forward error bounds for the rounded determinants.
-constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+// Shewchuk's forward error bound for orient3d's rounded determinant.
 constexpr double kOrient3dBound = PlaneFilter::kOrient3dBound;
-// Below this magnitude products may underflow and the bounds no longer hold.
-constexpr double kUnderflowGuard = PlaneFilter::kUnderflowGuard;
+// Below this magnitude products may underflow and the bound no longer holds;
 // orient3d's minors multiplied by a coordinate may have underflowed
-// (PlaneFilter::underflowSlack). orient2d's two products are off by at
-// most 2^-1074 then, which the guard's 1e-250 keeps far below its bound.
+// (PlaneFilter::underflowSlack).
+constexpr double kUnderflowGuard = PlaneFilter::kUnderflowGuard;
 
 int sign(const mpq_class& q) {
   return sgn(q);
@@ -65,18 +62,11 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
 
 }  // namespace exact
 
-int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+int orient2dBeyondFilter(double ax, double ay, double bx, double by, double cx, double cy) {
   const double left = (ax - cx) * (by - cy);
   const double right = (ay - cy) * (bx - cx);
-  const double det = left - right;
-  const double sum = std::fabs(left) + std::fabs(right);
-  const double bound = kOrient2dBound * sum;
-  if (std::isfinite(det) && sum > kUnderflowGuard) {
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  } else if (left == 0 && right == 0 && ((ax == cx || by == cy) && (ay == cy || bx == cx))) {
+  if (left == 0 && right == 0 && ((ax == cx || by == cy) && (ay == cy || bx == cx)))
     return 0;  // both products exactly zero because a factor is exactly zero
-  }
   if (expansion::safe({ax, ay, bx, by, cx, cy})) return expansion::orient2d(ax, ay, bx, by, cx, cy);
   return exact::orient2d(ax, ay, bx, by, cx, cy);
 }

@@ -16,7 +16,7 @@ namespace meshmend {
 
 // Sign of the 2-D orientation determinant of (a, b, c): +1 when c lies to the
 // left of the directed line a->b (counter-clockwise), -1 right, 0 collinear.
-int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
+inline int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
 
 // Sign of det[b-a, c-a, d-a]: +1 when d lies on the side of the plane through
 // a, b, c that the normal (b-a)x(c-a) points to, -1 on the other side, 0 when
@@ -121,6 +121,26 @@ class PlaneSide {
   Point3 a_, b_, c_;
   PlaneFilter filter_;
 };
+
+// orient2d where its filter cannot decide: exactly.
+int orient2dBeyondFilter(double ax, double ay, double bx, double by, double cx, double cy);
+
+// Inline: Shewchuk's filter certifies almost every call (the fans' test asks
+// it about three times per vertex), and a call cost a third of the test.
+inline int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+  constexpr double kBound = (3.0 + 16.0 * PlaneFilter::kEpsilon) * PlaneFilter::kEpsilon;
+  const double left = (ax - cx) * (by - cy);
+  const double right = (ay - cy) * (bx - cx);
+  const double det = left - right;
+  const double sum = std::fabs(left) + std::fabs(right);
+  // Below the guard the products may have underflowed and the bound no
+  // longer holds (they are off by at most 2^-1074 then, far below it).
+  if (std::isfinite(det) && sum > PlaneFilter::kUnderflowGuard) {
+    if (det > kBound * sum) return 1;
+    if (-det > kBound * sum) return -1;
+  }
+  return orient2dBeyondFilter(ax, ay, bx, by, cx, cy);
+}
 
 namespace exact {
 // Pure-GMP evaluations, used as the fallback and as the reference in tests.
