@@ -76,6 +76,11 @@ Box boxOf(const Point3& a, const Point3& b, const Point3& c) {
 }
 
 Box boxOf(const Point3& p) {
+  // A point stored as float (every point of a float host's mesh) is its own
+  // box: one conversion per coordinate instead of two roundings.
+  const float x = float(p[0]), y = float(p[1]), z = float(p[2]);
+  if ((double(x) == p[0]) & (double(y) == p[1]) & (double(z) == p[2]))
+    return {{x, y, z}, {x, y, z}};
   Box box;
   for (int k = 0; k < 3; ++k) {
     box.lo[k] = down(p[k]);
