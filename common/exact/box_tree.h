@@ -13,7 +13,9 @@
 #include <cstdint>
 #include <vector>
 
+#if defined(__SSE2__)
 #include <xmmintrin.h>
+#endif
 
 #include "common/base/huge_pages.h"
 #include "common/base/mesh.h"
@@ -324,6 +326,7 @@ class BoxTree {
 // ---- inline and templates ------------------------------------------------------
 
 inline unsigned BoxTree::overlapMask(const Box& q, std::uint32_t first, std::uint32_t count) const {
+#if defined(__SSE2__)
   const __m128 loX = _mm_set1_ps(q.lo[0]), loY = _mm_set1_ps(q.lo[1]), loZ = _mm_set1_ps(q.lo[2]);
   const __m128 hiX = _mm_set1_ps(q.hi[0]), hiY = _mm_set1_ps(q.hi[1]), hiZ = _mm_set1_ps(q.hi[2]);
   auto axis = [&](int k, std::uint32_t at, __m128 lo, __m128 hi) {  // as overlap(): NaN is false
@@ -337,6 +340,11 @@ inline unsigned BoxTree::overlapMask(const Box& q, std::uint32_t first, std::uin
   unsigned mask = four(first);
   if (count > 4) mask |= four(first + 4) << 4;
   return mask & ((1u << count) - 1);
+#else
+  unsigned mask = 0;
+  for (std::uint32_t j = 0; j < count; ++j) mask |= unsigned(overlap(q, leafBox(first + j))) << j;
+  return mask;
+#endif
 }
 
 template <class Visit>
