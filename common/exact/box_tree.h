@@ -351,9 +351,9 @@ template <class Visit>
 void BoxTree::within(std::uint32_t n, unsigned worker, Visit& visit) const {
   const Node& node = nodes_[n];
   if (leaf(node)) {
-    const std::uint32_t first = node.a, n = count(node);
-    for (std::uint32_t i = 0; i + 1 < n; ++i) {
-      std::uint32_t later = overlapMask(leafBox(first + i), first, n) & ~((2u << i) - 1);
+    const std::uint32_t first = node.a, size = count(node);
+    for (std::uint32_t i = 0; i + 1 < size; ++i) {
+      std::uint32_t later = overlapMask(leafBox(first + i), first, size) & ~((2u << i) - 1);
       for (; later; later &= later - 1)
         visit(first + i, first + std::uint32_t(__builtin_ctz(later)), worker);
     }

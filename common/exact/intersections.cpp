@@ -73,14 +73,8 @@ struct Soup {
   // The exact sides of points against face f's plane. Made for a pair, not
   // kept per face: the fans settle most pairs without one, and a filter per
   // face took twice the memory of the boxes.
-  struct Plane {
-    const Point3 &a, &b, &c;  // the face's corners, in the soup
-    PlaneFilter filter;
-    int operator()(const Point3& p) const { return filter.side(a, b, c, p); }
-  };
-  Plane plane(std::uint32_t f) const {
-    const Point3 &a = corner(f, 0), &b = corner(f, 1), &c = corner(f, 2);
-    return {a, b, c, PlaneFilter(a, b, c)};
+  PlaneSide plane(std::uint32_t f) const {
+    return PlaneSide(corner(f, 0), corner(f, 1), corner(f, 2));
   }
   TrianglePoints at(std::uint32_t f) const {
     const Triangle& t = triangles[f];
@@ -158,7 +152,7 @@ Candidates facesTouching(Soup& s, const Box& other) {
 // Exact: can the segment from corner i to corner j of face g meet face f?
 // False when both ends lie strictly on one side of f's plane.
 bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) {
-  const Soup::Plane side = s.plane(f);
+  const PlaneSide side = s.plane(f);
   return side(s.corner(g, i)) * side(s.corner(g, j)) <= 0;
 }
 
@@ -167,7 +161,7 @@ bool edgeMayMeet(const Soup& s, std::uint32_t g, int i, int j, std::uint32_t f) 
 // soon as one triangle lies strictly on one side (no contact).
 bool mayTouch(const Soup& s, std::uint32_t f, std::uint32_t g, PlaneSides& side) {
   auto against = [&](std::uint32_t plane, std::uint32_t face, int* out) {
-    const Soup::Plane sideOf = s.plane(plane);
+    const PlaneSide sideOf = s.plane(plane);
     for (int i = 0; i < 3; ++i) out[i] = sideOf(s.corner(face, i));
     return !(out[0] != 0 && out[1] == out[0] && out[2] == out[0]);
   };
