@@ -318,7 +318,7 @@ double Fairing::solve(const Eigen::MatrixXd& delta, std::vector<Point3>& x) cons
   return std::sqrt(sum / double(std::max<std::size_t>(1, rows_.size())));
 }
 
-bool Fairing::biharmonic(std::vector<Point3>& x, double& residual, bool fromShape) {
+bool Fairing::firstBiharmonic(std::vector<Point3>& x, double& residual, bool fromShape) {
   residual = 0;
   if (patch_.size() == patch_.n) return true;  // nothing to place
   const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(Eigen::Index(rows_.size()), 3);
@@ -331,9 +331,17 @@ bool Fairing::biharmonic(std::vector<Point3>& x, double& residual, bool fromShap
   System& sys = *system_;
   sys.solver.analyzePattern(sys.normal);
   sys.solver.factorize(sys.normal);
-  if (sys.solver.info() != Eigen::Success || solve(zero, x) < 0) return false;
-  // Then the weights of each shape in turn: the same pattern and ordering,
-  // the numbers factorised again.
+  if (sys.solver.info() != Eigen::Success) return false;
+  residual = solve(zero, x);
+  return residual >= 0;
+}
+
+bool Fairing::reweightBiharmonic(std::vector<Point3>& x, double& residual) {
+  if (patch_.size() == patch_.n) return true;  // nothing to place
+  // The weights of each shape in turn: the same pattern and ordering, the
+  // numbers factorised again.
+  System& sys = *system_;
+  const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(Eigen::Index(rows_.size()), 3);
   for (int pass = 0; pass < kReweightings; ++pass) {
     assemble(x, weightsAt(x));
     sys.solver.factorize(sys.normal);

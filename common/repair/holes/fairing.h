@@ -122,7 +122,13 @@ class Fairing {
   // patch in its domain (or, `fromShape`, where x has it), then twice with
   // those of the shape the last solve gave (kReweightings): one ordering
   // and symbolic analysis, the numbers factorised for each weight set.
-  bool biharmonic(std::vector<Point3>& x, double& residual, bool fromShape = false);
+  bool biharmonic(std::vector<Point3>& x, double& residual, bool fromShape = false) {
+    return firstBiharmonic(x, residual, fromShape) && reweightBiharmonic(x, residual);
+  }
+  // Its stages: the first solve (the system analysed and factorised), and
+  // the solves with the weights of each shape in turn.
+  bool firstBiharmonic(std::vector<Point3>& x, double& residual, bool fromShape = false);
+  bool reweightBiharmonic(std::vector<Point3>& x, double& residual);
   // The paper's: the Laplacians the model predicts at each row's vertex
   // (-4 A H n), a few rounds (normals and areas from the last shape); the
   // biharmonic shape first, with its system (factorised once for both).

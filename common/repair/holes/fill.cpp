@@ -438,12 +438,28 @@ class HoleFiller {
              HoleFairing& shaped, std::string& why) {
     const auto clock = Clock::now();
     shaped = mode;
-    bool ok = fairOnce(c, mode, x, residual, shaped, false);
     // The domain sized the triangles; where the shape in space stretches
     // them far beyond that, the patch is refined there and shaped again,
-    // from where it is (the flat placement follows the splits).
-    if (ok && smoothWithTangents(mode) &&
-        refineStretched(c.patch, x, c.flat, meanEdge_, kMaxStretch, forbidden()) > 0) {
+    // from where it is (the flat placement follows the splits). The
+    // biharmonic shape is looked at after its first solve too: a patch that
+    // is refined then is not reweighted before.
+    auto refine = [&] {
+      return refineStretched(c.patch, x, c.flat, meanEdge_, kMaxStretch, forbidden()) > 0;
+    };
+    bool ok, refined = false;
+    if (mode == HoleFairing::Biharmonic) {
+      if (!c.fairing) c.fairing = std::make_unique<Fairing>(c.patch, rim_);
+      ok = c.fairing->firstBiharmonic(x, residual);
+      refined = ok && refine();
+      if (ok && !refined) {
+        ok = c.fairing->reweightBiharmonic(x, residual);
+        refined = ok && refine();
+      }
+    } else {
+      ok = fairOnce(c, mode, x, residual, shaped, false);
+      refined = ok && smoothWithTangents(mode) && refine();
+    }
+    if (refined) {
       c.fairing.reset();
       ok = fairOnce(c, mode, x, residual, shaped, true);
     }
