@@ -34,28 +34,43 @@ using Solver = Eigen::SimplicialLDLT<Sparse, Eigen::Lower>;
 
 // The lower triangle of a symmetric pattern over `size` unknowns, from
 // the pairs (row >= column) it holds (repeats allowed): bucketed by
-// column, each column's few rows then sorted.
-Sparse lowerPattern(std::size_t size, const std::vector<std::pair<int, int>>& pairs) {
+// column, each column's distinct rows then sorted. `slots`, if given, gets
+// where each pair is in the values.
+Sparse lowerPattern(std::size_t size, const std::vector<std::pair<int, int>>& pairs,
+                    std::vector<int>* slots = nullptr) {
   std::vector<int> start(size + 1, 0);
   for (const auto& [row, column] : pairs) ++start[std::size_t(column) + 1];
   for (std::size_t c = 0; c < size; ++c) start[c + 1] += start[c];
-  std::vector<int> rows(pairs.size());
+  std::vector<int> byColumn(pairs.size());  // pair indices, bucketed by column
   {
     std::vector<int> fill(start.begin(), start.end() - 1);
-    for (const auto& [row, column] : pairs) rows[std::size_t(fill[std::size_t(column)]++)] = row;
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      byColumn[std::size_t(fill[std::size_t(pairs[p].second)]++)] = int(p);
   }
   Sparse m(static_cast<Eigen::Index>(size), static_cast<Eigen::Index>(size));
   m.resizeNonZeros(Eigen::Index(pairs.size()));
   int* outer = m.outerIndexPtr();
   int* inner = m.innerIndexPtr();
+  if (slots) slots->assign(pairs.size(), 0);
+  std::vector<int> at(size, -1);  // a row's slot in the column at hand
   int count = 0;
   outer[0] = 0;
   for (std::size_t c = 0; c < size; ++c) {
-    int* begin = rows.data() + start[c];
-    int* end = rows.data() + start[c + 1];
-    std::sort(begin, end);
-    end = std::unique(begin, end);
-    for (const int* r = begin; r != end; ++r) inner[count++] = *r;
+    int* const first = inner + count;
+    int* last = first;
+    for (int k = start[c]; k < start[c + 1]; ++k) {
+      const int row = pairs[std::size_t(byColumn[std::size_t(k)])].first;
+      if (at[std::size_t(row)] < 0) at[std::size_t(row)] = 0, *last++ = row;
+    }
+    std::sort(first, last);
+    for (int* r = first; r != last; ++r) at[std::size_t(*r)] = int(r - inner);
+    if (slots)
+      for (int k = start[c]; k < start[c + 1]; ++k) {
+        const int p = byColumn[std::size_t(k)];
+        (*slots)[std::size_t(p)] = at[std::size_t(pairs[std::size_t(p)].first)];
+      }
+    for (int* r = first; r != last; ++r) at[std::size_t(*r)] = -1;
+    count = int(last - inner);
     outer[c + 1] = count;
   }
   m.resizeNonZeros(count);
@@ -258,23 +273,25 @@ void Fairing::assemble(const std::vector<Point3>& x, const std::vector<TriangleW
     if (symbolic) sys.start.push_back(int(sys.key.size()));
   }
   if (symbolic) {
-    // The pattern of A^T A: every pair of unknowns that share a row.
+    // The pattern of A^T A: every pair of unknowns that share a row; each
+    // product of two of a row's coefficients adds to that pair's entry.
     std::vector<std::pair<int, int>> pairs;
-    for (std::size_t r = 0; r < rows_.size(); ++r)
+    std::vector<int> unknown;  // a row's entries on unknowns
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      unknown.clear();
       for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
-        for (int j = sys.start[r]; j < sys.start[r + 1]; ++j)
-          if (sys.key[std::size_t(i)] >= first &&
-              sys.key[std::size_t(j)] >= sys.key[std::size_t(i)])
-            pairs.push_back({sys.key[std::size_t(j)] - first, sys.key[std::size_t(i)] - first});
-    sys.normal = lowerPattern(unknowns, pairs);
-    // Where each product of two of a row's coefficients goes in A^T A.
-    for (std::size_t r = 0; r < rows_.size(); ++r)
-      for (int i = sys.start[r]; i < sys.start[r + 1]; ++i)
-        for (int j = sys.start[r]; j < sys.start[r + 1]; ++j) {
+        if (sys.key[std::size_t(i)] >= first) unknown.push_back(i);
+      for (int i : unknown)
+        for (int j : unknown) {
           const int a = sys.key[std::size_t(i)], b = sys.key[std::size_t(j)];
-          if (a >= first && b >= a)
-            sys.products.push_back({i, j, slotOf(sys.normal, b - first, a - first)});
+          if (b < a) continue;
+          pairs.push_back({b - first, a - first});
+          sys.products.push_back({i, j, 0});
         }
+    }
+    std::vector<int> slots;
+    sys.normal = lowerPattern(unknowns, pairs, &slots);
+    for (std::size_t p = 0; p < slots.size(); ++p) sys.products[p][2] = slots[p];
   }
   double* values = sys.normal.valuePtr();
   std::fill(values, values + sys.normal.nonZeros(), 0.0);
