@@ -106,8 +106,13 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCe
       bounds_.lo[k] = std::min(bounds_.lo[k], b.lo[k]);
       bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
     }
-  for (int k = 0; k < 3; ++k)
-    cellsPerUnit_[k] = 1 / std::max((bounds_.hi[k] - bounds_.lo[k]) / kCells, 1e-30f);
+  // Cubic cells, kCells along the longest axis: a box grown around a flat
+  // band of faces (a shallow intersection curve) then spans a few cells
+  // across the band, where with kCells along each axis it spanned dozens.
+  float longest = 0;
+  for (int k = 0; k < 3; ++k) longest = std::max(longest, bounds_.hi[k] - bounds_.lo[k]);
+  for (int k = 0; k < 3; ++k) cellsPerUnit_[k] = 1 / std::max(longest / kCells, 1e-30f);
+  std::vector<std::array<int, 3>> filled;  // each occupied cell once
   for (const Box& b : boxes) {
     int lo[3], hi[3];
     for (int k = 0; k < 3; ++k) cellRange(b, k, lo[k], hi[k]);
@@ -118,6 +123,7 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCe
           if (at == kEmpty) {
             at = std::uint32_t(cellBoxes_.size());
             cellBoxes_.push_back(b);
+            filled.push_back({x, y, z});
           } else {
             grow(cellBoxes_[at], b);
           }
@@ -129,15 +135,11 @@ BoxGrid::BoxGrid(const std::vector<Box>& boxes) : cellBox_(kCells * kCells * kCe
   for (int d = 0; d < 8; ++d)
     for (int m = 0; m < 8; ++m) containing[d] |= std::uint8_t(((m & d) == d) << m);
   blocks_.assign(cellBox_.size(), 0);
-  for (int x = 0; x < kCells; ++x)
-    for (int y = 0; y < kCells; ++y)
-      for (int z = 0; z < kCells; ++z) {
-        if (!occupied(x, y, z)) continue;
-        for (int d = 0; d < 8; ++d) {
-          const int bx = x - (d & 1), by = y - (d >> 1 & 1), bz = z - (d >> 2 & 1);
-          if (bx >= 0 && by >= 0 && bz >= 0) blocks_[index(bx, by, bz)] |= containing[d];
-        }
-      }
+  for (const auto& [x, y, z] : filled)
+    for (int d = 0; d < 8; ++d) {
+      const int bx = x - (d & 1), by = y - (d >> 1 & 1), bz = z - (d >> 2 & 1);
+      if (bx >= 0 && by >= 0 && bz >= 0) blocks_[index(bx, by, bz)] |= containing[d];
+    }
 }
 
 bool BoxGrid::inside(const Box& b) const {
