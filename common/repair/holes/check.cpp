@@ -37,13 +37,25 @@ std::size_t patchIntersections(const Surface& s, const std::vector<Triangle>& pa
   std::vector<Box> boxes;
   boxes.reserve(checked.size());
   Box bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  Point3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);  // the points'
   for (const Checked& c : checked) {
     boxes.push_back(boxOf(c.points[0], c.points[1], c.points[2]));
     for (int k = 0; k < 3; ++k) {
       bounds.lo[k] = std::min(bounds.lo[k], boxes.back().lo[k]);
       bounds.hi[k] = std::max(bounds.hi[k], boxes.back().hi[k]);
+      for (const Point3& q : c.points) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
     }
   }
+  // A face with all its corners beyond one side of the checked faces'
+  // points meets none of them (most of the faces near a hole): turned away
+  // before its box is rounded out to float.
+  auto beyond = [&](const TrianglePoints& p) {
+    for (int k = 0; k < 3; ++k)
+      if ((p[0][k] < lo[k] && p[1][k] < lo[k] && p[2][k] < lo[k]) ||
+          (p[0][k] > hi[k] && p[1][k] > hi[k] && p[2][k] > hi[k]))
+        return true;
+    return false;
+  };
   const BoxTree tree(boxes);
   std::atomic<std::size_t> pairs{0};
   tree.selfPairs([&](std::uint32_t i, std::uint32_t j, unsigned) {
@@ -56,6 +68,7 @@ std::size_t patchIntersections(const Surface& s, const std::vector<Triangle>& pa
     if (ownSet.count(f)) continue;
     const Triangle t = s.corners(f);
     const TrianglePoints p{point(t[0]), point(t[1]), point(t[2])};
+    if (beyond(p)) continue;
     const Box box = boxOf(p[0], p[1], p[2]);
     if (!overlap(box, bounds)) continue;
     tree.query(box, 0, [&](std::uint32_t i, unsigned) {
