@@ -199,6 +199,47 @@ TEST(BoxGrid, FacesTouchingAcrossAnExtentPastFloat) {
   EXPECT_EQ(grid.facesTouching(points, triangles, std::vector<char>(3, 0)), expected);
 }
 
+// Boxes in a thin slab (10 x 10 x 0.3, as around a shallow intersection
+// curve; the cells are cubes, so the slab has few along z): a face whose box
+// overlaps one of them touches the grid, and the faces touching it are
+// those whose boxes touch it.
+TEST(BoxGrid, FacesTouchingInAThinSlab) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> inside(0, 10), thin(0, 0.3), around(-1, 11),
+      aroundThin(-0.2, 0.5), size(-0.2, 0.2);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 300; ++i) {
+    const Point3 a(inside(rng), inside(rng), thin(rng));
+    boxes.push_back(boxOf(a, a + Point3(0.1, 0.1, 0.01), a + Point3(0.1, 0, 0.005)));
+  }
+  const BoxGrid grid(boxes);
+  std::vector<Point3> points;
+  std::vector<Triangle> triangles;
+  int overlapping = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const int first = int(points.size());
+    const Point3 a(around(rng), around(rng), aroundThin(rng));
+    points.insert(points.end(), {a, a + Point3(size(rng), size(rng), size(rng) / 10),
+                                 a + Point3(size(rng), size(rng), size(rng) / 10)});
+    triangles.push_back({first, first + 1, first + 2});
+    const Box q = boxOf(points[first], points[first + 1], points[first + 2]);
+    bool overlaps = false;
+    for (const Box& b : boxes) overlaps |= overlap(b, q);
+    if (!overlaps) continue;
+    ++overlapping;
+    EXPECT_TRUE(grid.touches(q)) << i;
+  }
+  EXPECT_GT(overlapping, 50);
+  std::vector<std::uint32_t> expected;
+  for (std::uint32_t f = 0; f < triangles.size(); ++f) {
+    const Triangle& t = triangles[f];
+    if (grid.touches(boxOf(points[t[0]], points[t[1]], points[t[2]]))) expected.push_back(f);
+  }
+  EXPECT_LT(expected.size(), triangles.size() / 2);  // the grid turns most away
+  EXPECT_EQ(grid.facesTouching(points, triangles, std::vector<char>(triangles.size(), 0)),
+            expected);
+}
+
 // Boxes spanning one or two cells along each axis (most faces' boxes): a
 // box overlapping one of the grid's touches it, along whichever axes it
 // spans two cells, and a box more than two cells from all of them does not.
