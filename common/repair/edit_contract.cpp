@@ -56,7 +56,9 @@ EditContract checkEditContract(const Mesh& before, const Mesh& after,
   const std::vector<char> changed = changedFaces(before, after, P, T);
   if (options.as_float)
     for (Point3& p : P) p = roundedToFloat(p);
-  const InspectResult was = inspect(before), is = inspect(after);
+  InspectOptions counts;
+  counts.measures = false;  // the counts below, no measures
+  const InspectResult was = inspect(before, counts), is = inspect(after, counts);
   c.non_manifold_edges_before = was.non_manifold_edges;
   c.non_manifold_edges_after = is.non_manifold_edges;
   c.inconsistent_edges_before = was.orientation_inconsistent_edges;

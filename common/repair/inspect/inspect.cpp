@@ -72,7 +72,7 @@ class Inspector {
     r_.vertices = P_.size();
     r_.faces = T_.size();
     topology();
-    duplicatePoints();
+    if (options_.measures) duplicatePoints();
     geometry();
     return std::move(r_);
   }
@@ -279,13 +279,14 @@ class Inspector {
       const Triangle& t = T_[f];
       if (!finite[t[0]] || !finite[t[1]] || !finite[t[2]]) continue;  // no geometry to judge
       const Point3 &a = P_[t[0]], &b = P_[t[1]], &c = P_[t[2]];
-      volume6 += (a - center) * ((b - center) ^ (c - center));
       const bool repeated =
           t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || a == b || b == c || c == a;
       if (repeated || collinear(a, b, c)) {
         ++r_.degenerate_faces;
         markFace(f, kFaceDegenerate);
       }
+      if (!options_.measures) continue;
+      volume6 += (a - center) * ((b - center) ^ (c - center));
       if (a == b || b == c || c == a) continue;  // angles undefined
       const double shortest = std::sqrt(
           std::min({(b - a).SquaredNorm(), (c - b).SquaredNorm(), (a - c).SquaredNorm()}));

@@ -17,6 +17,11 @@ namespace meshmend {
 struct InspectOptions {
   bool mark_defects = false;        // fill InspectResult::face_defects / vertex_defects
   bool self_intersections = false;  // also count self-intersecting pairs (exact, slower)
+  // The measures: bounding box, angles, shortest edge, volume, duplicate
+  // points. Off, only the counts of the topology (edges, borders,
+  // components, non-manifold vertices, duplicate faces) and of non-finite
+  // vertices and degenerate faces are made: what the edit contracts check.
+  bool measures = true;
 };
 
 // Bits of InspectResult::face_defects.

@@ -275,6 +275,13 @@ void measureOutput(Removal& w) {
 // with asFloat): the failures, one item each; empty when it holds.
 // `closed`: it must have no border edge; `degenerateAllowed`: collinear
 // faces the input brought. Sets remaining/verified when `countPairs`.
+// What the contract checks of a mesh's shape: counts, no measures.
+const InspectOptions kCounts = [] {
+  InspectOptions o;
+  o.measures = false;
+  return o;
+}();
+
 std::vector<std::string> contractFailures(const Mesh& mesh, bool asFloat, bool countPairs,
                                           bool closed, std::size_t degenerateAllowed,
                                           const Progress& progress,
@@ -286,7 +293,7 @@ std::vector<std::string> contractFailures(const Mesh& mesh, bool asFloat, bool c
         "the orientation: Filters > Normals > Invert Faces Orientation)");
     return failures;
   }
-  const InspectResult shape = inspect(mesh);
+  const InspectResult shape = inspect(mesh, kCounts);
   auto fail = [&](std::size_t n, const char* what) {
     if (n > 0) failures.push_back(std::to_string(n) + " " + what);
   };
@@ -363,7 +370,7 @@ bool nothingToRemove(const Mesh& input, const SelfIntersectionResult& r,
                      const SelfIntersectionOptions& options) {
   if (r.intersecting_pairs_before > 0 || r.faces_removed > 0 || r.vertices_separated > 0)
     return false;
-  const InspectResult shape = inspect(input);
+  const InspectResult shape = inspect(input, kCounts);
   return contractFailures(input, options.round_to_float, true,
                           r.input_closed && r.fin_edges_before == 0, shape.degenerate_faces,
                           options.progress)

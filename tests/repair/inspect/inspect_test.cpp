@@ -154,6 +154,36 @@ TEST(Inspect, SoupDefectsAreCounted) {
   EXPECT_FALSE(r.vertex_defects[0] & kVertexDuplicate);  // the first one is not the duplicate
 }
 
+// Without the measures (what the edit contracts ask for) the counts are
+// those of the full inspection, and the measures are not made.
+TEST(Inspect, CountsWithoutMeasuresAreTheSame) {
+  std::vector<Point3> p = positionsOf(tetrahedron());
+  p.emplace_back(0.5, 0, 0);  // 4: on edge (0,1)
+  p.emplace_back(0, 0, 0);    // 5: duplicate of 0
+  p.emplace_back(1, 1, -1);   // 6
+  std::vector<Triangle> t = trianglesOf(tetrahedron());
+  t.push_back({0, 4, 1});  // collinear
+  t.push_back({0, 1, 6});  // a fin on edge (0,1)
+  t.push_back({5, 2, 6});
+  const Mesh mesh = makeMesh(p, t);
+  InspectOptions counts;
+  counts.measures = false;
+  const InspectResult all = inspect(mesh), some = inspect(mesh, counts);
+  EXPECT_GT(all.non_manifold_edges, 0u);
+  EXPECT_GT(all.border_edges, 0u);
+  EXPECT_EQ(all.degenerate_faces, 1u);
+  EXPECT_EQ(all.duplicate_points, 1u);
+  EXPECT_GT(all.mean_min_angle_deg, 0);
+  EXPECT_EQ(some.non_manifold_edges, all.non_manifold_edges);
+  EXPECT_EQ(some.non_manifold_vertices, all.non_manifold_vertices);
+  EXPECT_EQ(some.orientation_inconsistent_edges, all.orientation_inconsistent_edges);
+  EXPECT_EQ(some.border_edges, all.border_edges);
+  EXPECT_EQ(some.connected_components, all.connected_components);
+  EXPECT_EQ(some.degenerate_faces, all.degenerate_faces);
+  EXPECT_EQ(some.duplicate_points, 0u);  // not looked for
+  EXPECT_EQ(some.mean_min_angle_deg, 0);  // no angles measured
+}
+
 TEST(Inspect, NearlyCollinearFaceIsNotDegenerate) {
   // The third point is off the line by one unit in the last place: only an
   // exact test tells it apart from collinear.
