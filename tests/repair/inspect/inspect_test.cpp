@@ -180,7 +180,7 @@ TEST(Inspect, CountsWithoutMeasuresAreTheSame) {
   EXPECT_EQ(some.border_edges, all.border_edges);
   EXPECT_EQ(some.connected_components, all.connected_components);
   EXPECT_EQ(some.degenerate_faces, all.degenerate_faces);
-  EXPECT_EQ(some.duplicate_points, 0u);  // not looked for
+  EXPECT_EQ(some.duplicate_points, 0u);   // not looked for
   EXPECT_EQ(some.mean_min_angle_deg, 0);  // no angles measured
 }
 
